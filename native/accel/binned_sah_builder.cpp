@@ -1,0 +1,218 @@
+// Binned SAH builder. Each range is binned along all three axes by centroid, the best of the
+// bins - 1 planes per axis is taken if it beats making a leaf, and the two halves are built in
+// parallel once they are large. Large ranges are also binned in parallel (a TBB reduction).
+#include "accel/binned_sah_builder.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+
+namespace toyrt {
+namespace {
+
+constexpr int kMaxBins = 64;
+// Below this depth binning decides splits; past it, median splits halve the range, so the depth
+// stays under kMaxBvhDepth even for adversarial inputs (2^32 primitives need 32 more levels).
+constexpr int kMedianSplitDepth = kMaxBvhDepth - 34;
+
+struct RangeBounds {
+  BBox box;      // of the primitives
+  BBox centers;  // of their centroids
+  void extend(const RangeBounds& o) { box.extend(o.box); centers.extend(o.centers); }
+};
+
+struct Bins {
+  std::array<BBox, 3 * kMaxBins> box;
+  std::array<uint32_t, 3 * kMaxBins> count{};
+  void merge(const Bins& o, int bins) {
+    for (int i = 0; i < 3 * bins; ++i) { box[i].extend(o.box[i]); count[i] += o.count[i]; }
+  }
+};
+
+class Builder {
+ public:
+  Builder(const BBox* bounds, const Vec3* centers, size_t count, const BinnedSahConfig& cfg)
+      : bounds_(bounds), centers_(centers), cfg_(cfg), ids_(count), nodes_(2 * count - 1) {
+    cfg_.bins = std::clamp(cfg_.bins, 2, kMaxBins);
+    cfg_.max_leaf = std::max(cfg_.max_leaf, 1u);
+    for (size_t i = 0; i < count; ++i) ids_[i] = uint32_t(i);
+  }
+
+  Bvh run() {
+    const RangeBounds root = range_bounds(0, ids_.size());
+    next_node_ = 1;
+    build(0, 0, ids_.size(), root, 1);
+    return flatten();
+  }
+
+ private:
+  RangeBounds range_bounds(size_t begin, size_t end) const {
+    auto accumulate = [&](const tbb::blocked_range<size_t>& r, RangeBounds acc) {
+      for (size_t i = r.begin(); i != r.end(); ++i) {
+        acc.box.extend(bounds_[ids_[i]]);
+        acc.centers.extend(centers_[ids_[i]]);
+      }
+      return acc;
+    };
+    if (end - begin < cfg_.parallel_threshold) return accumulate({begin, end}, RangeBounds{});
+    return tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(begin, end, 4096), RangeBounds{}, accumulate,
+        [](RangeBounds a, const RangeBounds& b) { a.extend(b); return a; });
+  }
+
+  int bin_of(const Vec3& c, int axis, const BBox& centers, const Vec3& scale) const {
+    const int k = int((c[axis] - centers.lo[axis]) * scale[axis]);
+    return std::clamp(k, 0, cfg_.bins - 1);
+  }
+
+  Vec3 bin_scale(const BBox& centers) const {
+    const Vec3 e = centers.extent();
+    // (1 - eps) keeps the largest centroid in the last bin rather than one past it.
+    const float s = float(cfg_.bins) * (1.0f - 1e-6f);
+    return {e.x > 0 ? s / e.x : 0.0f, e.y > 0 ? s / e.y : 0.0f, e.z > 0 ? s / e.z : 0.0f};
+  }
+
+  Bins bin_range(size_t begin, size_t end, const BBox& centers, const Vec3& scale) const {
+    auto accumulate = [&](const tbb::blocked_range<size_t>& r, Bins bins) {
+      for (size_t i = r.begin(); i != r.end(); ++i) {
+        const uint32_t p = ids_[i];
+        for (int a = 0; a < 3; ++a) {
+          const int k = a * kMaxBins + bin_of(centers_[p], a, centers, scale);
+          bins.box[k].extend(bounds_[p]);
+          ++bins.count[k];
+        }
+      }
+      return bins;
+    };
+    if (end - begin < cfg_.parallel_threshold) return accumulate({begin, end}, Bins{});
+    return tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(begin, end, 4096), Bins{}, accumulate,
+        [&](Bins a, const Bins& b) { a.merge(b, kMaxBins); return a; });
+  }
+
+  struct Split {
+    int axis = -1;
+    int bin = 0;  // primitives in bins <= bin go left
+    float cost = kInfinity;
+  };
+
+  Split find_split(const Bins& bins, const BBox& box, size_t n) const {
+    Split best;
+    const float inv_area = 1.0f / std::max(box.half_area(), 1e-30f);
+    std::array<float, kMaxBins> right_cost;
+    for (int a = 0; a < 3; ++a) {
+      const int base = a * kMaxBins;
+      BBox acc;
+      uint32_t cnt = 0;
+      for (int i = cfg_.bins - 1; i > 0; --i) {  // right side holds bins i .. bins-1
+        acc.extend(bins.box[base + i]);
+        cnt += bins.count[base + i];
+        right_cost[i] = cnt ? acc.half_area() * float(cnt) : kInfinity;
+      }
+      acc = BBox{};
+      cnt = 0;
+      for (int i = 0; i < cfg_.bins - 1; ++i) {  // left side holds bins 0 .. i
+        acc.extend(bins.box[base + i]);
+        cnt += bins.count[base + i];
+        if (cnt == 0 || cnt == n) continue;
+        const float cost = cfg_.traversal_cost +
+                           cfg_.intersection_cost * inv_area * (acc.half_area() * float(cnt) + right_cost[i + 1]);
+        if (cost < best.cost) best = {a, i, cost};
+      }
+    }
+    return best;
+  }
+
+  void make_leaf(uint32_t node, size_t begin, size_t end) {
+    nodes_[node].first = uint32_t(begin);
+    nodes_[node].count = uint32_t(end - begin);
+  }
+
+  void build(uint32_t node, size_t begin, size_t end, const RangeBounds& rb, int depth) {
+    nodes_[node].set_bbox(rb.box);
+    const size_t n = end - begin;
+    if (n == 1) return make_leaf(node, begin, end);
+
+    size_t mid = begin;
+    const Vec3 extent = rb.centers.extent();
+    const bool coincident = extent.x <= 0 && extent.y <= 0 && extent.z <= 0;
+    Split split;
+    if (!coincident && depth < kMedianSplitDepth) {
+      const Vec3 scale = bin_scale(rb.centers);
+      split = find_split(bin_range(begin, end, rb.centers, scale), rb.box, n);
+      const float leaf_cost = cfg_.intersection_cost * float(n);
+      if (n <= cfg_.max_leaf && leaf_cost <= split.cost) return make_leaf(node, begin, end);
+      if (split.axis >= 0) {
+        auto left_of = [&](uint32_t p) { return bin_of(centers_[p], split.axis, rb.centers, scale) <= split.bin; };
+        mid = size_t(std::partition(ids_.begin() + begin, ids_.begin() + end, left_of) - ids_.begin());
+      }
+    } else if (n <= cfg_.max_leaf) {
+      return make_leaf(node, begin, end);
+    }
+    if (mid == begin || mid == end) {
+      // No usable plane (coincident centroids, or too deep): split at the median of the widest
+      // centroid axis, which always halves the range.
+      mid = begin + n / 2;
+      const int axis = max_dimension(extent);
+      std::nth_element(ids_.begin() + begin, ids_.begin() + mid, ids_.begin() + end,
+                       [&](uint32_t a, uint32_t b) { return centers_[a][axis] < centers_[b][axis]; });
+    }
+
+    const uint32_t left = next_node_.fetch_add(2);
+    nodes_[node].first = left;
+    nodes_[node].count = 0;
+    auto build_left = [&] { build(left, begin, mid, range_bounds(begin, mid), depth + 1); };
+    auto build_right = [&] { build(left + 1, mid, end, range_bounds(mid, end), depth + 1); };
+    if (n >= cfg_.parallel_threshold) {
+      tbb::parallel_invoke(build_left, build_right);
+    } else {
+      build_left();
+      build_right();
+    }
+  }
+
+  // Re-lays the nodes in depth-first order, children pairs adjacent. Parallel builds allocate
+  // node slots in whatever order tasks ran; this makes the layout, and so every traversal
+  // result including ties, independent of the thread count, and keeps subtrees close in memory.
+  Bvh flatten() const {
+    Bvh bvh;
+    bvh.prim_ids = ids_;
+    bvh.nodes.reserve(next_node_);
+    bvh.nodes.push_back(nodes_[0]);
+    std::vector<std::pair<uint32_t, uint32_t>> stack{{0u, 0u}};  // (old index, new index)
+    while (!stack.empty()) {
+      auto [old_index, new_index] = stack.back();
+      stack.pop_back();
+      const Node& n = nodes_[old_index];
+      if (n.is_leaf()) continue;
+      const uint32_t child = uint32_t(bvh.nodes.size());
+      bvh.nodes.push_back(nodes_[n.first]);
+      bvh.nodes.push_back(nodes_[n.first + 1]);
+      bvh.nodes[new_index].first = child;
+      stack.push_back({n.first + 1, child + 1});
+      stack.push_back({n.first, child});
+    }
+    return bvh;
+  }
+
+  const BBox* bounds_;
+  const Vec3* centers_;
+  BinnedSahConfig cfg_;
+  std::vector<uint32_t> ids_;
+  std::vector<Node> nodes_;
+  std::atomic<uint32_t> next_node_{0};
+};
+
+}  // namespace
+
+Bvh build_binned_sah(const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
+                     const BinnedSahConfig& config) {
+  if (count == 0) return {};
+  return Builder(prim_bounds, prim_centers, count, config).run();
+}
+
+}  // namespace toyrt

@@ -1,0 +1,24 @@
+// Top-down BVH builder with the surface area heuristic evaluated over bins of centroids
+// (Wald 2007, "On fast construction of SAH-based bounding volume hierarchies"). Works on any
+// primitives given their boxes and centres: triangles for a mesh, instances for the top level.
+#pragma once
+
+#include "accel/bvh.h"
+
+namespace toyrt {
+
+struct BinnedSahConfig {
+  int bins = 32;                  // candidate split planes per axis are bins - 1
+  uint32_t max_leaf = 8;          // ranges larger than this are always split
+  float traversal_cost = 1.0f;    // cost of one node visit relative to one primitive test
+  float intersection_cost = 1.0f;
+  size_t parallel_threshold = 8192;  // ranges at least this large are binned and split in parallel
+};
+
+// Builds over `count` primitives. Runs on the calling thread's TBB arena, so the caller chooses
+// the thread count. The result does not depend on the thread count: nodes are laid out in
+// depth-first order after the build.
+Bvh build_binned_sah(const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
+                     const BinnedSahConfig& config = {});
+
+}  // namespace toyrt

@@ -1,0 +1,34 @@
+// The bounding volume hierarchy as plain data: a flat node array (root at 0, children of a node
+// adjacent) and the primitive order its leaves index. Builders produce it (binned_sah_builder.h,
+// and the LBVH in kernels/), traversal reads it (traverse.h); nothing else owns it.
+#pragma once
+
+#include "accel/node.h"
+
+#include <string>
+#include <vector>
+
+namespace toyrt {
+
+// Traversal keeps an explicit stack of this many entries; builders never exceed this depth.
+inline constexpr int kMaxBvhDepth = 96;
+
+struct Bvh {
+  std::vector<Node> nodes;
+  std::vector<uint32_t> prim_ids;  // leaf slots -> primitive index in the builder's input
+
+  bool empty() const { return nodes.empty(); }
+
+  // Expected cost of a random ray (surface area heuristic, traversal and intersection cost 1):
+  // the figure of merit builders are compared by.
+  double sah_cost(double traversal_cost = 1.0, double intersection_cost = 1.0) const;
+  int depth() const;
+  size_t leaf_count() const;
+
+  // Checks the structural invariants against the primitives' bounds: every primitive in exactly
+  // one leaf, every child box inside its parent, every primitive inside its leaf, depth within
+  // kMaxBvhDepth. Returns an empty string when all hold, else what failed.
+  std::string validate(const BBox* prim_bounds, size_t prim_count) const;
+};
+
+}  // namespace toyrt

@@ -1,0 +1,54 @@
+// A triangle mesh stored once in object space, with its own BVH; instances refer to it by id.
+#pragma once
+
+#include "accel/binned_sah_builder.h"
+#include "geometry/triangle.h"
+
+#include <vector>
+
+namespace toyrt {
+
+using Triangle = glm::u32vec3;  // vertex indices
+
+class Mesh {
+ public:
+  // Validates and takes the data. Throws std::invalid_argument on a non-finite vertex or an index
+  // out of range. Degenerate triangles (two equal vertices, or exactly collinear) are kept in
+  // the mesh, so triangle indices stay those of the input, but left out of the BVH: no ray can hit
+  // a triangle of zero area.
+  Mesh(std::vector<Vec3> vertices, std::vector<Triangle> triangles);
+
+  // Builds (or rebuilds) the BVH; runs on the caller's TBB arena.
+  void build(const BinnedSahConfig& config = {});
+  bool built() const { return built_; }
+
+  // Closest hit within [tnear, tfar): shrinks tfar and writes u, v, prim on a hit.
+  bool intersect(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v,
+                 int32_t& prim) const;
+  // Any hit within [tnear, tfar).
+  bool occluded(const Vec3& org, const Vec3& dir, float tnear, float tfar) const;
+
+  const std::vector<Vec3>& vertices() const { return vertices_; }
+  const std::vector<Triangle>& triangles() const { return triangles_; }
+  const Bvh& bvh() const { return bvh_; }
+  const BBox& bounds() const { return bounds_; }
+  size_t degenerate_count() const { return triangles_.size() - bvh_.prim_ids.size(); }
+  // Bytes held by this mesh (input arrays, BVH and leaf triangles).
+  size_t memory_bytes() const;
+
+ private:
+  template <bool AnyHit>
+  bool trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v,
+             int32_t& prim) const;
+
+  std::vector<Vec3> vertices_;
+  std::vector<Triangle> triangles_;
+  Bvh bvh_;
+  // Per BVH leaf slot: the triangle's vertices, so a leaf test reads one contiguous block
+  // (bvh_.prim_ids holds the slot's index in triangles_).
+  std::vector<TriangleVerts> leaf_triangles_;
+  BBox bounds_;
+  bool built_ = false;
+};
+
+}  // namespace toyrt

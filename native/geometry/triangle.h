@@ -1,0 +1,88 @@
+// Watertight ray/triangle intersection (Woop, Benthin and Wald 2013, "Watertight Ray/Triangle
+// Intersection", JCGT 2(1)). The ray is turned into a shear along its dominant axis, so every
+// edge test is a 2D orientation test of the same translated vertices; a shared edge gets the
+// same value of the same expression from both of its triangles, so a ray through an edge or a
+// vertex cannot slip between them. Exact zeros are recomputed in double precision, as the paper
+// does, so the sign of an edge function is never decided by a rounding.
+#pragma once
+
+#include "core/math.h"
+
+#include <utility>
+
+namespace toyrt {
+
+// The three vertices of one triangle, as a leaf stores them (36 bytes, no index indirection).
+struct TriangleVerts {
+  Vec3 p0, p1, p2;
+};
+
+// Per-ray constants of the shear transform, computed once per traversal.
+struct WatertightRay {
+  Vec3 org;
+  int kx, ky, kz;      // axis permutation: kz is the dominant direction axis
+  float sx, sy, sz;    // shear and scale that map the direction to (0, 0, 1)
+};
+
+inline WatertightRay make_watertight_ray(const Vec3& org, const Vec3& dir) {
+  WatertightRay r;
+  r.org = org;
+  r.kz = max_dimension(glm::abs(dir));
+  r.kx = (r.kz + 1) % 3;
+  r.ky = (r.kx + 1) % 3;
+  // Swapping x and y when the dominant component is negative keeps the winding, so the sign
+  // convention of U, V, W does not depend on the ray's direction.
+  if (dir[r.kz] < 0.0f) std::swap(r.kx, r.ky);
+  r.sx = dir[r.kx] / dir[r.kz];
+  r.sy = dir[r.ky] / dir[r.kz];
+  r.sz = 1.0f / dir[r.kz];
+  return r;
+}
+
+// Tests the triangle against the ray segment [tnear, tfar). On a hit, writes t and the
+// barycentrics u, v with p = (1 - u - v) p0 + u p1 + v p2, and returns true. Both faces count.
+// A degenerate (zero-area) triangle never hits: its determinant is zero.
+inline bool intersect_triangle(const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2,
+                               float tnear, float tfar, float& t, float& u, float& v) {
+  const Vec3 a = p0 - r.org, b = p1 - r.org, c = p2 - r.org;
+  const float ax = a[r.kx] - r.sx * a[r.kz], ay = a[r.ky] - r.sy * a[r.kz];
+  const float bx = b[r.kx] - r.sx * b[r.kz], by = b[r.ky] - r.sy * b[r.kz];
+  const float cx = c[r.kx] - r.sx * c[r.kz], cy = c[r.ky] - r.sy * c[r.kz];
+
+  // Scaled barycentrics: U weights p0, V weights p1, W weights p2.
+  float eu = cx * by - cy * bx;
+  float ev = ax * cy - ay * cx;
+  float ew = bx * ay - by * ax;
+  if (eu == 0.0f || ev == 0.0f || ew == 0.0f) {
+    // The float products may have cancelled: decide the edge signs exactly. Products of two
+    // floats are exact in double, and a correctly rounded difference keeps the exact sign (and
+    // is zero only when the products are equal), so these signs are the true ones.
+    const double du = double(cx) * double(by) - double(cy) * double(bx);
+    const double dv = double(ax) * double(cy) - double(ay) * double(cx);
+    const double dw = double(bx) * double(ay) - double(by) * double(ax);
+    if ((du < 0.0 || dv < 0.0 || dw < 0.0) && (du > 0.0 || dv > 0.0 || dw > 0.0)) return false;
+    eu = static_cast<float>(du);
+    ev = static_cast<float>(dv);
+    ew = static_cast<float>(dw);
+  } else if ((eu < 0.0f || ev < 0.0f || ew < 0.0f) && (eu > 0.0f || ev > 0.0f || ew > 0.0f)) {
+    return false;
+  }
+
+  const float det = eu + ev + ew;
+  if (det == 0.0f) return false;
+
+  const float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
+  const float scaled_t = eu * az + ev * bz + ew * cz;
+  // Compare in the scaled domain to avoid the division for rejected hits.
+  const float abs_det = std::fabs(det);
+  const float signed_t = det < 0.0f ? -scaled_t : scaled_t;
+  if (!(signed_t >= tnear * abs_det) || !(signed_t < tfar * abs_det)) return false;
+
+  const float inv_det = 1.0f / det;
+  t = scaled_t * inv_det;
+  u = ev * inv_det;
+  v = ew * inv_det;
+  return true;
+}
+
+}  // namespace toyrt

@@ -1,0 +1,321 @@
+// The Python module `toyrt`: a thin binding that checks and converts numpy arrays, releases the
+// GIL, and calls the core. Every misuse raises a Python exception naming what is wrong.
+#include "geometry/offset_ray.h"
+#include "scene/scene.h"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstring>
+#include <mutex>
+#include <shared_mutex>
+#include <string>
+
+namespace py = pybind11;
+using namespace toyrt;
+
+namespace {
+
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+
+std::string shape_of(const py::array& a) {
+  std::string s = "(";
+  for (py::ssize_t i = 0; i < a.ndim(); ++i) s += (i ? ", " : "") + std::to_string(a.shape(i));
+  return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+// Any array-like of numbers becomes a C-contiguous float32 array of shape (N, 3).
+FloatArray as_points(py::handle obj, const char* name) {
+  py::array a;
+  try {
+    a = py::array::ensure(obj);
+  } catch (const py::error_already_set&) {
+  }
+  if (!a) throw py::type_error(std::string(name) + " must be an array of shape (N, 3)");
+  const char kind = a.dtype().kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u')
+    throw py::type_error(std::string(name) + " must hold numbers, not dtype " + std::string(py::str(a.dtype())));
+  if (a.ndim() != 2 || a.shape(1) != 3)
+    throw py::value_error(std::string(name) + " must have shape (N, 3), got " + shape_of(a));
+  return FloatArray::ensure(a);
+}
+
+std::vector<Vec3> to_vec3s(const FloatArray& a) {
+  std::vector<Vec3> out(size_t(a.shape(0)));
+  if (!out.empty()) std::memcpy(out.data(), a.data(), out.size() * sizeof(Vec3));
+  return out;
+}
+
+std::vector<Triangle> to_triangles(py::handle obj) {
+  py::array a;
+  try {
+    a = py::array::ensure(obj);
+  } catch (const py::error_already_set&) {
+  }
+  if (!a) throw py::type_error("triangles must be an integer array of shape (M, 3)");
+  const char kind = a.dtype().kind();
+  if (kind != 'i' && kind != 'u')
+    throw py::type_error("triangles must be an integer array (vertex indices), not dtype " + std::string(py::str(a.dtype())));
+  if (a.ndim() != 2 || a.shape(1) != 3)
+    throw py::value_error("triangles must have shape (M, 3), got " + shape_of(a));
+  auto idx = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+  if (kind == 'u' && a.itemsize() == 8) {
+    // uint64 above 2^63 would wrap to negative int64: check the originals.
+    auto u = py::array_t<uint64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+    for (py::ssize_t i = 0; i < u.size(); ++i)
+      if (u.data()[i] > UINT32_MAX) throw py::value_error("triangle " + std::to_string(i / 3) + " has an index out of range");
+  }
+  std::vector<Triangle> out(size_t(a.shape(0)));
+  const int64_t* p = idx.data();
+  for (size_t i = 0; i < out.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      const int64_t v = p[3 * i + k];
+      if (v < 0) throw py::value_error("triangle " + std::to_string(i) + " has a negative vertex index");
+      if (v > int64_t(UINT32_MAX)) throw py::value_error("triangle " + std::to_string(i) + " has an index out of range");
+      out[i][k] = uint32_t(v);
+    }
+  }
+  return out;
+}
+
+// A (4, 4) row-major matrix (Blender's matrix_world layout) becomes GLM's column-major Mat4.
+Mat4 to_matrix(py::handle obj) {
+  py::array a;
+  try {
+    a = py::array::ensure(obj);
+  } catch (const py::error_already_set&) {
+  }
+  if (!a || (a.dtype().kind() != 'f' && a.dtype().kind() != 'i' && a.dtype().kind() != 'u'))
+    throw py::type_error("transform must be a (4, 4) array of numbers (row-major world matrix)");
+  if (a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4)
+    throw py::value_error("transform must have shape (4, 4), got " + shape_of(a));
+  auto m = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+  Mat4 out;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) out[c][r] = float(m.data()[4 * r + c]);
+  return out;
+}
+
+int check_threads(int threads) {
+  if (threads < 0) throw py::value_error("threads must be >= 0 (0 means all cores), got " + std::to_string(threads));
+  return threads;
+}
+
+// tnear / tfar: a number applied to every ray, or one value per ray.
+struct PerRay {
+  FloatArray storage;
+  float scalar = 0.0f;
+  const float* data = nullptr;
+  size_t stride = 0;
+};
+
+PerRay per_ray(py::handle obj, size_t count, const char* name) {
+  PerRay out;
+  if (py::isinstance<py::float_>(obj) || py::isinstance<py::int_>(obj)) {
+    out.scalar = obj.cast<float>();
+  } else {
+    py::array a;
+    try {
+      a = py::array::ensure(obj);
+    } catch (const py::error_already_set&) {
+    }
+    if (!a || (a.dtype().kind() != 'f' && a.dtype().kind() != 'i' && a.dtype().kind() != 'u'))
+      throw py::type_error(std::string(name) + " must be a number or an array of numbers, one per ray");
+    if (a.ndim() == 0) {
+      out.scalar = FloatArray::ensure(a).data()[0];
+    } else {
+      if (a.ndim() != 1 || size_t(a.shape(0)) != count)
+        throw py::value_error(std::string(name) + " must be a number or have shape (" + std::to_string(count) + ",), got " + shape_of(a));
+      out.storage = FloatArray::ensure(a);
+      out.data = out.storage.data();
+      out.stride = 1;
+      return out;
+    }
+  }
+  if (std::isnan(out.scalar)) throw py::value_error(std::string(name) + " is NaN");
+  out.data = &out.scalar;
+  return out;
+}
+
+// The Python-visible scene: the core Scene plus a readers/writer lock, so scripts that query
+// from several threads while another adds geometry get consistent answers, never a crash.
+class PyScene {
+ public:
+  uint32_t add_mesh(py::handle vertices, py::handle triangles, py::handle transform) {
+    std::vector<Vec3> verts = to_vec3s(as_points(vertices, "vertices"));
+    std::vector<Triangle> tris = to_triangles(triangles);
+    const Mat4 m = transform.is_none() ? Mat4(1.0f) : to_matrix(transform);
+    std::unique_lock lock(mutex_);
+    Scene::checked_inverse(m);  // before the mesh is added, so a bad call leaves the scene unchanged
+    const uint32_t id = scene_.add_mesh(std::move(verts), std::move(tris));
+    scene_.add_instance(id, m);
+    return id;
+  }
+
+  uint32_t add_instance(int64_t mesh, py::handle transform) {
+    const Mat4 m = to_matrix(transform);
+    std::unique_lock lock(mutex_);
+    if (mesh < 0 || size_t(mesh) >= scene_.mesh_count())
+      throw py::value_error("unknown mesh id " + std::to_string(mesh) + " (the scene has " +
+                            std::to_string(scene_.mesh_count()) + " meshes)");
+    return scene_.add_instance(uint32_t(mesh), m);
+  }
+
+  void commit(const std::string& builder, int threads) {
+    CommitOptions opt;
+    opt.builder = parse_builder(builder);
+    opt.threads = check_threads(threads);
+    std::unique_lock lock(mutex_);
+    py::gil_scoped_release release;
+    scene_.commit(opt);
+  }
+
+  py::dict intersect(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads) {
+    auto [org, dir] = rays(origins, directions);
+    const size_t n = size_t(org.shape(0));
+    const PerRay near = per_ray(tnear, n, "tnear"), far = per_ray(tfar, n, "tfar");
+    py::array_t<float> t(n), u(n), v(n);
+    py::array_t<int32_t> prim(n), instance(n);
+    const RayBatch batch{org.data(), dir.data(), near.data, near.stride, far.data, far.stride, n};
+    const HitBatch hits{t.mutable_data(), u.mutable_data(), v.mutable_data(), prim.mutable_data(), instance.mutable_data()};
+    {
+      py::gil_scoped_release release;
+      std::shared_lock lock(mutex_);
+      require_committed();
+      scene_.intersect(batch, hits, check_threads(threads));
+    }
+    py::dict out;
+    out["t"] = t;
+    out["prim"] = prim;
+    out["instance"] = instance;
+    out["u"] = u;
+    out["v"] = v;
+    return out;
+  }
+
+  py::array_t<bool> occluded(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads) {
+    auto [org, dir] = rays(origins, directions);
+    const size_t n = size_t(org.shape(0));
+    const PerRay near = per_ray(tnear, n, "tnear"), far = per_ray(tfar, n, "tfar");
+    py::array_t<bool> blocked(n);
+    static_assert(sizeof(bool) == sizeof(uint8_t));
+    const RayBatch batch{org.data(), dir.data(), near.data, near.stride, far.data, far.stride, n};
+    {
+      py::gil_scoped_release release;
+      std::shared_lock lock(mutex_);
+      require_committed();
+      scene_.occluded(batch, reinterpret_cast<uint8_t*>(blocked.mutable_data()), check_threads(threads));
+    }
+    return blocked;
+  }
+
+  py::dict bvh_stats(int64_t mesh) {
+    std::shared_lock lock(mutex_);
+    require_committed();
+    const Bvh* bvh = &scene_.top_level();
+    if (mesh >= 0) {
+      if (size_t(mesh) >= scene_.mesh_count()) throw py::value_error("unknown mesh id " + std::to_string(mesh));
+      bvh = &scene_.mesh(uint32_t(mesh)).bvh();
+    }
+    py::dict d;
+    d["nodes"] = bvh->nodes.size();
+    d["leaves"] = bvh->leaf_count();
+    d["depth"] = bvh->depth();
+    d["sah_cost"] = bvh->sah_cost();
+    return d;
+  }
+
+  size_t mesh_count() { std::shared_lock l(mutex_); return scene_.mesh_count(); }
+  size_t instance_count() { std::shared_lock l(mutex_); return scene_.instance_count(); }
+  size_t triangle_count() { std::shared_lock l(mutex_); return scene_.stored_triangle_count(); }
+  size_t memory_bytes() { std::shared_lock l(mutex_); return scene_.memory_bytes(); }
+  bool committed() { std::shared_lock l(mutex_); return scene_.committed(); }
+  double build_ms() { std::shared_lock l(mutex_); return scene_.commit_stats().build_ms; }
+
+ private:
+  std::pair<FloatArray, FloatArray> rays(py::handle origins, py::handle directions) {
+    FloatArray org = as_points(origins, "origins"), dir = as_points(directions, "directions");
+    if (org.shape(0) != dir.shape(0))
+      throw py::value_error("origins and directions must hold the same number of rays, got " +
+                            std::to_string(org.shape(0)) + " and " + std::to_string(dir.shape(0)));
+    return {org, dir};
+  }
+
+  void require_committed() const {
+    if (!scene_.committed())
+      throw std::logic_error(scene_.instance_count() == 0 && scene_.mesh_count() == 0
+                                 ? "query before commit(): add meshes, then call commit()"
+                                 : "the scene changed since the last commit(): call commit() before queries");
+  }
+
+  Scene scene_;
+  std::shared_mutex mutex_;
+};
+
+}  // namespace
+
+PYBIND11_MODULE(toyrt, m) {
+  m.doc() = "TOYRT's native core: watertight triangles, SAH BVH, two-level scenes, batch ray queries.";
+  m.attr("__version__") = "0.1.0";
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const std::logic_error& e) {
+      // std::invalid_argument is bad input; other logic errors are calls in the wrong order.
+      if (dynamic_cast<const std::invalid_argument*>(&e))
+        PyErr_SetString(PyExc_ValueError, e.what());
+      else
+        PyErr_SetString(PyExc_RuntimeError, e.what());
+    } catch (const std::bad_alloc&) {
+      PyErr_SetString(PyExc_MemoryError, "toyrt: out of memory");
+    }
+  });
+
+  py::class_<PyScene>(m, "Scene", "A two-level scene: meshes stored once, placed by instances.")
+      .def(py::init<>())
+      .def("add_mesh", &PyScene::add_mesh, py::arg("vertices"), py::arg("triangles"), py::arg("transform") = py::none(),
+           "Adds a mesh and one instance of it; returns the mesh id.\n"
+           "vertices: (N, 3) numbers (stored as float32), finite. triangles: (M, 3) integer vertex\n"
+           "indices. transform: None (identity) or a (4, 4) row-major affine world matrix.\n"
+           "Degenerate (zero-area) triangles are kept but can never be hit.")
+      .def("add_instance", &PyScene::add_instance, py::arg("mesh"), py::arg("transform"),
+           "Places mesh `mesh` again with a (4, 4) row-major affine world matrix; returns the instance id.")
+      .def("commit", &PyScene::commit, py::arg("builder") = "auto", py::arg("threads") = 0,
+           "Builds the BVHs of new meshes and the top level. builder: 'auto' or 'sah' ('lbvh' to come);\n"
+           "threads: 0 for all cores.")
+      .def("intersect", &PyScene::intersect, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0f,
+           py::arg("tfar") = std::numeric_limits<float>::infinity(), py::arg("threads") = 0,
+           "Nearest hits of rays org + t * dir with tnear <= t < tfar (world units of t: the direction's\n"
+           "length). origins, directions: (N, 3); tnear, tfar: numbers or (N,) arrays.\n"
+           "Returns a dict of (N,) arrays: t (float32, inf on a miss), prim (int32 triangle index in its\n"
+           "mesh, -1 on a miss), instance (int32), u, v (float32; p = (1-u-v) p0 + u p1 + v p2).\n"
+           "Rays with a zero or non-finite direction, a non-finite origin, or tnear > tfar miss.")
+      .def("occluded", &PyScene::occluded, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0f,
+           py::arg("tfar") = std::numeric_limits<float>::infinity(), py::arg("threads") = 0,
+           "Whether anything lies on each ray with tnear <= t < tfar; a (N,) bool array. Stops at the first hit.")
+      .def("bvh_stats", &PyScene::bvh_stats, py::arg("mesh") = -1,
+           "Node count, leaf count, depth and SAH cost of a mesh's BVH, or of the top level for mesh=-1.")
+      .def_property_readonly("mesh_count", &PyScene::mesh_count)
+      .def_property_readonly("instance_count", &PyScene::instance_count)
+      .def_property_readonly("triangle_count", &PyScene::triangle_count, "Triangles stored, each mesh counted once.")
+      .def_property_readonly("memory_bytes", &PyScene::memory_bytes)
+      .def_property_readonly("committed", &PyScene::committed)
+      .def_property_readonly("build_ms", &PyScene::build_ms, "Wall time of the last commit in milliseconds.");
+
+  m.def(
+      "offset_ray_origin",
+      [](py::handle points, py::handle normals) {
+        FloatArray p = as_points(points, "points"), n = as_points(normals, "normals");
+        if (p.shape(0) != n.shape(0)) throw py::value_error("points and normals must have the same length");
+        const size_t count = size_t(p.shape(0));
+        py::array_t<float> out({py::ssize_t(count), py::ssize_t(3)});
+        const Vec3* pp = reinterpret_cast<const Vec3*>(p.data());
+        const Vec3* nn = reinterpret_cast<const Vec3*>(n.data());
+        Vec3* o = reinterpret_cast<Vec3*>(out.mutable_data());
+        for (size_t i = 0; i < count; ++i) o[i] = offset_ray_origin(pp[i], nn[i]);
+        return out;
+      },
+      py::arg("points"), py::arg("normals"),
+      "Ray origins moved off the surface along the normals (Waechter and Binder 2019), so rays\n"
+      "leaving the surface do not hit it again: (N, 3) float32.");
+}

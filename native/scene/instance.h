@@ -1,0 +1,17 @@
+// One placement of a mesh in the world: the mesh is shared, the instance carries only its
+// transforms (10,000 instances of one mesh cost 10,000 of these, not 10,000 meshes).
+#pragma once
+
+#include "core/bbox.h"
+
+namespace toyrt {
+
+struct Instance {
+  uint32_t mesh = 0;
+  Mat4 to_world{1.0f};   // object -> world, affine
+  Mat4 to_object{1.0f};  // its inverse: rays are carried into object space, t is unchanged
+  bool identity = true;  // skips the ray transform for the common untransformed case
+  BBox world_bounds;     // of the mesh's box corners, transformed
+};
+
+}  // namespace toyrt
