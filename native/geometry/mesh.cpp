@@ -72,21 +72,28 @@ bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, flo
   const RayBoxData box_ray = make_ray_box_data(org, dir);
   const WatertightRay tri_ray = make_watertight_ray(org, dir);
   const TriangleVerts* tris = leaf_triangles_.data();
-  return traverse<AnyHit>(bvh_, box_ray, tnear, tfar, [&](uint32_t first, uint32_t count, float& t_max) {
+  uint32_t slot = 0;
+  const bool found = traverse<AnyHit>(bvh_, box_ray, tnear, tfar, [&](uint32_t first, uint32_t count, float& t_max) {
     bool hit = false;
     for (uint32_t s = first; s < first + count; ++s) {
       float t, hu, hv;
       if (intersect_triangle(tri_ray, tris[s].p0, tris[s].p1, tris[s].p2, tnear, t_max, t, hu, hv)) {
         t_max = t;
-        u = hu;
-        v = hv;
-        prim = int32_t(bvh_.prim_ids[s]);
+        slot = s;
         hit = true;
         if constexpr (AnyHit) return true;
       }
     }
     return hit;
   });
+  if constexpr (!AnyHit) {
+    if (found) {
+      const TriangleVerts& tri = tris[slot];
+      refine_hit(org, dir, tri.p0, tri.p1, tri.p2, tnear, tfar, u, v);
+      prim = int32_t(bvh_.prim_ids[slot]);
+    }
+  }
+  return found;
 }
 
 bool Mesh::intersect(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v,

@@ -20,7 +20,9 @@ inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& n) {
   constexpr float kIntScale = 256.0f;          // ulps per unit of normal
   Vec3 out;
   for (int a = 0; a < 3; ++a) {
-    const int32_t step = int32_t(kIntScale * n[a]);
+    // A non-finite or huge normal would overflow the conversion (undefined behaviour): no step.
+    const float scaled = kIntScale * n[a];
+    const int32_t step = std::fabs(scaled) < 1e6f ? int32_t(scaled) : 0;
     int32_t bits;
     std::memcpy(&bits, &p[a], sizeof bits);
     // Adding to the bit pattern moves away from zero for positive steps on a positive number:

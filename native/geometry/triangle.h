@@ -8,6 +8,7 @@
 
 #include "core/math.h"
 
+#include <algorithm>
 #include <utility>
 
 namespace toyrt {
@@ -19,7 +20,7 @@ struct TriangleVerts {
 
 // Per-ray constants of the shear transform, computed once per traversal.
 struct WatertightRay {
-  Vec3 org;
+  Vec3 org, dir;
   int kx, ky, kz;      // axis permutation: kz is the dominant direction axis
   float sx, sy, sz;    // shear and scale that map the direction to (0, 0, 1)
 };
@@ -27,6 +28,7 @@ struct WatertightRay {
 inline WatertightRay make_watertight_ray(const Vec3& org, const Vec3& dir) {
   WatertightRay r;
   r.org = org;
+  r.dir = dir;
   r.kz = max_dimension(glm::abs(dir));
   r.kx = (r.kz + 1) % 3;
   r.ky = (r.kx + 1) % 3;
@@ -37,6 +39,41 @@ inline WatertightRay make_watertight_ray(const Vec3& org, const Vec3& dir) {
   r.sy = dir[r.ky] / dir[r.kz];
   r.sz = 1.0f / dir[r.kz];
   return r;
+}
+
+// Bound on the rounding error of the scaled distance T computed below (the derivation of pbrt-v4,
+// section 6.8.4: errors of the translated and sheared coordinates, then of the edge functions,
+// then of their weighted sum). A hit whose T is within this bound of tnear may really be behind
+// the ray's start; those few are decided in double.
+inline float near_start_error(float ax, float ay, float bx, float by, float cx, float cy, float az, float bz,
+                              float cz, float eu, float ev, float ew) {
+  const float max_z = std::max({std::fabs(az), std::fabs(bz), std::fabs(cz)});
+  const float max_x = std::max({std::fabs(ax), std::fabs(bx), std::fabs(cx)});
+  const float max_y = std::max({std::fabs(ay), std::fabs(by), std::fabs(cy)});
+  const float max_e = std::max({std::fabs(eu), std::fabs(ev), std::fabs(ew)});
+  const float delta_z = gamma(3) * max_z;
+  const float delta_x = gamma(5) * (max_x + max_z), delta_y = gamma(5) * (max_y + max_z);
+  const float delta_e = 2.0f * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+  return 3.0f * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e);
+}
+
+// The hit test for a candidate whose float distance is too close to tnear to trust: the plane
+// crossing in double precision (Moller-Trumbore on the same float inputs). The float test has
+// already placed the ray inside the triangle, so only the distance is decided here.
+inline bool near_start_in_double(const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2, float tnear,
+                                 float tfar, float& t, float& u, float& v) {
+  const DVec3 o(r.org), d(r.dir), a(p0);
+  const DVec3 e1 = DVec3(p1) - a, e2 = DVec3(p2) - a;
+  const DVec3 pv = glm::cross(d, e2);
+  const double det = glm::dot(e1, pv);
+  if (det == 0.0) return false;  // the ray lies in the plane: no crossing distance
+  const DVec3 tv = o - a, qv = glm::cross(tv, e1);
+  const double td = glm::dot(e2, qv) / det;
+  if (!(td >= double(tnear) && td < double(tfar))) return false;
+  t = std::max(float(td), tnear);
+  u = float(glm::dot(tv, pv) / det);
+  v = float(glm::dot(d, qv) / det);
+  return true;
 }
 
 // Tests the triangle against the ray segment [tnear, tfar). On a hit, writes t and the
@@ -76,13 +113,40 @@ inline bool intersect_triangle(const WatertightRay& r, const Vec3& p0, const Vec
   // Compare in the scaled domain to avoid the division for rejected hits.
   const float abs_det = std::fabs(det);
   const float signed_t = det < 0.0f ? -scaled_t : scaled_t;
-  if (!(signed_t >= tnear * abs_det) || !(signed_t < tfar * abs_det)) return false;
+  if (!(signed_t < tfar * abs_det)) return false;
+  if (!(signed_t - tnear * abs_det > near_start_error(ax, ay, bx, by, cx, cy, az, bz, cz, eu, ev, ew))) {
+    // Too close to tnear for float to tell which side the triangle is on: a ray leaving a
+    // sliver, or a grazing one. Decide in double, where the answer is reliable.
+    return near_start_in_double(r, p0, p1, p2, tnear, tfar, t, u, v);
+  }
 
   const float inv_det = 1.0f / det;
   t = scaled_t * inv_det;
   u = ev * inv_det;
   v = ew * inv_det;
   return true;
+}
+
+// Recomputes t, u, v of an accepted hit in double precision (Moller-Trumbore on the same float
+// inputs). The float test above decides hit or miss watertightly, but its t and barycentrics come
+// from edge functions that cancel badly on slivers and grazing hits (relative errors up to 1e-3
+// on a 1e4:1 sliver); one double evaluation per ray, for the nearest hit only, makes them
+// accurate to float precision. u and v are those of the true crossing point, so for a grazing
+// hit that rounding let in they may lie outside [0, 1] by as much as the point lies outside the
+// triangle (a distance of rounding size, though on a sliver that is a visible fraction of its
+// narrow barycentric range); clamping them would move the point along the sliver instead.
+inline void refine_hit(const Vec3& org, const Vec3& dir, const Vec3& p0, const Vec3& p1, const Vec3& p2,
+                       float tnear, float& t, float& u, float& v) {
+  const DVec3 o(org), d(dir), a(p0);
+  const DVec3 e1 = DVec3(p1) - a, e2 = DVec3(p2) - a;
+  const DVec3 pv = glm::cross(d, e2);
+  const double det = glm::dot(e1, pv);
+  if (det == 0.0) return;  // the ray lies in the triangle's plane: keep the float answer
+  const double inv = 1.0 / det;
+  const DVec3 tv = o - a, qv = glm::cross(tv, e1);
+  t = std::max(float(glm::dot(e2, qv) * inv), tnear);
+  u = float(glm::dot(tv, pv) * inv);
+  v = float(glm::dot(d, qv) * inv);
 }
 
 }  // namespace toyrt

@@ -61,6 +61,7 @@ void Scene::commit(const CommitOptions& options) {
   if (options.builder == BuilderKind::Lbvh)
     throw std::invalid_argument("builder 'lbvh' is not available yet: use 'sah' or 'auto'");
   stats_ = {};
+  instances_.shrink_to_fit();  // many instances are added one by one: drop the growth slack
   run_with_threads(options.threads, [&] {
     // Meshes first (each build is parallel inside), then the top level over their boxes.
     for (auto& mesh : meshes_) {

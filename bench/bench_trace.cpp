@@ -1,0 +1,186 @@
+// Trace benchmark: the same meshes and rays through TOYRT and Embree 3 in one process, on one
+// thread and on all, reported as ratios to Embree (timings on shared machines are noisy; ratios
+// measured side by side, best of several runs, are what carry over). Writes a Markdown table.
+//
+//   bench_trace [--out FILE] [--runs N] [--quick]
+#include "core/parallel.h"
+#include "embree_oracle.h"
+#include "scene/scene.h"
+#include "test_scenes.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+using namespace toyrt;
+using namespace toyrt::testing;
+
+namespace {
+
+double best_ms(int runs, const std::function<void()>& f) {
+  double best = 1e300;
+  for (int i = 0; i < runs; ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    f();
+    best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  }
+  return best;
+}
+
+struct Flat {  // a ray set as the batch API takes it
+  std::vector<float> org, dir, tfar;
+  size_t count = 0;
+};
+
+Flat flatten(const std::vector<Ray>& rays) {
+  Flat f;
+  f.count = rays.size();
+  for (const Ray& r : rays) {
+    f.org.insert(f.org.end(), {r.org.x, r.org.y, r.org.z});
+    f.dir.insert(f.dir.end(), {r.dir.x, r.dir.y, r.dir.z});
+    f.tfar.push_back(r.tfar);
+  }
+  return f;
+}
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+  return "unknown CPU";
+}
+
+struct Row {
+  std::string mesh, rays, threads;
+  size_t count;
+  double toyrt_ms, embree_ms;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string out_path;
+  int runs = 5;
+  bool quick = false;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out_path = argv[++i];
+    else if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--quick")) quick = true;
+    else {
+      std::fprintf(stderr, "usage: %s [--out FILE] [--runs N] [--quick]\n", argv[0]);
+      return 2;
+    }
+  }
+  const int all = int(std::thread::hardware_concurrency());
+  const int width = quick ? 320 : 1024, height = quick ? 240 : 768;
+
+  struct Case { std::string name; MeshData mesh; };
+  std::vector<Case> cases;
+  cases.push_back({"bumpy sphere, 1.0M triangles", uv_sphere(708, 708, 1.0f, 0.15f)});
+  cases.push_back({"triangle soup, 200K triangles", triangle_soup(200000, 0.02f, 1)});
+
+  std::ostringstream md, builds;
+  std::vector<Row> rows;
+  builds << "| mesh | threads | TOYRT build ms | Embree build ms | TOYRT / Embree time |\n|---|---|---|---|---|\n";
+  for (const Case& c : cases) {
+    std::fprintf(stderr, "%s\n", c.name.c_str());
+    // Builds, each thread count.
+    for (int threads : {1, all}) {
+      const double mine = best_ms(std::max(1, runs / 2), [&] {
+        Scene s;
+        s.add_instance(s.add_mesh(c.mesh.vertices, c.mesh.triangles), Mat4(1.0f));
+        CommitOptions opt;
+        opt.builder = BuilderKind::Sah;
+        opt.threads = threads;
+        s.commit(opt);
+      });
+      const double theirs = best_ms(std::max(1, runs / 2), [&] { EmbreeScene e(c.mesh.vertices, c.mesh.triangles, false, threads); });
+      builds << "| " << c.name << " | " << threads << " | " << mine << " | " << theirs << " | " << mine / theirs << " |\n";
+    }
+    Scene scene;
+    scene.add_instance(scene.add_mesh(c.mesh.vertices, c.mesh.triangles), Mat4(1.0f));
+    scene.commit();
+    const EmbreeScene embree(c.mesh.vertices, c.mesh.triangles);
+
+    const std::vector<Ray> primary = primary_rays(bounds_of(c.mesh), width, height);
+    std::vector<Hit> hits(primary.size());
+    for (size_t i = 0; i < primary.size(); ++i) hits[i] = embree.intersect(primary[i]);
+    const BBox box = bounds_of(c.mesh);
+    const Vec3 light = box.center() + glm::length(box.extent()) * Vec3(-0.4f, -0.9f, 1.3f);
+    const std::vector<std::pair<std::string, std::vector<Ray>>> sets = {
+        {"primary", primary}, {"diffuse", diffuse_rays(c.mesh, primary, hits, 17)},
+        {"shadow", shadow_rays(c.mesh, primary, hits, light)}};
+
+    for (const auto& [kind, rays] : sets) {
+      const Flat f = flatten(rays);
+      const bool shadow = kind == "shadow";
+      const float tnear = 0.0f;
+      const RayBatch batch{f.org.data(), f.dir.data(), &tnear, 0, f.tfar.data(), 1, f.count};
+      std::vector<float> t(f.count), u(f.count), v(f.count);
+      std::vector<int32_t> prim(f.count), inst(f.count);
+      std::vector<uint8_t> blocked(f.count);
+      for (int threads : {1, all}) {
+        const double mine = best_ms(runs, [&] {
+          if (shadow) scene.occluded(batch, blocked.data(), threads);
+          else scene.intersect(batch, {t.data(), u.data(), v.data(), prim.data(), inst.data()}, threads);
+        });
+        // Embree through the same harness: TBB tasks of 256 rays, single-ray queries.
+        const double theirs = best_ms(runs, [&] {
+          run_with_threads(threads, [&] {
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+              for (size_t i = r.begin(); i != r.end(); ++i) {
+                if (shadow) blocked[i] = embree.occluded(rays[i]);
+                else t[i] = embree.intersect(rays[i]).t;
+              }
+            });
+          });
+        });
+        rows.push_back({c.name, kind, std::to_string(threads), rays.size(), mine, theirs});
+        std::fprintf(stderr, "  %-8s %d thread(s): TOYRT %.1f Mrays/s, Embree %.1f Mrays/s\n", kind.c_str(), threads,
+                     rays.size() / mine / 1e3, rays.size() / theirs / 1e3);
+      }
+    }
+  }
+
+  char date[64];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+  md << "# Trace benchmark: TOYRT against Embree " << RTC_VERSION_STRING << "\n\n"
+     << "Written by `make bench-trace` (`build/bench/bench_trace`) on " << date << ": " << cpu_model() << ", "
+     << all << " hardware threads. Best of " << runs << " runs for tracing, each engine in the same process on the "
+     << "same rays; Embree 3 with its default scene flags and build quality, single-ray queries "
+     << "(`rtcIntersect1`/`rtcOccluded1`) through the same TBB harness as TOYRT's batch API. Rays: a "
+     << width << "x" << height << " pinhole camera (primary), one cosine-distributed bounce from each primary hit "
+     << "(diffuse), and one ray from each primary hit to a point light (shadow, any-hit query).\n\n"
+     << "## Tracing\n\n| mesh | rays | threads | count | TOYRT Mrays/s | Embree Mrays/s | TOYRT / Embree |\n"
+     << "|---|---|---|---|---|---|---|\n";
+  for (const Row& r : rows) {
+    char line[512];
+    std::snprintf(line, sizeof line, "| %s | %s | %s | %zu | %.2f | %.2f | **%.2f** |\n", r.mesh.c_str(), r.rays.c_str(),
+                  r.threads.c_str(), r.count, r.count / r.toyrt_ms / 1e3, r.count / r.embree_ms / 1e3,
+                  r.embree_ms / r.toyrt_ms);
+    md << line;
+  }
+  md << "\n## Building\n\n" << builds.str();
+  std::cout << md.str();
+  if (!out_path.empty()) {
+    std::ofstream out(out_path);
+    out << md.str();
+    std::fprintf(stderr, "wrote %s\n", out_path.c_str());
+  }
+  return 0;
+}

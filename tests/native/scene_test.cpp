@@ -1,0 +1,185 @@
+// The two-level scene: instances with arbitrary affine transforms, shared mesh storage, the
+// batch API, and rays that must simply miss.
+#include "scene/scene.h"
+#include "oracle_compare.h"
+#include "test_scenes.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace toyrt;
+using namespace toyrt::testing;
+
+namespace {
+
+MeshData flattened(const MeshData& m, const Mat4& to_world) {
+  MeshData out = m;
+  for (Vec3& v : out.vertices) v = Vec3(to_world * glm::vec4(v, 1.0f));
+  return out;
+}
+
+std::vector<Ray> random_rays(size_t n, float spread, uint64_t seed) {
+  std::mt19937 rng{uint32_t(seed)};
+  std::uniform_real_distribution<float> sym(-1.0f, 1.0f);
+  std::vector<Ray> rays(n);
+  for (Ray& r : rays) {
+    r.org = spread * Vec3(sym(rng), sym(rng), sym(rng));
+    r.dir = Vec3(sym(rng), sym(rng), sym(rng));
+  }
+  return rays;
+}
+
+}  // namespace
+
+TEST(Scene, RotatedAndNonUniformlyScaledInstancesMatchFlattenedGeometry) {
+  const MeshData m = uv_sphere(24, 48, 1.0f, 0.25f);
+  std::vector<Mat4> placements;
+  for (int i = 0; i < 6; ++i) {
+    Mat4 x = glm::translate(Mat4(1.0f), Vec3(3.0f * (i % 3) - 3.0f, 3.0f * (i / 3) - 1.5f, 0.3f * i));
+    x = glm::rotate(x, 0.7f * float(i + 1), glm::normalize(Vec3(1.0f, 2.0f, float(i))));
+    x = glm::scale(x, Vec3(0.5f + 0.3f * i, 1.2f, 0.4f + 0.1f * i));
+    placements.push_back(x);
+  }
+  Scene scene;
+  const uint32_t id = scene.add_mesh(m.vertices, m.triangles);
+  for (const Mat4& x : placements) scene.add_instance(id, x);
+  scene.commit();
+  EXPECT_EQ(scene.mesh_count(), 1u);
+
+  // Reference: every instance's triangles moved to world space, in one Embree scene.
+  MeshData world;
+  std::vector<int32_t> owner;
+  for (size_t i = 0; i < placements.size(); ++i) {
+    const MeshData f = flattened(m, placements[i]);
+    const uint32_t base = uint32_t(world.vertices.size());
+    world.vertices.insert(world.vertices.end(), f.vertices.begin(), f.vertices.end());
+    for (const Triangle& t : f.triangles) {
+      world.triangles.push_back(t + base);
+      owner.push_back(int32_t(i));
+    }
+  }
+  const EmbreeScene embree(world.vertices, world.triangles);
+  size_t clear_disagreements = 0, checked = 0;
+  for (const Ray& r : random_rays(40000, 6.0f, 11)) {
+    const Hit mine = scene.intersect(r), ref = embree.intersect(r);
+    if (mine.found() != ref.found()) {
+      // Allowed only on a triangle's boundary, where rounding of the transform decides.
+      const Hit& h = mine.found() ? mine : ref;
+      const int32_t world_prim = mine.found() ? int32_t(mine.instance * m.triangles.size() + mine.prim) : h.prim;
+      if (judge(world, Hit{h.t, h.u, h.v, world_prim, 0}, r) == Verdict::Crossed) ++clear_disagreements;
+      continue;
+    }
+    if (!ref.found()) continue;
+    ++checked;
+    EXPECT_EQ(mine.instance, owner[size_t(ref.prim)]);
+    EXPECT_NEAR(mine.t, ref.t, 1e-4f * std::max(1.0f, ref.t));
+    if (mine.prim == ref.prim % int32_t(m.triangles.size())) {
+      EXPECT_NEAR(mine.u, ref.u, 1e-3f);
+      EXPECT_NEAR(mine.v, ref.v, 1e-3f);
+    }
+  }
+  EXPECT_EQ(clear_disagreements, 0u);
+  EXPECT_GT(checked, 2000u);
+}
+
+TEST(Scene, OccludedAgreesWithIntersect) {
+  const MeshData m = triangle_soup(5000, 0.05f, 21);
+  Scene scene;
+  const uint32_t id = scene.add_mesh(m.vertices, m.triangles);
+  scene.add_instance(id, glm::translate(Mat4(1.0f), Vec3(0.5f, 0.0f, 0.0f)));
+  scene.commit();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> unit(0.0f, 2.0f);
+  for (Ray r : random_rays(20000, 1.5f, 12)) {
+    r.tfar = unit(rng);
+    EXPECT_EQ(scene.occluded(r), scene.intersect(r).found());
+  }
+}
+
+TEST(Scene, TenThousandInstancesStoreTheMeshOnce) {
+  const MeshData m = uv_sphere(100, 200);  // 39,600 triangles
+  Scene scene;
+  const uint32_t id = scene.add_mesh(m.vertices, m.triangles);
+  for (int i = 0; i < 10000; ++i)
+    scene.add_instance(id, glm::translate(Mat4(1.0f), Vec3(3.0f * (i % 100), 3.0f * (i / 100), 0.0f)));
+  scene.commit();
+  EXPECT_EQ(scene.instanced_triangle_count(), 10000u * m.triangles.size());
+  const size_t one_mesh = scene.mesh(id).memory_bytes();
+  // Per instance: its record and at most two top-level nodes and an id.
+  const size_t per_instance = sizeof(Instance) + 2 * sizeof(Node) + sizeof(uint32_t);
+  EXPECT_LE(scene.memory_bytes(), one_mesh + 10000 * per_instance + 4096);
+  // And every instance is really there: a ray down onto each of a sample of them hits it.
+  for (int i = 0; i < 10000; i += 97) {
+    Ray r;
+    r.org = Vec3(3.0f * (i % 100), 3.0f * (i / 100), 5.0f);
+    r.dir = Vec3(0.0f, 0.0f, -1.0f);
+    const Hit h = scene.intersect(r);
+    ASSERT_TRUE(h.found());
+    EXPECT_EQ(h.instance, i);
+    EXPECT_NEAR(h.t, 4.0f, 1e-3f);
+  }
+}
+
+TEST(Scene, BatchResultsDoNotDependOnThreadCount) {
+  const MeshData m = uv_sphere(60, 120, 1.0f, 0.2f);
+  Scene scene;
+  scene.add_instance(scene.add_mesh(m.vertices, m.triangles), Mat4(1.0f));
+  scene.commit();
+  const auto rays = random_rays(50000, 2.0f, 13);
+  std::vector<float> org, dir;
+  for (const Ray& r : rays) {
+    org.insert(org.end(), {r.org.x, r.org.y, r.org.z});
+    dir.insert(dir.end(), {r.dir.x, r.dir.y, r.dir.z});
+  }
+  const float tnear = 0.0f, tfar = kInfinity;
+  const RayBatch batch{org.data(), dir.data(), &tnear, 0, &tfar, 0, rays.size()};
+  auto run = [&](int threads) {
+    std::vector<float> t(rays.size()), u(rays.size()), v(rays.size());
+    std::vector<int32_t> prim(rays.size()), inst(rays.size());
+    scene.intersect(batch, {t.data(), u.data(), v.data(), prim.data(), inst.data()}, threads);
+    return std::make_pair(t, prim);
+  };
+  const auto one = run(1), two = run(2);
+  EXPECT_EQ(one, two);
+  for (size_t i = 0; i < rays.size(); i += 101) EXPECT_EQ(one.first[i], scene.intersect(rays[i]).t);
+}
+
+TEST(Scene, InvalidRaysMissInsteadOfFailing) {
+  const MeshData m = uv_sphere(10, 20);
+  Scene scene;
+  scene.add_instance(scene.add_mesh(m.vertices, m.triangles), Mat4(1.0f));
+  scene.commit();
+  const float nan = std::nanf("");
+  for (const Ray& r : {Ray{Vec3(0), 0.0f, Vec3(0), kInfinity}, Ray{Vec3(nan), 0.0f, Vec3(1, 0, 0), kInfinity},
+                       Ray{Vec3(0), 0.0f, Vec3(nan, 1, 0), kInfinity}, Ray{Vec3(0), 2.0f, Vec3(1, 0, 0), 1.0f},
+                       Ray{Vec3(0), 0.0f, Vec3(kInfinity, 0, 0), kInfinity}}) {
+    EXPECT_FALSE(scene.intersect(r).found());
+    EXPECT_FALSE(scene.occluded(r));
+  }
+}
+
+TEST(Scene, EmptySceneAndEmptyMeshMissEverything) {
+  Scene empty;
+  empty.commit();
+  EXPECT_FALSE(empty.intersect(Ray{Vec3(0), 0.0f, Vec3(1, 0, 0), kInfinity}).found());
+  Scene scene;
+  scene.add_instance(scene.add_mesh({}, {}), Mat4(1.0f));
+  scene.add_instance(0, glm::translate(Mat4(1.0f), Vec3(1.0f)));
+  scene.commit();
+  EXPECT_FALSE(scene.intersect(Ray{Vec3(0), 0.0f, Vec3(1, 0, 0), kInfinity}).found());
+}
+
+TEST(Scene, RejectsBadTransformsAndIndices) {
+  Scene scene;
+  EXPECT_THROW(scene.add_instance(0, Mat4(1.0f)), std::invalid_argument);  // no mesh yet
+  const uint32_t id = scene.add_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
+  EXPECT_THROW(scene.add_instance(id, Mat4(0.0f)), std::invalid_argument);                  // not affine
+  EXPECT_THROW(scene.add_instance(id, glm::scale(Mat4(1.0f), Vec3(1, 0, 1))), std::invalid_argument);  // singular
+  Mat4 nan(1.0f);
+  nan[3][0] = std::nanf("");
+  EXPECT_THROW(scene.add_instance(id, nan), std::invalid_argument);
+  EXPECT_THROW(scene.add_mesh({{0, 0, 0}}, {{0, 0, 1}}), std::invalid_argument);
+  EXPECT_THROW(scene.add_mesh({{0, 0, std::nanf("")}}, {}), std::invalid_argument);
+}
