@@ -1,6 +1,6 @@
 #include "geometry/mesh.h"
 
-#include "accel/traverse.h"
+#include "accel/wide_traverse.h"
 
 #include <stdexcept>
 #include <string>
@@ -55,14 +55,31 @@ void Mesh::build(const BinnedSahConfig& config) {
     bounds_.extend(b);
   }
   bvh_ = build_binned_sah(boxes.data(), centers.data(), boxes.size(), config);
-  // Translate builder slots to triangle indices and copy the vertices into leaf order.
-  leaf_triangles_.resize(bvh_.prim_ids.size());
-  for (size_t s = 0; s < bvh_.prim_ids.size(); ++s) {
-    const uint32_t tri = valid[bvh_.prim_ids[s]];
-    const Triangle& t = triangles_[tri];
-    bvh_.prim_ids[s] = tri;
-    leaf_triangles_[s] = {vertices_[t.x], vertices_[t.y], vertices_[t.z]};
-  }
+  for (uint32_t& id : bvh_.prim_ids) id = valid[id];  // builder slots -> triangle indices
+  wide_ = collapse(bvh_, kBlockWidth);
+  // Copy every leaf's triangles into blocks and point the wide leaves at them.
+  blocks_.clear();
+  blocks_.reserve(bvh_.prim_ids.size() / 2);
+  auto emit = [&](uint32_t first, uint32_t count) {
+    const uint32_t start = uint32_t(blocks_.size());
+    for (uint32_t k = 0; k < count; k += kBlockWidth) {
+      TriangleBlock b{};
+      for (int lane = 0; lane < kBlockWidth; ++lane) {
+        b.prim[lane] = kNoTriangle;
+        if (k + lane >= count) continue;
+        const uint32_t tri = bvh_.prim_ids[first + k + lane];
+        b.prim[lane] = tri;
+        for (int v = 0; v < 3; ++v)
+          for (int a = 0; a < 3; ++a) b.p[v][a][lane] = vertices_[triangles_[tri][v]][a];
+      }
+      blocks_.push_back(b);
+    }
+    return start;
+  };
+  if (wide_.root_leaf_count) wide_.root_leaf_first = emit(wide_.root_leaf_first, wide_.root_leaf_count);
+  for (WideNode& n : wide_.nodes)
+    for (int i = 0; i < kWidth; ++i)
+      if (n.count[i]) n.child[i] = emit(n.child[i], n.count[i]);
   built_ = true;
 }
 
@@ -71,26 +88,29 @@ bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, flo
                  int32_t& prim) const {
   const RayBoxData box_ray = make_ray_box_data(org, dir);
   const WatertightRay tri_ray = make_watertight_ray(org, dir);
-  const TriangleVerts* tris = leaf_triangles_.data();
-  uint32_t slot = 0;
-  const bool found = traverse<AnyHit>(bvh_, box_ray, tnear, tfar, [&](uint32_t first, uint32_t count, float& t_max) {
+  const TriangleBlock* blocks = blocks_.data();
+  uint32_t found_block = 0;
+  int found_lane = 0;
+  const bool found = traverse_wide<AnyHit>(wide_, box_ray, tnear, tfar, [&](uint32_t first, uint32_t count, float& t_max) {
     bool hit = false;
-    for (uint32_t s = first; s < first + count; ++s) {
-      float t, hu, hv;
-      if (intersect_triangle(tri_ray, tris[s].p0, tris[s].p1, tris[s].p2, tnear, t_max, t, hu, hv)) {
-        t_max = t;
-        slot = s;
-        hit = true;
-        if constexpr (AnyHit) return true;
-      }
+    const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
+    for (uint32_t k = first; k < end; ++k) {
+      hit |= intersect_block<AnyHit>(tri_ray, blocks[k], tnear, t_max, [&](int lane, float t) {
+        if (t < t_max) {
+          t_max = t;
+          found_block = k;
+          found_lane = lane;
+        }
+      });
+      if (AnyHit && hit) return true;
     }
     return hit;
   });
   if constexpr (!AnyHit) {
     if (found) {
-      const TriangleVerts& tri = tris[slot];
-      refine_hit(org, dir, tri.p0, tri.p1, tri.p2, tnear, tfar, u, v);
-      prim = int32_t(bvh_.prim_ids[slot]);
+      const TriangleBlock& b = blocks[found_block];
+      refine_hit(org, dir, b.vertex(found_lane, 0), b.vertex(found_lane, 1), b.vertex(found_lane, 2), tnear, tfar, u, v);
+      prim = int32_t(b.prim[found_lane]);
     }
   }
   return found;
@@ -110,7 +130,7 @@ bool Mesh::occluded(const Vec3& org, const Vec3& dir, float tnear, float tfar) c
 size_t Mesh::memory_bytes() const {
   return vertices_.capacity() * sizeof(Vec3) + triangles_.capacity() * sizeof(Triangle) +
          bvh_.nodes.capacity() * sizeof(Node) + bvh_.prim_ids.capacity() * sizeof(uint32_t) +
-         leaf_triangles_.capacity() * sizeof(TriangleVerts);
+         blocks_.capacity() * sizeof(TriangleBlock) + wide_.nodes.capacity() * sizeof(WideNode);
 }
 
 }  // namespace toyrt

@@ -2,7 +2,8 @@
 #pragma once
 
 #include "accel/binned_sah_builder.h"
-#include "geometry/triangle.h"
+#include "accel/wide_bvh.h"
+#include "geometry/triangle_block.h"
 
 #include <vector>
 
@@ -44,9 +45,10 @@ class Mesh {
   std::vector<Vec3> vertices_;
   std::vector<Triangle> triangles_;
   Bvh bvh_;
-  // Per BVH leaf slot: the triangle's vertices, so a leaf test reads one contiguous block
-  // (bvh_.prim_ids holds the slot's index in triangles_).
-  std::vector<TriangleVerts> leaf_triangles_;
+  WideBvh wide_;  // bvh_ collapsed for tracing
+  // The leaves' triangles in blocks of four, in traversal order: a wide leaf child's `child`
+  // is its first block, its `count` the number of triangles (blocks = count rounded up to 4).
+  std::vector<TriangleBlock> blocks_;
   BBox bounds_;
   bool built_ = false;
 };

@@ -13,11 +13,6 @@
 
 namespace toyrt {
 
-// The three vertices of one triangle, as a leaf stores them (36 bytes, no index indirection).
-struct TriangleVerts {
-  Vec3 p0, p1, p2;
-};
-
 // Per-ray constants of the shear transform, computed once per traversal.
 struct WatertightRay {
   Vec3 org, dir;
@@ -60,7 +55,7 @@ inline float near_start_error(float ax, float ay, float bx, float by, float cx, 
 // The hit test for a candidate whose float distance is too close to tnear to trust: the plane
 // crossing in double precision (Moller-Trumbore on the same float inputs). The float test has
 // already placed the ray inside the triangle, so only the distance is decided here.
-inline bool near_start_in_double(const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2, float tnear,
+[[gnu::noinline, gnu::cold]] inline bool near_start_in_double(const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2, float tnear,
                                  float tfar, float& t, float& u, float& v) {
   const DVec3 o(r.org), d(r.dir), a(p0);
   const DVec3 e1 = DVec3(p1) - a, e2 = DVec3(p2) - a;
@@ -76,10 +71,26 @@ inline bool near_start_in_double(const WatertightRay& r, const Vec3& p0, const V
   return true;
 }
 
+// Edge functions recomputed in double when a float one came out exactly zero. Products of two
+// floats are exact in double, and a correctly rounded difference keeps the exact sign (and is
+// zero only when the products are equal), so these signs are the true ones. Returns whether the
+// signs agree (the ray passes inside or on the boundary), and writes the values back.
+[[gnu::noinline, gnu::cold]] inline bool edge_signs_in_double(float ax, float ay, float bx, float by, float cx,
+                                                                float cy, float& eu, float& ev, float& ew) {
+  const double du = double(cx) * double(by) - double(cy) * double(bx);
+  const double dv = double(ax) * double(cy) - double(ay) * double(cx);
+  const double dw = double(bx) * double(ay) - double(by) * double(ax);
+  if ((du < 0.0 || dv < 0.0 || dw < 0.0) && (du > 0.0 || dv > 0.0 || dw > 0.0)) return false;
+  eu = static_cast<float>(du);
+  ev = static_cast<float>(dv);
+  ew = static_cast<float>(dw);
+  return true;
+}
+
 // Tests the triangle against the ray segment [tnear, tfar). On a hit, writes t and the
 // barycentrics u, v with p = (1 - u - v) p0 + u p1 + v p2, and returns true. Both faces count.
 // A degenerate (zero-area) triangle never hits: its determinant is zero.
-inline bool intersect_triangle(const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2,
+[[gnu::always_inline]] inline bool intersect_triangle(const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2,
                                float tnear, float tfar, float& t, float& u, float& v) {
   const Vec3 a = p0 - r.org, b = p1 - r.org, c = p2 - r.org;
   const float ax = a[r.kx] - r.sx * a[r.kz], ay = a[r.ky] - r.sy * a[r.kz];
@@ -90,17 +101,9 @@ inline bool intersect_triangle(const WatertightRay& r, const Vec3& p0, const Vec
   float eu = cx * by - cy * bx;
   float ev = ax * cy - ay * cx;
   float ew = bx * ay - by * ax;
-  if (eu == 0.0f || ev == 0.0f || ew == 0.0f) {
-    // The float products may have cancelled: decide the edge signs exactly. Products of two
-    // floats are exact in double, and a correctly rounded difference keeps the exact sign (and
-    // is zero only when the products are equal), so these signs are the true ones.
-    const double du = double(cx) * double(by) - double(cy) * double(bx);
-    const double dv = double(ax) * double(cy) - double(ay) * double(cx);
-    const double dw = double(bx) * double(ay) - double(by) * double(ax);
-    if ((du < 0.0 || dv < 0.0 || dw < 0.0) && (du > 0.0 || dv > 0.0 || dw > 0.0)) return false;
-    eu = static_cast<float>(du);
-    ev = static_cast<float>(dv);
-    ew = static_cast<float>(dw);
+  if (__builtin_expect(eu == 0.0f || ev == 0.0f || ew == 0.0f, 0)) {
+    // The float products may have cancelled: decide the edge signs exactly.
+    if (!edge_signs_in_double(ax, ay, bx, by, cx, cy, eu, ev, ew)) return false;
   } else if ((eu < 0.0f || ev < 0.0f || ew < 0.0f) && (eu > 0.0f || ev > 0.0f || ew > 0.0f)) {
     return false;
   }

@@ -1,0 +1,107 @@
+// Traversal of a WideBvh: all kWidth child boxes of a node are slab-tested at once with SIMD
+// vectors (GCC vector extensions: AVX with -march on current x86, SSE pairs otherwise), the
+// children hit are visited nearest first, the others stacked with their entry distance.
+// Same leaf callback contract as traverse.h.
+#pragma once
+
+#include "accel/wide_bvh.h"
+
+#if defined(__SSE__)
+#include <immintrin.h>
+#endif
+
+#include <cstring>
+
+namespace toyrt {
+
+namespace simd {
+using vfloat = float __attribute__((vector_size(kWidth * sizeof(float))));
+using vint = int32_t __attribute__((vector_size(kWidth * sizeof(float))));
+
+inline vfloat load(const float* p) {
+  vfloat v;
+  std::memcpy(&v, p, sizeof v);  // the rows are aligned; this compiles to one aligned load
+  return v;
+}
+inline vfloat splat(float x) { return vfloat{} + x; }
+// Lane-wise max / min that keep `acc` where `candidate` is NaN (see safe_max in core/math.h).
+inline vfloat max_keep(vfloat acc, vfloat candidate) { return candidate > acc ? candidate : acc; }
+inline vfloat min_keep(vfloat acc, vfloat candidate) { return candidate < acc ? candidate : acc; }
+// One bit per lane whose comparison result is true (all bits set).
+template <class V>
+inline uint32_t mask_of(V lanes) {
+  constexpr int n = int(sizeof(V) / sizeof(int32_t));
+#if defined(__AVX__)
+  if constexpr (n == 8) return uint32_t(_mm256_movemask_ps(reinterpret_cast<__m256>(lanes)));
+#endif
+#if defined(__SSE__)
+  if constexpr (n == 4) return uint32_t(_mm_movemask_ps(reinterpret_cast<__m128>(lanes)));
+#endif
+  uint32_t m = 0;
+  for (int i = 0; i < n; ++i) m |= uint32_t(lanes[i] != 0) << i;
+  return m;
+}
+}  // namespace simd
+
+template <bool AnyHit, class LeafFn>
+inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear, float& tfar, LeafFn&& leaf) {
+  using namespace simd;
+  if (bvh.nodes.empty()) return bvh.root_leaf_count && leaf(bvh.root_leaf_first, bvh.root_leaf_count, tfar);
+
+  const vfloat ox = splat(ray.org.x), oy = splat(ray.org.y), oz = splat(ray.org.z);
+  const vfloat ix = splat(ray.inv_dir.x), iy = splat(ray.inv_dir.y), iz = splat(ray.inv_dir.z);
+  const vfloat start = splat(tnear);
+  const vfloat widen = splat(1.0f + 2.0f * gamma(3));  // conservative far distance, as in intersect_box
+
+  struct Entry { uint32_t child, count; float tentry; };
+  Entry stack[(kWidth - 1) * kMaxBvhDepth + 1];
+  int sp = 0;
+  Entry current{0, 0, tnear};
+  bool found = false;
+  for (;;) {
+    if (current.count == 0) {
+      const WideNode& n = bvh.nodes[current.child];
+      const vfloat tnx = (load(n.bounds[ray.near[0]]) - ox) * ix, tfx = (load(n.bounds[ray.far[0]]) - ox) * ix;
+      const vfloat tny = (load(n.bounds[ray.near[1]]) - oy) * iy, tfy = (load(n.bounds[ray.far[1]]) - oy) * iy;
+      const vfloat tnz = (load(n.bounds[ray.near[2]]) - oz) * iz, tfz = (load(n.bounds[ray.far[2]]) - oz) * iz;
+      const vfloat tmin = max_keep(max_keep(max_keep(start, tnx), tny), tnz);
+      vfloat tmax = min_keep(min_keep(min_keep(splat(kInfinity), tfx), tfy), tfz) * widen;
+      tmax = min_keep(tmax, splat(tfar));
+      uint32_t mask = mask_of(tmin <= tmax);
+      if (mask != 0) {
+        // Children hit, sorted by entry distance (insertion sort: usually one to three).
+        Entry hits[kWidth];
+        int count = 0;
+        while (mask) {
+          const int i = __builtin_ctz(mask);
+          mask &= mask - 1;
+          const Entry e{n.child[i], n.count[i], tmin[i]};
+          int k = count++;
+          while (k > 0 && hits[k - 1].tentry > e.tentry) {
+            hits[k] = hits[k - 1];
+            --k;
+          }
+          hits[k] = e;
+        }
+        for (int k = count - 1; k > 0; --k) {
+          stack[sp++] = hits[k];
+          // Start fetching the stacked subtrees now: traversal is bound by memory latency.
+          if (hits[k].count == 0) __builtin_prefetch(&bvh.nodes[hits[k].child]);
+        }
+        current = hits[0];
+        continue;
+      }
+    } else if (leaf(current.child, current.count, tfar)) {
+      found = true;
+      if constexpr (AnyHit) return true;
+    }
+    // Pop the next subtree that may still hold a nearer hit.
+    for (;;) {
+      if (sp == 0) return found;
+      current = stack[--sp];
+      if (current.tentry <= tfar) break;
+    }
+  }
+}
+
+}  // namespace toyrt

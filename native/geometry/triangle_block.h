@@ -1,0 +1,115 @@
+// Leaf storage for tracing: triangles in blocks of four, coordinates side by side, so the
+// watertight test of triangle.h runs on a whole block with one set of SIMD instructions. Each lane
+// evaluates exactly the scalar test's expressions (the build disables FMA contraction), so the
+// block test is as watertight as the scalar one; the rare lanes that need the scalar test's
+// double-precision paths are handed to it.
+#pragma once
+
+#include "accel/wide_traverse.h"
+#include "geometry/triangle.h"
+
+#include <cstring>
+
+namespace toyrt {
+
+inline constexpr int kBlockWidth = 4;
+inline constexpr uint32_t kNoTriangle = 0xFFFFFFFFu;
+
+struct alignas(16) TriangleBlock {
+  float p[3][3][kBlockWidth];  // [vertex][axis][lane]
+  uint32_t prim[kBlockWidth];  // triangle index in the mesh; kNoTriangle for an unused lane
+
+  Vec3 vertex(int lane, int k) const { return {p[k][0][lane], p[k][1][lane], p[k][2][lane]}; }
+};
+static_assert(sizeof(TriangleBlock) == 160, "TriangleBlock: 9 coordinate rows and the ids");
+
+namespace simd4 {
+using vfloat = float __attribute__((vector_size(16)));
+using vint = int32_t __attribute__((vector_size(16)));
+inline vfloat load(const float* p) {
+  vfloat v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline vfloat splat(float x) { return vfloat{} + x; }
+inline vfloat abs(vfloat x) {
+  vint bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  bits &= 0x7FFFFFFF;
+  std::memcpy(&x, &bits, sizeof x);
+  return x;
+}
+inline vfloat max(vfloat a, vfloat b) { return a > b ? a : b; }
+using simd::mask_of;
+}  // namespace simd4
+
+// Tests the block's triangles against [tnear, tfar). For each lane hit, hit(lane, t) is called
+// (nearest lanes are not sorted; the caller keeps the minimum); with AnyHit the first ends it.
+// Returns whether any lane was hit.
+template <bool AnyHit, class OnHit>
+[[gnu::always_inline]] inline bool intersect_block(const WatertightRay& r, const TriangleBlock& b, float tnear, float tfar, OnHit&& hit) {
+  using namespace simd4;
+  const vfloat ox = splat(r.org[r.kx]), oy = splat(r.org[r.ky]), oz = splat(r.org[r.kz]);
+  const vfloat sx = splat(r.sx), sy = splat(r.sy), sz = splat(r.sz);
+  // Translated and sheared vertices, exactly as intersect_triangle computes them.
+  vfloat x[3], y[3], z[3];
+  for (int k = 0; k < 3; ++k) {
+    const vfloat vz = load(b.p[k][r.kz]) - oz;
+    x[k] = (load(b.p[k][r.kx]) - ox) - sx * vz;
+    y[k] = (load(b.p[k][r.ky]) - oy) - sy * vz;
+    z[k] = sz * vz;
+  }
+  const vfloat eu = x[2] * y[1] - y[2] * x[1];
+  const vfloat ev = x[0] * y[2] - y[0] * x[2];
+  const vfloat ew = x[1] * y[0] - y[1] * x[0];
+  const vfloat zero = splat(0.0f);
+  vint used;
+  std::memcpy(&used, b.prim, sizeof used);
+  used = used != vint{} - 1;  // lanes holding a triangle
+  const vint exact_zero = (eu == zero) | (ev == zero) | (ew == zero);
+  const vint mixed = ((eu < zero) | (ev < zero) | (ew < zero)) & ((eu > zero) | (ev > zero) | (ew > zero));
+  const vfloat det = eu + ev + ew;
+  const vfloat scaled_t = eu * z[0] + ev * z[1] + ew * z[2];
+  const vfloat abs_det = abs(det);
+  const vfloat signed_t = det < zero ? -scaled_t : scaled_t;
+  const vint in_range = (det != zero) & (signed_t < splat(tfar) * abs_det);
+  const vint candidate = used & ~mixed & in_range;
+  // Most blocks a ray reaches it misses entirely: stop before the error bound.
+  if (!mask_of(candidate | (used & exact_zero))) return false;
+
+  // near_start_error of triangle.h, lane-wise.
+  const vfloat max_z = max(max(abs(z[0]), abs(z[1])), abs(z[2]));
+  const vfloat max_x = max(max(abs(x[0]), abs(x[1])), abs(x[2]));
+  const vfloat max_y = max(max(abs(y[0]), abs(y[1])), abs(y[2]));
+  const vfloat max_e = max(max(abs(eu), abs(ev)), abs(ew));
+  const vfloat delta_x = splat(gamma(5)) * (max_x + max_z), delta_y = splat(gamma(5)) * (max_y + max_z);
+  const vfloat delta_e = splat(2.0f) * (splat(gamma(2)) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+  const vfloat error = splat(3.0f) * (splat(gamma(3)) * max_e * max_z + delta_e * max_z + splat(gamma(3)) * max_z * max_e);
+  const vint clear_of_start = signed_t - splat(tnear) * abs_det > error;
+
+  // Lanes the vector test decides, and lanes that need the scalar test's double precision.
+  const uint32_t accepted = mask_of(candidate & ~exact_zero & clear_of_start);
+  const uint32_t scalar = mask_of(used & (exact_zero | (candidate & ~clear_of_start)));
+  bool any = false;
+  if (accepted) {
+    const vfloat t = scaled_t * (splat(1.0f) / det);  // as the scalar test: times the reciprocal
+    for (uint32_t m = accepted; m; m &= m - 1) {
+      const int lane = __builtin_ctz(m);
+      hit(lane, t[lane]);
+      any = true;
+      if constexpr (AnyHit) return true;
+    }
+  }
+  for (uint32_t m = scalar; m; m &= m - 1) {
+    const int lane = __builtin_ctz(m);
+    float t, u, v;
+    if (intersect_triangle(r, b.vertex(lane, 0), b.vertex(lane, 1), b.vertex(lane, 2), tnear, tfar, t, u, v)) {
+      hit(lane, t);
+      any = true;
+      if constexpr (AnyHit) return true;
+    }
+  }
+  return any;
+}
+
+}  // namespace toyrt
