@@ -38,6 +38,8 @@ TEST(OffsetRayOrigin, LeavingRaysNeverHitTheirOwnSurface) {
         EXPECT_LE(glm::length(moved), 1e-4f + 1e-4f * glm::length(p));
       }
       EXPECT_EQ(self_hits, 0) << "scale " << scale << " distance " << distance;
-      if (distance >= 1e3f) EXPECT_GT(naive_self_hits, 0) << "the case should be hard without the offset";
+      if (distance >= 1e3f) {
+        EXPECT_GT(naive_self_hits, 0) << "the case should be hard without the offset";
+      }
     }
 }

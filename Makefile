@@ -1,0 +1,103 @@
+# TOYRT: the entry point. `make demo` and `make test` are all a newcomer needs;
+# `make setup` (which `make test` runs first) installs everything and is a fast no-op when done.
+#
+#   make setup        Debian packages, .venv with pytest, native build, add-on installed + enabled
+#   make test         C++ tests (ctest), Python tests (pytest), Blender tests (tests/blender)
+#   make demo         the demo render (comes with the Blender engine issue)
+#   make bench-trace  ray-tracing benchmark against Embree -> docs/bench-trace.md
+#   make clean        remove build/ (and its stamps);  make distclean: also .venv
+
+SHELL := /bin/bash
+.SHELLFLAGS := -eu -o pipefail -c
+.DEFAULT_GOAL := help
+
+BUILD    := build
+VENV     := .venv
+# Debian's Python, never a pyenv shim: the module must match the Python Blender 3.4 runs (3.11).
+SYS_PY   := /usr/bin/python3
+BLENDER  ?= blender
+JOBS     ?= 2
+# Extra arguments for the first configure, e.g. CMAKE_ARGS=-DTOYRT_NATIVE_ARCH=OFF
+CMAKE_ARGS ?=
+
+APT_PACKAGES := cmake g++ make libglm-dev pybind11-dev python3-dev python3-numpy python3-venv \
+	libembree-dev libtbb-dev libgtest-dev googletest ocl-icd-opencl-dev opencl-headers \
+	pocl-opencl-icd clinfo blender
+# The stamp's name carries a hash of the list, so adding a package re-runs the check.
+APT_STAMP   := $(BUILD)/.stamp-apt-$(firstword $(shell printf '%s' '$(APT_PACKAGES)' | md5sum))
+VENV_STAMP  := $(VENV)/.stamp-requirements
+
+BLENDER_TESTS := $(sort $(wildcard tests/blender/test_*.py))
+
+.PHONY: help setup apt venv configure native addon test test-native test-python test-blender \
+	demo bench-trace clean distclean
+
+help:
+	@sed -n '2,9p' Makefile | sed 's/^# \{0,1\}//'
+
+# ---- setup ------------------------------------------------------------------------------------------
+setup: apt venv native addon
+
+apt: $(APT_STAMP)
+$(APT_STAMP):
+	@mkdir -p $(BUILD)
+	scripts/ensure-apt.sh $(APT_PACKAGES)
+	@rm -f $(BUILD)/.stamp-apt-*
+	@touch $@
+
+venv: $(VENV_STAMP)
+$(VENV_STAMP): requirements-test.txt | $(APT_STAMP)
+	@# Recreate a venv that was not made from Debian's Python (e.g. by a pyenv shim).
+	@if [ -d $(VENV) ] && ! grep -qx 'home = /usr/bin' $(VENV)/pyvenv.cfg 2>/dev/null; then \
+		echo "venv: $(VENV) was not made by $(SYS_PY); recreating"; rm -rf $(VENV); fi
+	@[ -x $(VENV)/bin/python ] || { echo "venv: creating $(VENV)"; $(SYS_PY) -m venv --system-site-packages $(VENV); }
+	$(VENV)/bin/python -m pip install -q -r requirements-test.txt
+	@touch $@
+
+configure: $(BUILD)/CMakeCache.txt
+$(BUILD)/CMakeCache.txt: | $(APT_STAMP)
+	@# A failed configure leaves a CMakeCache.txt behind: remove it so the next run configures again.
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS) || { rm -f $@; exit 1; }
+
+# Always asks CMake: it knows what changed, and does nothing in well under a second when nothing did.
+native: $(BUILD)/CMakeCache.txt
+	@# (run as a top-level make: no "Entering directory" noise, its own -j)
+	@env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL cmake --build $(BUILD) -j$(JOBS)
+
+# Copies addon/render_toyrt + the module into Blender's user add-ons folder when they changed, and
+# enables the add-on in the user's preferences once (see the script).
+addon: native
+	@BLENDER=$(BLENDER) BUILD_DIR=$(BUILD) scripts/install-addon.sh
+
+# ---- tests ------------------------------------------------------------------------------------------
+test: setup
+	@$(MAKE) --no-print-directory test-native test-python test-blender
+
+test-native:
+	ctest --test-dir $(BUILD) --output-on-failure --no-tests=error
+
+test-python:
+	PYTHONPATH=$(BUILD)/python $(VENV)/bin/python -m pytest tests/python -q
+
+# No --factory-startup: these tests check the add-on as installed and enabled in the user's
+# preferences (factory settings would start Blender without it).
+test-blender:
+	@[ -n "$(BLENDER_TESTS)" ] || { echo "no tests/blender/test_*.py found" >&2; exit 1; }
+	@passed=0; for t in $(BLENDER_TESTS); do \
+		echo "blender: $$t"; \
+		$(BLENDER) -b --python-exit-code 1 --python $$t || { echo "FAILED: $$t" >&2; echo "blender: $$passed passed, 1 failed"; exit 1; }; \
+		passed=$$((passed + 1)); \
+	done; echo "blender: $$passed passed, 0 failed"
+
+# ---- the rest ---------------------------------------------------------------------------------------
+demo:
+	@echo "make demo: the demo render comes with the Blender render-engine issue; nothing to show yet."
+
+bench-trace: native
+	$(if $(filter /%,$(BUILD)),,./)$(BUILD)/bench/bench_trace --out docs/bench-trace.md
+
+clean:
+	rm -rf $(BUILD)
+
+distclean: clean
+	rm -rf $(VENV)
