@@ -68,6 +68,16 @@ inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear
       vfloat tmax = min_keep(min_keep(min_keep(splat(kInfinity), tfx), tfy), tfz) * widen;
       tmax = min_keep(tmax, splat(tfar));
       uint32_t mask = mask_of(tmin <= tmax);
+      if (mask != 0 && AnyHit) {
+        // Any hit ends the walk, so order matters little: no sort, visit the first child hit.
+        current = Entry{n.child[__builtin_ctz(mask)], n.count[__builtin_ctz(mask)], 0.0f};
+        for (mask &= mask - 1; mask; mask &= mask - 1) {
+          const int i = __builtin_ctz(mask);
+          stack[sp++] = Entry{n.child[i], n.count[i], 0.0f};
+          if (n.count[i] == 0) __builtin_prefetch(&bvh.nodes[n.child[i]]);
+        }
+        continue;
+      }
       if (mask != 0) {
         // Children hit, sorted by entry distance (insertion sort: usually one to three).
         Entry hits[kWidth];
