@@ -6,14 +6,21 @@
 namespace toyrt {
 
 namespace {
-// The contiguous range of prim_ids under every node, children before parents.
+// The contiguous range of prim_ids under every node (first, count), by a post-order walk:
+// builders lay nodes out in different orders (depth first for SAH, by split position for LBVH).
 std::vector<std::pair<uint32_t, uint32_t>> subtree_ranges(const Bvh& bvh) {
-  std::vector<std::pair<uint32_t, uint32_t>> range(bvh.nodes.size());  // (first, count)
-  // Depth-first layout puts children after their parent: a backwards sweep sees children first.
-  for (size_t i = bvh.nodes.size(); i-- > 0;) {
+  std::vector<std::pair<uint32_t, uint32_t>> range(bvh.nodes.size());
+  std::vector<std::pair<uint32_t, bool>> stack{{0u, false}};
+  while (!stack.empty()) {
+    const auto [i, children_done] = stack.back();
+    stack.pop_back();
     const Node& n = bvh.nodes[i];
     if (n.is_leaf()) {
       range[i] = {n.first, n.count};
+    } else if (!children_done) {
+      stack.push_back({i, true});
+      stack.push_back({n.first, false});
+      stack.push_back({n.first + 1, false});
     } else {
       const auto l = range[n.first], r = range[n.first + 1];
       range[i] = {std::min(l.first, r.first), l.second + r.second};

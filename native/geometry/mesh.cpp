@@ -34,15 +34,15 @@ Mesh::Mesh(std::vector<Vec3> vertices, std::vector<Triangle> triangles)
   }
 }
 
-void Mesh::build(const BinnedSahConfig& config) {
-  std::vector<uint32_t> valid;
+void Mesh::prepare(std::vector<BBox>& boxes, std::vector<Vec3>& centers, std::vector<uint32_t>& valid) {
+  valid.clear();
   valid.reserve(triangles_.size());
   for (size_t i = 0; i < triangles_.size(); ++i) {
     const Triangle& t = triangles_[i];
     if (!is_degenerate(vertices_[t.x], vertices_[t.y], vertices_[t.z])) valid.push_back(uint32_t(i));
   }
-  std::vector<BBox> boxes(valid.size());
-  std::vector<Vec3> centers(valid.size());
+  boxes.resize(valid.size());
+  centers.resize(valid.size());
   bounds_ = BBox{};
   for (size_t k = 0; k < valid.size(); ++k) {
     const Triangle& t = triangles_[valid[k]];
@@ -54,7 +54,26 @@ void Mesh::build(const BinnedSahConfig& config) {
     centers[k] = b.center();
     bounds_.extend(b);
   }
-  bvh_ = build_binned_sah(boxes.data(), centers.data(), boxes.size(), config);
+}
+
+void Mesh::build(const BinnedSahConfig& config) {
+  std::vector<BBox> boxes;
+  std::vector<Vec3> centers;
+  std::vector<uint32_t> valid;
+  prepare(boxes, centers, valid);
+  finish(build_binned_sah(boxes.data(), centers.data(), boxes.size(), config), valid);
+}
+
+void Mesh::build_lbvh(const LbvhConfig& config, LbvhStats* stats) {
+  std::vector<BBox> boxes;
+  std::vector<Vec3> centers;
+  std::vector<uint32_t> valid;
+  prepare(boxes, centers, valid);
+  finish(toyrt::build_lbvh(boxes.data(), centers.data(), boxes.size(), config, stats), valid);
+}
+
+void Mesh::finish(Bvh bvh, const std::vector<uint32_t>& valid) {
+  bvh_ = std::move(bvh);
   for (uint32_t& id : bvh_.prim_ids) id = valid[id];  // builder slots -> triangle indices
   wide_ = collapse(bvh_, kBlockWidth);
   // Copy every leaf's triangles into blocks and point the wide leaves at them.

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "accel/binned_sah_builder.h"
+#include "accel/lbvh_builder.h"
 #include "accel/wide_bvh.h"
 #include "geometry/triangle_block.h"
 
@@ -19,8 +20,11 @@ class Mesh {
   // a triangle of zero area.
   Mesh(std::vector<Vec3> vertices, std::vector<Triangle> triangles);
 
-  // Builds (or rebuilds) the BVH; runs on the caller's TBB arena.
+  // Builds (or rebuilds) the BVH with the SAH builder; runs on the caller's TBB arena.
   void build(const BinnedSahConfig& config = {});
+  // Builds with the LBVH kernels (OpenCL); throws opencl::OpenClError if they cannot run, leaving
+  // the mesh unbuilt.
+  void build_lbvh(const LbvhConfig& config, LbvhStats* stats = nullptr);
   bool built() const { return built_; }
 
   // Closest hit within [tnear, tfar): shrinks tfar and writes u, v, prim on a hit.
@@ -38,6 +42,11 @@ class Mesh {
   size_t memory_bytes() const;
 
  private:
+  // Boxes and centres of the triangles that can be hit, and their indices.
+  void prepare(std::vector<BBox>& boxes, std::vector<Vec3>& centers, std::vector<uint32_t>& valid);
+  // From a builder's Bvh over `valid`: translate ids, collapse, fill the triangle blocks.
+  void finish(Bvh bvh, const std::vector<uint32_t>& valid);
+
   template <bool AnyHit>
   bool trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v,
              int32_t& prim) const;

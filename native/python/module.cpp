@@ -161,13 +161,39 @@ class PyScene {
     return scene_.add_instance(uint32_t(mesh), m);
   }
 
-  void commit(const std::string& builder, int threads) {
+  void commit(const std::string& builder, int threads, py::handle expected_rays) {
     CommitOptions opt;
     opt.builder = parse_builder(builder);
     opt.threads = check_threads(threads);
-    std::unique_lock lock(mutex_);
-    py::gil_scoped_release release;
-    scene_.commit(opt);
+    if (!expected_rays.is_none()) {
+      if (!py::isinstance<py::int_>(expected_rays) && !py::isinstance<py::float_>(expected_rays))
+        throw py::type_error("expected_rays must be a number (or None when unknown)");
+      opt.expected_rays = expected_rays.cast<double>();
+      if (!(opt.expected_rays >= 0.0) || !std::isfinite(opt.expected_rays))
+        throw py::value_error("expected_rays must be a finite number >= 0 (or None when unknown)");
+    }
+    std::string warning;
+    {
+      std::unique_lock lock(mutex_);
+      py::gil_scoped_release release;
+      scene_.commit(opt);
+      warning = scene_.commit_stats().warning;
+    }
+    // One clear warning when the LBVH could not run and the SAH builder stood in.
+    if (!warning.empty() && PyErr_WarnEx(PyExc_RuntimeWarning, warning.c_str(), 1) != 0) throw py::error_already_set();
+  }
+
+  py::dict last_commit() {
+    std::shared_lock lock(mutex_);
+    const CommitStats& st = scene_.commit_stats();
+    py::dict d;
+    d["build_ms"] = st.build_ms;
+    d["lbvh_compile_ms"] = st.lbvh_compile_ms;
+    d["meshes_built"] = st.meshes_built;
+    d["sah_meshes"] = st.sah_meshes;
+    d["lbvh_meshes"] = st.lbvh_meshes;
+    d["warning"] = st.warning;
+    return d;
   }
 
   py::dict intersect(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads) {
@@ -281,8 +307,15 @@ PYBIND11_MODULE(toyrt, m) {
       .def("add_instance", &PyScene::add_instance, py::arg("mesh"), py::arg("transform"),
            "Places mesh `mesh` again with a (4, 4) row-major affine world matrix; returns the instance id.")
       .def("commit", &PyScene::commit, py::arg("builder") = "auto", py::arg("threads") = 0,
-           "Builds the BVHs of new meshes and the top level. builder: 'auto' or 'sah' ('lbvh' to come);\n"
-           "threads: 0 for all cores.")
+           py::arg("expected_rays") = py::none(),
+           "Builds the BVHs of new meshes and the top level.\n"
+           "builder: 'sah' (binned SAH on the CPU: the faster trees), 'lbvh' (Karras' linear BVH as OpenCL\n"
+           "kernels: the faster builds; falls back to 'sah' with a RuntimeWarning when no OpenCL device or\n"
+           "kernel build is available), or 'auto' (per mesh, whichever makes build + tracing cheaper for\n"
+           "`expected_rays` rays; without that estimate, 'sah'). threads: 0 for all cores.")
+      .def_property_readonly("last_commit", &PyScene::last_commit,
+           "What the last commit did: build_ms, lbvh_compile_ms (OpenCL compilation, first LBVH build of\n"
+           "the process only), meshes_built, sah_meshes, lbvh_meshes, warning.")
       .def("intersect", &PyScene::intersect, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0f,
            py::arg("tfar") = std::numeric_limits<float>::infinity(), py::arg("threads") = 0,
            "Nearest hits of rays org + t * dir with tnear <= t < tfar (world units of t: the direction's\n"

@@ -2,6 +2,7 @@
 
 #include "accel/traverse.h"
 #include "core/parallel.h"
+#include "opencl/device.h"
 
 #include <glm/gtc/matrix_inverse.hpp>
 #include <tbb/blocked_range.h>
@@ -58,15 +59,30 @@ uint32_t Scene::add_instance(uint32_t mesh, const Mat4& to_world) {
 
 void Scene::commit(const CommitOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  if (options.builder == BuilderKind::Lbvh)
-    throw std::invalid_argument("builder 'lbvh' is not available yet: use 'sah' or 'auto'");
   stats_ = {};
   instances_.shrink_to_fit();  // many instances are added one by one: drop the growth slack
   run_with_threads(options.threads, [&] {
     // Meshes first (each build is parallel inside), then the top level over their boxes.
     for (auto& mesh : meshes_) {
       if (mesh->built()) continue;
-      mesh->build(options.sah);
+      BuilderKind kind = options.builder;
+      if (kind == BuilderKind::Auto) kind = options.cost_model.choose(mesh->triangles().size(), options.expected_rays);
+      if (kind == BuilderKind::Lbvh) {
+        try {
+          LbvhStats lbvh_stats;
+          mesh->build_lbvh(options.lbvh, &lbvh_stats);
+          stats_.lbvh_compile_ms += lbvh_stats.compile_ms;
+          ++stats_.lbvh_meshes;
+        } catch (const opencl::OpenClError& e) {
+          if (stats_.warning.empty())
+            stats_.warning = std::string("LBVH builder unavailable, using the SAH builder instead: ") + e.what();
+          kind = BuilderKind::Sah;
+        }
+      }
+      if (kind == BuilderKind::Sah) {
+        mesh->build(options.sah);
+        ++stats_.sah_meshes;
+      }
       ++stats_.meshes_built;
     }
     std::vector<uint32_t> placed;

@@ -9,6 +9,8 @@
 
 #include "core/ray.h"
 #include "geometry/mesh.h"
+#include "accel/builder_choice.h"
+#include "accel/lbvh_builder.h"
 #include "scene/instance.h"
 
 #include <memory>
@@ -17,21 +19,28 @@
 
 namespace toyrt {
 
-enum class BuilderKind { Auto, Sah, Lbvh };
-
 // Parses "auto", "sah", "lbvh"; throws std::invalid_argument on anything else.
 BuilderKind parse_builder(const std::string& name);
 
 struct CommitOptions {
   BuilderKind builder = BuilderKind::Auto;
   int threads = 0;  // 0: all cores
+  // Rays the caller expects to trace (pixels x samples x rays per sample), for "auto"; < 0:
+  // unknown, and "auto" keeps the SAH builder.
+  double expected_rays = -1.0;
   BinnedSahConfig sah;
+  LbvhConfig lbvh;
+  BuilderCostModel cost_model;
 };
 
 struct CommitStats {
-  double build_ms = 0.0;            // wall time of the last commit
-  size_t meshes_built = 0;          // meshes whose BVH the last commit (re)built
-  std::string builder = "sah";      // what the last commit used
+  double build_ms = 0.0;         // wall time of the last commit
+  double lbvh_compile_ms = 0.0;  // OpenCL kernel compilation inside it (first LBVH build of the process)
+  size_t meshes_built = 0;       // meshes whose BVH the last commit (re)built
+  size_t sah_meshes = 0, lbvh_meshes = 0;
+  // Set when an LBVH build could not run (no OpenCL device, kernel build failure) and the SAH
+  // builder stood in: one message per commit.
+  std::string warning;
 };
 
 // A batch of rays as flat arrays: origins and directions are (count, 3) row-major; tnear and tfar

@@ -13,10 +13,13 @@ using namespace toyrt::testing;
 namespace {
 
 // through: shoot the diffuse rays into the surface (for convex meshes, which outgoing rays miss).
-void expect_agreement(const char* name, const MeshData& m, bool through = false, int width = 256, int height = 192) {
+void expect_agreement(BuilderKind builder, const char* name, const MeshData& m, bool through = false, int width = 256,
+                      int height = 192) {
   Scene scene;
   scene.add_instance(scene.add_mesh(m.vertices, m.triangles), Mat4(1.0f));
-  scene.commit();
+  CommitOptions options;
+  options.builder = builder;
+  scene.commit(options);
   const EmbreeScene embree(m.vertices, m.triangles);
 
   const BBox box = bounds_of(m);
@@ -47,29 +50,36 @@ void expect_agreement(const char* name, const MeshData& m, bool through = false,
 
 }  // namespace
 
-TEST(EmbreeOracle, RandomTriangleSoupAgrees) { expect_agreement("soup", triangle_soup(100000, 0.03f, 1)); }
+// Every test runs once per builder: the LBVH must pass exactly what the SAH BVH passes.
+class EmbreeOracle : public ::testing::TestWithParam<BuilderKind> {};
+INSTANTIATE_TEST_SUITE_P(Builders, EmbreeOracle, ::testing::Values(BuilderKind::Sah, BuilderKind::Lbvh),
+                         [](const ::testing::TestParamInfo<BuilderKind>& info) {
+                           return info.param == BuilderKind::Sah ? std::string("Sah") : std::string("Lbvh");
+                         });
 
-TEST(EmbreeOracle, ClosedSphereAgrees) { expect_agreement("sphere", uv_sphere(200, 400), true); }
+TEST_P(EmbreeOracle, RandomTriangleSoupAgrees) { expect_agreement(GetParam(), "soup", triangle_soup(100000, 0.03f, 1)); }
 
-TEST(EmbreeOracle, MillionTriangleMeshAgrees) {
+TEST_P(EmbreeOracle, ClosedSphereAgrees) { expect_agreement(GetParam(), "sphere", uv_sphere(200, 400), true); }
+
+TEST_P(EmbreeOracle, MillionTriangleMeshAgrees) {
   const MeshData m = uv_sphere(708, 708, 1.0f, 0.15f);  // 1,000,872 triangles, bumpy, shared vertices
   ASSERT_GE(m.triangle_count(), 1000000u);
-  expect_agreement("bumpy-1M", m, false, 512, 384);
+  expect_agreement(GetParam(), "bumpy-1M", m, false, 512, 384);
 }
 
-TEST(EmbreeOracle, LongThinSliversAgree) { expect_agreement("slivers", slivers(50000, 2)); }
+TEST_P(EmbreeOracle, LongThinSliversAgree) { expect_agreement(GetParam(), "slivers", slivers(50000, 2)); }
 
-TEST(EmbreeOracle, GeometryFarFromTheOriginAgrees) {
+TEST_P(EmbreeOracle, GeometryFarFromTheOriginAgrees) {
   // A unit-sized object at 1e4 and 1e5, and one of radius 100 at 1e6 (where float spacing is
   // 1/16, a unit object would be a handful of grid points).
   for (auto [distance, radius] : {std::pair{1e4f, 1.0f}, std::pair{1e5f, 1.0f}, std::pair{1e6f, 100.0f}}) {
     const std::string name = "far-" + std::to_string(int(distance));
     const Vec3 offset(distance, -distance, 0.5f * distance);
-    expect_agreement(name.c_str(), transformed(uv_sphere(100, 200, 1.0f, 0.2f), radius, offset));
+    expect_agreement(GetParam(), name.c_str(), transformed(uv_sphere(100, 200, 1.0f, 0.2f), radius, offset));
   }
 }
 
-TEST(EmbreeOracle, TinyScaleAgrees) {
-  expect_agreement("tiny-1e-3", transformed(uv_sphere(100, 200, 1.0f, 0.2f), 1e-3f, Vec3(0.0f)));
-  expect_agreement("tiny-soup", transformed(triangle_soup(20000, 0.03f, 9), 1e-3f, Vec3(2e-3f)));
+TEST_P(EmbreeOracle, TinyScaleAgrees) {
+  expect_agreement(GetParam(), "tiny-1e-3", transformed(uv_sphere(100, 200, 1.0f, 0.2f), 1e-3f, Vec3(0.0f)));
+  expect_agreement(GetParam(), "tiny-soup", transformed(triangle_soup(20000, 0.03f, 9), 1e-3f, Vec3(2e-3f)));
 }

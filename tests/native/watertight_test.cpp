@@ -12,10 +12,12 @@ using namespace toyrt::testing;
 
 namespace {
 
-void expect_watertight(const char* name, const MeshData& m, const Vec3& inside, int per_edge = 4) {
+void expect_watertight(BuilderKind builder, const char* name, const MeshData& m, const Vec3& inside, int per_edge = 4) {
   Scene scene;
   scene.add_instance(scene.add_mesh(m.vertices, m.triangles), Mat4(1.0f));
-  scene.commit();
+  CommitOptions options;
+  options.builder = builder;
+  scene.commit(options);
   const std::vector<Ray> rays = rays_at_vertices_and_edges(m, inside, per_edge, 99);
   size_t misses = 0, unoccluded = 0;
   for (const Ray& r : rays) {
@@ -37,30 +39,37 @@ void expect_watertight(const char* name, const MeshData& m, const Vec3& inside, 
 
 }  // namespace
 
-TEST(Watertight, SphereHasNoGapsAtEdgesOrVertices) {
-  expect_watertight("sphere", uv_sphere(100, 200), Vec3(0.0f));
-  expect_watertight("sphere-off-centre", uv_sphere(100, 200), Vec3(0.3f, -0.2f, 0.1f));
+// Every test runs once per builder: the LBVH must pass exactly what the SAH BVH passes.
+class Watertight : public ::testing::TestWithParam<BuilderKind> {};
+INSTANTIATE_TEST_SUITE_P(Builders, Watertight, ::testing::Values(BuilderKind::Sah, BuilderKind::Lbvh),
+                         [](const ::testing::TestParamInfo<BuilderKind>& info) {
+                           return info.param == BuilderKind::Sah ? std::string("Sah") : std::string("Lbvh");
+                         });
+
+TEST_P(Watertight, SphereHasNoGapsAtEdgesOrVertices) {
+  expect_watertight(GetParam(), "sphere", uv_sphere(100, 200), Vec3(0.0f));
+  expect_watertight(GetParam(), "sphere-off-centre", uv_sphere(100, 200), Vec3(0.3f, -0.2f, 0.1f));
 }
 
-TEST(Watertight, FanOfThousandsSharingOneVertexHasNoGaps) {
+TEST_P(Watertight, FanOfThousandsSharingOneVertexHasNoGaps) {
   // 2 apexes, each shared by 5000 triangles: rays at the apex meet 5000 candidate triangles.
-  expect_watertight("bicone-fan", bicone_fan(5000), Vec3(0.01f, 0.02f, 0.0f), 8);
+  expect_watertight(GetParam(), "bicone-fan", bicone_fan(5000), Vec3(0.01f, 0.02f, 0.0f), 8);
 }
 
-TEST(Watertight, BumpyMeshHasNoGaps) {
-  expect_watertight("bumpy", uv_sphere(150, 300, 1.0f, 0.2f), Vec3(0.05f));
+TEST_P(Watertight, BumpyMeshHasNoGaps) {
+  expect_watertight(GetParam(), "bumpy", uv_sphere(150, 300, 1.0f, 0.2f), Vec3(0.05f));
 }
 
-TEST(Watertight, HoldsFarFromTheOriginAndAtTinyScale) {
+TEST_P(Watertight, HoldsFarFromTheOriginAndAtTinyScale) {
   for (float d : {1e3f, 1e5f, 1e6f}) {
     const Vec3 offset(d, -0.5f * d, 0.25f * d);
-    expect_watertight(("far-" + std::to_string(int(d))).c_str(), transformed(uv_sphere(60, 120), 1.0f, offset), offset);
+    expect_watertight(GetParam(), ("far-" + std::to_string(int(d))).c_str(), transformed(uv_sphere(60, 120), 1.0f, offset), offset);
   }
-  expect_watertight("tiny-1e-3", transformed(uv_sphere(60, 120), 1e-3f, Vec3(0.0f)), Vec3(0.0f));
-  expect_watertight("tiny-1e-6", transformed(uv_sphere(60, 120), 1e-6f, Vec3(1e-6f)), Vec3(1e-6f));
+  expect_watertight(GetParam(), "tiny-1e-3", transformed(uv_sphere(60, 120), 1e-3f, Vec3(0.0f)), Vec3(0.0f));
+  expect_watertight(GetParam(), "tiny-1e-6", transformed(uv_sphere(60, 120), 1e-6f, Vec3(1e-6f)), Vec3(1e-6f));
 }
 
-TEST(Watertight, HoldsThroughAnInstanceTransform) {
+TEST_P(Watertight, HoldsThroughAnInstanceTransform) {
   const MeshData m = uv_sphere(60, 120);
   Scene scene;
   const uint32_t id = scene.add_mesh(m.vertices, m.triangles);
@@ -71,7 +80,9 @@ TEST(Watertight, HoldsThroughAnInstanceTransform) {
   x[3] = glm::vec4(5.0f, -3.0f, 2.0f, 1.0f);
   scene.add_instance(id, x);
   scene.add_instance(id, glm::mat4(1.0f));  // a second one, so the top level is walked
-  scene.commit();
+  CommitOptions options;
+  options.builder = GetParam();
+  scene.commit(options);
   const Vec3 centre(x[3]);
   size_t misses = 0, rays = 0;
   for (Ray r : rays_at_vertices_and_edges(transformed(m, 1.0f, Vec3(0.0f)), Vec3(0.0f), 2, 5)) {

@@ -1,0 +1,333 @@
+#include "accel/lbvh_builder.h"
+
+#include "lbvh_kernel_source.h"  // generated from kernels/lbvh.cl by CMake
+#include "opencl/device.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <chrono>
+#include <numeric>
+
+namespace toyrt {
+namespace {
+
+// Quantisation shared by the kernel and the reference: the same float operations in the same
+// order (the core and the kernel are both compiled without FMA contraction).
+struct MortonFrame {
+  Vec3 lo, scale;
+  uint32_t bits;
+};
+
+MortonFrame morton_frame(const BBox& centroid_bounds, MortonBits bits) {
+  const uint32_t b = uint32_t(bits);
+  const float cells = float((1u << b) - 1u);
+  const Vec3 extent = centroid_bounds.extent();
+  MortonFrame f{centroid_bounds.lo, Vec3(0.0f), b};
+  for (int a = 0; a < 3; ++a) f.scale[a] = extent[a] > 0.0f ? cells / extent[a] : 0.0f;
+  return f;
+}
+
+uint64_t spread_bits(uint64_t v, uint32_t bits) {
+  uint64_t out = 0;
+  for (uint32_t k = 0; k < bits; ++k) out |= ((v >> k) & 1u) << (3 * k);
+  return out;
+}
+
+uint64_t morton_code(const Vec3& c, const MortonFrame& f) {
+  const float cells = float((1u << f.bits) - 1u);
+  uint64_t q[3];
+  for (int a = 0; a < 3; ++a) q[a] = uint64_t(std::min(std::max((c[a] - f.lo[a]) * f.scale[a], 0.0f), cells));
+  return (spread_bits(q[0], f.bits) << 2) | (spread_bits(q[1], f.bits) << 1) | spread_bits(q[2], f.bits);
+}
+
+// As OpenCL's clz: defined for zero.
+int clz32(uint32_t x) { return x ? __builtin_clz(x) : 32; }
+
+// See common_prefix in kernels/lbvh.cl: equal keys are told apart by their indices.
+int common_prefix(const std::vector<uint64_t>& keys, int64_t i, int64_t j) {
+  const int64_t n = int64_t(keys.size());
+  if (j < 0 || j >= n) return -1;
+  const uint64_t a = keys[size_t(i)], b = keys[size_t(j)];
+  if (a == b) return 64 + clz32(uint32_t(i ^ j));
+  return __builtin_clzll(a ^ b);
+}
+
+void emit_node(const std::vector<uint64_t>& keys, int64_t i, LbvhNode& node) {
+  const int d = common_prefix(keys, i, i + 1) - common_prefix(keys, i, i - 1) >= 0 ? 1 : -1;
+  const int min_prefix = common_prefix(keys, i, i - d);
+  int64_t max_len = 2;
+  while (common_prefix(keys, i, i + max_len * d) > min_prefix) max_len *= 2;
+  int64_t len = 0;
+  for (int64_t t = max_len / 2; t >= 1; t /= 2)
+    if (common_prefix(keys, i, i + (len + t) * d) > min_prefix) len += t;
+  const int64_t j = i + len * d;
+  const int node_prefix = common_prefix(keys, i, j);
+  int64_t split = 0;
+  for (int64_t div = 2;; div *= 2) {
+    const int64_t t = (len + div - 1) / div;
+    if (common_prefix(keys, i, i + (split + t) * d) > node_prefix) split += t;
+    if (t == 1) break;
+  }
+  const int64_t gamma = i + split * d + std::min(d, 0);
+  node.left = std::min(i, j) == gamma ? ~int32_t(gamma) : int32_t(gamma);
+  node.right = std::max(i, j) == gamma + 1 ? ~int32_t(gamma + 1) : int32_t(gamma + 1);
+}
+
+BBox centroid_bounds_of(const Vec3* centers, size_t count) {
+  BBox b;
+  for (size_t i = 0; i < count; ++i) b.extend(centers[i]);
+  return b;
+}
+
+}  // namespace
+
+LbvhHierarchy build_lbvh_hierarchy_reference(const BBox* prim_bounds, const Vec3* centers, size_t count,
+                                             const LbvhConfig& config) {
+  LbvhHierarchy h;
+  if (count == 0) return h;
+  const MortonFrame frame = morton_frame(centroid_bounds_of(centers, count), config.bits);
+  std::vector<uint64_t> codes(count);
+  for (size_t i = 0; i < count; ++i) codes[i] = morton_code(centers[i], frame);
+  h.values.resize(count);
+  std::iota(h.values.begin(), h.values.end(), 0u);
+  // Stable, as the kernels' radix sort: equal codes keep input order.
+  std::stable_sort(h.values.begin(), h.values.end(), [&](uint32_t a, uint32_t b) { return codes[a] < codes[b]; });
+  h.keys.resize(count);
+  for (size_t k = 0; k < count; ++k) h.keys[k] = codes[h.values[k]];
+  if (count == 1) return h;
+  h.nodes.resize(count - 1);
+  h.internal_parent.assign(count - 1, -1);
+  h.leaf_parent.assign(count, -1);
+  for (size_t i = 0; i + 1 < count; ++i) {
+    emit_node(h.keys, int64_t(i), h.nodes[i]);
+    for (int32_t child : {h.nodes[i].left, h.nodes[i].right})
+      (child < 0 ? h.leaf_parent[size_t(~child)] : h.internal_parent[size_t(child)]) = int32_t(i);
+  }
+  // Bounds bottom up: children have no fixed index order, so recurse from the root (post-order).
+  std::vector<std::pair<int32_t, bool>> stack{{0, false}};
+  auto bounds_of = [&](int32_t child, float* lo, float* hi) {
+    if (child < 0) {
+      const BBox& b = prim_bounds[h.values[size_t(~child)]];
+      for (int a = 0; a < 3; ++a) lo[a] = b.lo[a], hi[a] = b.hi[a];
+    } else {
+      for (int a = 0; a < 3; ++a) lo[a] = h.nodes[size_t(child)].lo[a], hi[a] = h.nodes[size_t(child)].hi[a];
+    }
+  };
+  while (!stack.empty()) {
+    auto [i, children_done] = stack.back();
+    stack.pop_back();
+    LbvhNode& node = h.nodes[size_t(i)];
+    if (!children_done) {
+      stack.push_back({i, true});
+      if (node.left >= 0) stack.push_back({node.left, false});
+      if (node.right >= 0) stack.push_back({node.right, false});
+      continue;
+    }
+    float llo[3], lhi[3], rlo[3], rhi[3];
+    bounds_of(node.left, llo, lhi);
+    bounds_of(node.right, rlo, rhi);
+    for (int a = 0; a < 3; ++a) {
+      node.lo[a] = std::fmin(llo[a], rlo[a]);
+      node.hi[a] = std::fmax(lhi[a], rhi[a]);
+    }
+  }
+  return h;
+}
+
+namespace {
+
+// Runs the kernels. Fills `hierarchy` (Karras nodes and parents, and the keys when asked) and/or
+// `bvh` (the flat nodes written on the device), whichever is non-null.
+void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config,
+                LbvhStats* stats, LbvhHierarchy* hierarchy, bool with_keys, Bvh* bvh) {
+  using namespace opencl;
+  if (count >= size_t(INT32_MAX) / 2) throw OpenClError("LBVH: more than 2^30 primitives");
+  const Device& dev = device();
+  static std::atomic<bool> compiled{false};
+  const bool compiling_now = !compiled.exchange(true);
+  const Program& prog = program("lbvh", kLbvhKernelSource, "-cl-std=CL1.2");
+  double compile_ms = prog.compile_ms;
+  if (compiling_now) {
+    // Drivers finish compiling at a kernel's first launch (PoCL does): run every stage once on
+    // three boxes so that this cost lands in compile_ms, not in the first build's time.
+    const auto warm = std::chrono::steady_clock::now();
+    const BBox tiny[3] = {{Vec3(0.0f), Vec3(1.0f)}, {Vec3(1.0f), Vec3(2.0f)}, {Vec3(2.0f), Vec3(3.0f)}};
+    const Vec3 tiny_centers[3] = {Vec3(0.5f), Vec3(1.5f), Vec3(2.5f)};
+    Bvh unused;
+    run_opencl(tiny, tiny_centers, 3, config, nullptr, nullptr, false, &unused);
+    compile_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - warm).count();
+  }
+  if (stats) {
+    stats->device = dev.name;
+    stats->compile_ms = compiling_now ? compile_ms : 0.0;
+    stats->stages.clear();
+  }
+  const auto start = std::chrono::steady_clock::now();
+  auto last = start;
+  auto stage = [&](const char* name) {
+    if (!stats) return;
+    check(clFinish(dev.queue), "clFinish");
+    const auto now = std::chrono::steady_clock::now();
+    stats->stages.emplace_back(name, std::chrono::duration<double, std::milli>(now - last).count());
+    last = now;
+  };
+  if (count == 0) return;
+  const cl_uint n = cl_uint(count);
+
+  Buffer centers_buf(count * sizeof(Vec3), CL_MEM_READ_ONLY, centers);
+  // Centroid bounds: partial boxes on the device, the last few merged here.
+  const size_t partials = std::min<size_t>(count, 1024);
+  Buffer partial_buf(partials * 6 * sizeof(float));
+  Kernel(prog.program, "centroid_bounds").arg(0, centers_buf.get()).arg(1, n).arg(2, partial_buf.get()).run(partials);
+  std::vector<float> partial(partials * 6);
+  partial_buf.read(partial.data(), partial.size() * sizeof(float));
+  BBox cb;
+  for (size_t g = 0; g < partials; ++g) {
+    cb.extend(Vec3(partial[6 * g], partial[6 * g + 1], partial[6 * g + 2]));
+    cb.extend(Vec3(partial[6 * g + 3], partial[6 * g + 4], partial[6 * g + 5]));
+  }
+  const MortonFrame frame = morton_frame(cb, config.bits);
+  stage("centroid bounds");
+
+  Buffer keys[2] = {Buffer(count * sizeof(uint64_t)), Buffer(count * sizeof(uint64_t))};
+  Buffer values[2] = {Buffer(count * sizeof(uint32_t)), Buffer(count * sizeof(uint32_t))};
+  Kernel(prog.program, "morton_codes")
+      .arg(0, centers_buf.get()).arg(1, n)
+      .arg(2, frame.lo.x).arg(3, frame.lo.y).arg(4, frame.lo.z)
+      .arg(5, frame.scale.x).arg(6, frame.scale.y).arg(7, frame.scale.z)
+      .arg(8, cl_uint(frame.bits)).arg(9, keys[0].get()).arg(10, values[0].get())
+      .run(count);
+  stage("morton codes");
+
+  // Radix sort, 8 bits a pass over the 3 x bits code bits.
+  const cl_uint block = 4096;
+  const size_t blocks = (count + block - 1) / block;
+  Buffer hist(256 * blocks * sizeof(cl_uint));
+  Kernel histogram(prog.program, "radix_histogram"), scan(prog.program, "radix_scan"),
+      scatter(prog.program, "radix_scatter");
+  const uint32_t key_bits = 3 * frame.bits;
+  int in = 0;
+  for (cl_uint shift = 0; shift < key_bits; shift += 8, in ^= 1) {
+    histogram.arg(0, keys[in].get()).arg(1, n).arg(2, shift).arg(3, block).arg(4, hist.get()).run(blocks);
+    scan.arg(0, hist.get()).arg(1, cl_uint(256 * blocks)).run(1);
+    scatter.arg(0, keys[in].get()).arg(1, values[in].get()).arg(2, n).arg(3, shift).arg(4, block)
+        .arg(5, hist.get()).arg(6, keys[in ^ 1].get()).arg(7, values[in ^ 1].get())
+        .run(blocks);
+  }
+  stage("radix sort");
+
+  std::vector<uint32_t> order(count);
+  values[in].read(order.data(), count * sizeof(uint32_t));
+  if (hierarchy && with_keys) {
+    hierarchy->keys.resize(count);
+    keys[in].read(hierarchy->keys.data(), count * sizeof(uint64_t));
+  }
+  if (count == 1) {
+    if (hierarchy) hierarchy->values = order;
+    if (bvh) *bvh = to_bvh(LbvhHierarchy{{}, order, {}, {}, {}}, prim_bounds);
+    return;
+  }
+  const size_t internal = count - 1;
+  Buffer nodes(internal * sizeof(LbvhNode)), internal_parent(internal * sizeof(cl_int)),
+      leaf_parent(count * sizeof(cl_int)), flags(internal * sizeof(cl_int));
+  Kernel(prog.program, "emit_hierarchy")
+      .arg(0, keys[in].get()).arg(1, n).arg(2, nodes.get()).arg(3, internal_parent.get()).arg(4, leaf_parent.get())
+      .run(internal);
+  stage("hierarchy");
+
+  // BBox is six packed floats (lo.xyz, hi.xyz): the layout the kernels read.
+  static_assert(sizeof(BBox) == 6 * sizeof(float), "BBox must be six packed floats");
+  Buffer bounds_buf(count * sizeof(BBox), CL_MEM_READ_ONLY, prim_bounds);
+  Buffer sorted_bounds(count * sizeof(BBox));
+  Kernel(prog.program, "gather_bounds")
+      .arg(0, bounds_buf.get()).arg(1, values[in].get()).arg(2, n).arg(3, sorted_bounds.get())
+      .run(count);
+  flags.fill_zero(internal * sizeof(cl_int));
+  Kernel(prog.program, "propagate_bounds")
+      .arg(0, sorted_bounds.get()).arg(1, n).arg(2, nodes.get())
+      .arg(3, internal_parent.get()).arg(4, leaf_parent.get()).arg(5, flags.get())
+      .run(count);
+  stage("bounds");
+
+  if (bvh) {
+    bvh->nodes.resize(2 * count - 1);
+    const size_t bytes = bvh->nodes.size() * sizeof(Node);
+    Buffer flat(bytes, CL_MEM_WRITE_ONLY, bvh->nodes.data());  // written in place where the device can
+    Kernel(prog.program, "write_bvh_nodes")
+        .arg(0, nodes.get()).arg(1, internal_parent.get()).arg(2, leaf_parent.get()).arg(3, sorted_bounds.get())
+        .arg(4, n).arg(5, flat.get())
+        .run(2 * count - 1);
+    flat.sync_to_host(bytes);
+    bvh->prim_ids = order;
+    stage("flat nodes");
+  }
+  if (hierarchy) {
+    hierarchy->values = std::move(order);
+    hierarchy->nodes.resize(internal);
+    hierarchy->internal_parent.resize(internal);
+    hierarchy->leaf_parent.resize(count);
+    nodes.read(hierarchy->nodes.data(), internal * sizeof(LbvhNode));
+    internal_parent.read(hierarchy->internal_parent.data(), internal * sizeof(cl_int));
+    leaf_parent.read(hierarchy->leaf_parent.data(), count * sizeof(cl_int));
+  }
+  check(clFinish(dev.queue), "clFinish");
+}
+
+}  // namespace
+
+LbvhHierarchy build_lbvh_hierarchy_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count,
+                                          const LbvhConfig& config, LbvhStats* stats, bool with_keys) {
+  LbvhHierarchy h;
+  run_opencl(prim_bounds, centers, count, config, stats, &h, with_keys, nullptr);
+  return h;
+}
+
+Bvh to_bvh(const LbvhHierarchy& h, const BBox* prim_bounds) {
+  Bvh bvh;
+  const size_t count = h.values.size();
+  if (count == 0) return bvh;
+  bvh.prim_ids = h.values;
+  bvh.nodes.resize(2 * count - 1);
+  if (count == 1) {
+    bvh.nodes[0].set_bbox(prim_bounds[h.values[0]]);
+    bvh.nodes[0].first = 0;
+    bvh.nodes[0].count = 1;
+    return bvh;
+  }
+  // The same placement as the write_bvh_nodes kernel.
+  auto split_of = [&](int32_t p) { const int32_t l = h.nodes[size_t(p)].left; return uint32_t(l >= 0 ? l : ~l); };
+  auto slot = [&](int32_t p, int32_t child) {
+    return 1u + 2u * split_of(p) + (h.nodes[size_t(p)].right == child ? 1u : 0u);
+  };
+  for (size_t i = 0; i + 1 < count; ++i) {
+    const LbvhNode& src = h.nodes[i];
+    Node& node = bvh.nodes[i == 0 ? 0 : slot(h.internal_parent[i], int32_t(i))];
+    node.set_bbox({{src.lo[0], src.lo[1], src.lo[2]}, {src.hi[0], src.hi[1], src.hi[2]}});
+    node.first = 1u + 2u * split_of(int32_t(i));
+    node.count = 0;
+  }
+  for (size_t k = 0; k < count; ++k) {
+    Node& node = bvh.nodes[slot(h.leaf_parent[k], ~int32_t(k))];
+    node.set_bbox(prim_bounds[h.values[k]]);
+    node.first = uint32_t(k);
+    node.count = 1;
+  }
+  return bvh;
+}
+
+Bvh build_lbvh(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config,
+               LbvhStats* stats) {
+  const auto start = std::chrono::steady_clock::now();
+  Bvh bvh;
+  run_opencl(prim_bounds, centers, count, config, stats, nullptr, false, &bvh);
+  if (stats)
+    stats->build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return bvh;
+}
+
+Bvh build_lbvh_reference(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config) {
+  return to_bvh(build_lbvh_hierarchy_reference(prim_bounds, centers, count, config), prim_bounds);
+}
+
+}  // namespace toyrt

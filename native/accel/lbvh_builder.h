@@ -1,0 +1,58 @@
+// Linear BVH (Karras 2012): primitives sorted along a Morton curve, the hierarchy read off the
+// sorted codes, boxes filled in bottom up. The OpenCL build runs kernels/lbvh.cl (on PoCL here);
+// the reference build runs the same algorithm on the CPU, with the same float operations, so the
+// two agree node for node. Both end in the same binary Bvh the SAH builder makes (leaves of one
+// primitive; collapse() gathers them into 4-triangle leaves for tracing).
+#pragma once
+
+#include "accel/bvh.h"
+#include "accel/lbvh_layout.h"
+
+#include <string>
+#include <vector>
+
+namespace toyrt {
+
+struct LbvhConfig {
+  // 30-bit codes tell 1024 positions per axis apart, 63-bit codes two million; see docs/lbvh.md
+  // for what the finer codes buy and cost.
+  MortonBits bits = MortonBits::k30;
+};
+
+struct LbvhStats {
+  double compile_ms = 0.0;  // kernel compilation, paid once per process (0 after the first build)
+  double build_ms = 0.0;    // uploads, kernels, download and conversion to Bvh
+  std::string device;
+  // Wall time of each stage, in pipeline order (the queue is drained between stages).
+  std::vector<std::pair<std::string, double>> stages;
+};
+
+// What the Karras construction produces before conversion: n - 1 internal nodes (root 0), and
+// the primitive order (sorted slot -> input index), with the sorted keys.
+struct LbvhHierarchy {
+  std::vector<LbvhNode> nodes;
+  std::vector<uint32_t> values;
+  std::vector<uint64_t> keys;
+  std::vector<int32_t> internal_parent;  // -1 at the root
+  std::vector<int32_t> leaf_parent;
+};
+
+// OpenCL build; throws opencl::OpenClError when there is no device or the kernels fail to build.
+// The sorted keys are read back only when with_keys (tests compare them with the reference).
+LbvhHierarchy build_lbvh_hierarchy_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count,
+                                          const LbvhConfig& config, LbvhStats* stats = nullptr,
+                                          bool with_keys = false);
+// The same construction on the CPU, single-threaded: the reference the kernels are checked by.
+LbvhHierarchy build_lbvh_hierarchy_reference(const BBox* prim_bounds, const Vec3* centers, size_t count,
+                                             const LbvhConfig& config);
+// The flat Bvh of a hierarchy, laid out as the write_bvh_nodes kernel lays it out (children of
+// internal node p at 1 + 2 gamma_p; see lbvh_layout.h).
+Bvh to_bvh(const LbvhHierarchy& h, const BBox* prim_bounds);
+
+// OpenCL build straight to a Bvh (the flat nodes are written on the device).
+Bvh build_lbvh(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config = {},
+               LbvhStats* stats = nullptr);
+// The reference build straight to a Bvh.
+Bvh build_lbvh_reference(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config = {});
+
+}  // namespace toyrt
