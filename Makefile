@@ -5,6 +5,7 @@
 #   make test         C++ tests (ctest), Python tests (pytest), Blender tests (tests/blender)
 #   make demo         the demo render (comes with the Blender engine issue)
 #   make bench-trace  ray-tracing benchmark against Embree -> docs/bench-trace.md
+#   make bench-lbvh   builders (LBVH, SAH, Embree) from 10K to 4M triangles -> docs/lbvh-bench.md, lbvh.png
 #   make clean        remove build/ (and its stamps);  make distclean: also .venv
 
 SHELL := /bin/bash
@@ -22,7 +23,7 @@ CMAKE_ARGS ?=
 
 APT_PACKAGES := cmake g++ make libglm-dev pybind11-dev python3-dev python3-numpy python3-venv \
 	libembree-dev libtbb-dev libgtest-dev googletest ocl-icd-opencl-dev opencl-headers \
-	pocl-opencl-icd clinfo blender
+	pocl-opencl-icd clinfo blender python3-matplotlib
 # The stamp's name carries a hash of the list, so adding a package re-runs the check.
 APT_STAMP   := $(BUILD)/.stamp-apt-$(firstword $(shell printf '%s' '$(APT_PACKAGES)' | md5sum))
 VENV_STAMP  := $(VENV)/.stamp-requirements
@@ -30,10 +31,10 @@ VENV_STAMP  := $(VENV)/.stamp-requirements
 BLENDER_TESTS := $(sort $(wildcard tests/blender/test_*.py))
 
 .PHONY: help setup apt venv configure native addon test test-native test-python test-blender \
-	demo bench-trace clean distclean
+	demo bench-trace bench-lbvh clean distclean
 
 help:
-	@sed -n '2,9p' Makefile | sed 's/^# \{0,1\}//'
+	@sed -n '2,10p' Makefile | sed 's/^# \{0,1\}//'
 
 # ---- setup ------------------------------------------------------------------------------------------
 setup: apt venv native addon
@@ -95,6 +96,11 @@ demo:
 
 bench-trace: native
 	$(if $(filter /%,$(BUILD)),,./)$(BUILD)/bench/bench_trace --out docs/bench-trace.md
+
+# Builders from 10K to 4M triangles (LBVH on PoCL, SAH, Embree): docs/lbvh.md and its chart.
+bench-lbvh: native
+	$(if $(filter /%,$(BUILD)),,./)$(BUILD)/bench/bench_lbvh --out docs/lbvh-bench.md --csv docs/lbvh.csv
+	$(SYS_PY) bench/plot_lbvh.py docs/lbvh.csv docs/lbvh.png
 
 clean:
 	rm -rf $(BUILD)

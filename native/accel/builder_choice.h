@@ -4,8 +4,8 @@
 //   cost(SAH)  = kSahBuildNs  * n + R * kTraceNs
 //   cost(LBVH) = kLbvhBuildNs * n + R * kTraceNs * kLbvhTraceFactor
 // so the LBVH wins when R < n * (kSahBuildNs - kLbvhBuildNs) / (kTraceNs * (kLbvhTraceFactor - 1)).
-// The constants are per-core-agnostic ratios measured by `make bench-lbvh` on the benchmark
-// meshes (docs/lbvh.md), which also checks that the choice lands within 10 % of the better total.
+// Break-even: about 11 rays per triangle. The constants were measured on this project's
+// machines; `make bench-lbvh` reports how close the choice lands to the better total.
 #pragma once
 
 #include <cstddef>
@@ -15,10 +15,11 @@ namespace toyrt {
 enum class BuilderKind { Auto, Sah, Lbvh };
 
 struct BuilderCostModel {
-  double sah_build_ns = 500.0;    // per triangle, binned SAH with TBB (measured 450-540 at 1M, 2 cores)
-  double lbvh_build_ns = 170.0;   // per triangle, LBVH kernels on PoCL (measured 150-200 at 1M, 2 cores)
-  double trace_ns = 250.0;        // per ray through a SAH tree (primary, diffuse and shadow mixed, 2 cores)
-  double lbvh_trace_factor = 1.3; // an LBVH tree's ray cost relative to SAH's (measured 1.2-1.4)
+  // Measured by `make bench-lbvh` on 2 cores (docs/lbvh-bench.md), 10K to 4M triangles:
+  double sah_build_ns = 450.0;    // per triangle, binned SAH with TBB (420-750)
+  double lbvh_build_ns = 150.0;   // per triangle, LBVH kernels on PoCL (125-260)
+  double trace_ns = 130.0;        // per ray through a SAH tree, primary/diffuse/shadow mixed (100-230)
+  double lbvh_trace_factor = 1.2; // an LBVH tree's ray cost relative to SAH's (1.06-1.28)
 
   // expected_rays < 0: unknown, which keeps the SAH tree (the faster to trace).
   BuilderKind choose(size_t triangles, double expected_rays) const {

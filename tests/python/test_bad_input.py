@@ -65,8 +65,10 @@ def test_unknown_mesh_and_builder():
         s.add_instance(-1, np.eye(4))
     with pytest.raises(ValueError, match="unknown builder 'fast'"):
         s.commit(builder="fast")
-    with pytest.raises(ValueError, match="not available yet"):
-        s.commit(builder="lbvh")
+    with pytest.raises(ValueError, match="expected_rays"):
+        s.commit(expected_rays=-5)
+    with pytest.raises(TypeError, match="expected_rays"):
+        s.commit(expected_rays="many")
     with pytest.raises(ValueError, match="threads"):
         s.commit(threads=-1)
 

@@ -262,3 +262,59 @@ def test_stats_report_the_trees():
     assert stats["leaves"] >= 1 and stats["nodes"] >= 1 and stats["sah_cost"] > 0
     assert s.triangle_count == 2 and s.instance_count == 1 and s.committed
     assert s.build_ms >= 0.0
+
+
+def test_lbvh_builder_gives_the_same_hits_as_sah():
+    rng = np.random.default_rng(11)
+    centres = rng.uniform(0, 1, (20000, 1, 3))
+    vertices = (centres + rng.uniform(-0.02, 0.02, (20000, 3, 3))).reshape(-1, 3).astype(np.float32)
+    triangles = np.arange(60000, dtype=np.uint32).reshape(-1, 3)
+    org = rng.uniform(-0.5, 1.5, (20000, 3)).astype(np.float32)
+    d = (rng.uniform(0, 1, (20000, 3)) - org).astype(np.float32)
+    hits = {}
+    for builder in ("sah", "lbvh"):
+        s = toyrt.Scene()
+        s.add_mesh(vertices, triangles)
+        s.commit(builder=builder)
+        assert s.last_commit[f"{builder}_meshes"] == 1 and s.last_commit["warning"] == ""
+        hits[builder] = s.intersect(org, d)
+    assert np.array_equal(np.isfinite(hits["sah"]["t"]), np.isfinite(hits["lbvh"]["t"]))
+    np.testing.assert_array_equal(hits["sah"]["t"], hits["lbvh"]["t"])  # same triangles, same double refinement
+
+
+def test_auto_builder_follows_the_expected_ray_count():
+    rng = np.random.default_rng(12)
+    vertices = rng.uniform(0, 1, (30000, 3)).astype(np.float32)
+    triangles = np.arange(30000, dtype=np.uint32).reshape(-1, 3)
+    s = toyrt.Scene()
+    s.add_mesh(vertices, triangles)
+    s.commit(builder="auto")  # no estimate: the faster-tracing SAH tree
+    assert s.last_commit["sah_meshes"] == 1
+    s.add_mesh(vertices, triangles)
+    s.commit(builder="auto", expected_rays=1000)  # a handful of rays: the cheaper build
+    assert s.last_commit["lbvh_meshes"] == 1
+    s.add_mesh(vertices, triangles)
+    s.commit(builder="auto", expected_rays=1e9)
+    assert s.last_commit["sah_meshes"] == 1
+
+
+def test_lbvh_without_opencl_falls_back_with_one_warning():
+    import subprocess
+    import sys
+    code = (
+        "import warnings, numpy as np, toyrt\n"
+        "s = toyrt.Scene()\n"
+        "v = np.random.default_rng(1).uniform(0, 1, (300, 3)).astype(np.float32)\n"
+        "s.add_mesh(v, np.arange(300).reshape(-1, 3)); s.add_mesh(v, np.arange(300).reshape(-1, 3))\n"
+        "with warnings.catch_warnings(record=True) as w:\n"
+        "    warnings.simplefilter('always')\n"
+        "    s.commit(builder='lbvh')\n"
+        "print(len(w), w[0].category.__name__, s.last_commit['sah_meshes'])\n"
+        "print(str(w[0].message))\n"
+    )
+    import os
+    env = dict(os.environ, TOYRT_OPENCL="off", PYTHONPATH=os.pathsep.join(sys.path))
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout
+    first, message = out.splitlines()[:2]
+    assert first == "1 RuntimeWarning 2"
+    assert "SAH builder instead" in message and "TOYRT_OPENCL=off" in message
