@@ -1,2 +1,13 @@
-# Sources of the light-transport building blocks, added to toyrt_core:
-#   target_sources(toyrt_core PRIVATE camera/camera.cpp ...)
+# Sources of the light-transport building blocks, added to toyrt_core (headers beside them):
+# camera/ (Blender's camera), sampling/ (header only: counter-based RNG, Sobol-Owen pattern,
+# warps, frames), lights/ (point, sphere and area lights, their samplers, the light selector),
+# materials/ (Lambert, textures, refraction and Fresnel).
+target_sources(toyrt_core PRIVATE
+  camera/camera.cpp
+  lights/area_light.cpp
+  lights/light_selector.cpp
+  lights/point_light.cpp
+  lights/spherical_rectangle.cpp
+  materials/refraction.cpp
+  materials/texture.cpp
+)

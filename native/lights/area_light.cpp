@@ -1,0 +1,140 @@
+#include "lights/area_light.h"
+
+#include "lights/spherical_rectangle.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace toyrt {
+namespace {
+
+void require(bool ok, const char* message) {
+  if (!ok) throw std::invalid_argument(std::string("area light: ") + message);
+}
+
+bool use_solid_angle(const AreaLight& light) {
+  return light.sampling == AreaSampling::SolidAngle && light.is_rectangle();
+}
+
+// Density of area sampling, converted to solid angle.
+float area_pdf(const AreaLight& light, float distance, float cos_light) {
+  return distance * distance / (light.area * cos_light);
+}
+
+}  // namespace
+
+AreaLight AreaLight::make(AreaShape shape, float size, float size_y, const Mat4& m, float power, const Vec3& color,
+                          AreaSampling sampling) {
+  const bool square = shape == AreaShape::Square || shape == AreaShape::Disk;
+  const float sx = size, sy = square ? size : size_y;
+  require(std::isfinite(sx) && std::isfinite(sy) && sx > 0.0f && sy > 0.0f, "size must be positive and finite");
+  require(std::isfinite(power) && power >= 0.0f, "power must be finite and >= 0 W");
+  require(is_finite(color) && !glm::any(glm::lessThan(color, Vec3(0.0f))), "colour must be finite and >= 0");
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) require(std::isfinite(m[c][r]), "matrix_world is not finite");
+  require(m[0][3] == 0.0f && m[1][3] == 0.0f && m[2][3] == 0.0f && m[3][3] == 1.0f,
+          "matrix_world must be affine: its last row must be 0 0 0 1");
+  const Vec3 ax(m[0]), ay(m[1]), az(m[2]);
+  const float lx = glm::length(ax), ly = glm::length(ay), lz = glm::length(az);
+  require(lx > 0.0f && ly > 0.0f && lz > 0.0f, "matrix_world has a zero scale");
+  constexpr float kShear = 1e-4f;  // cosine tolerance for float rotation matrices
+  require(std::fabs(glm::dot(ax, ay)) <= kShear * lx * ly && std::fabs(glm::dot(ax, az)) <= kShear * lx * lz &&
+              std::fabs(glm::dot(ay, az)) <= kShear * ly * lz,
+          "matrix_world is sheared: the light would not be a rectangle");
+
+  AreaLight light;
+  light.shape = shape;
+  light.sampling = sampling;
+  light.center = Vec3(m[3]);
+  light.edge_x = sx * ax;
+  light.edge_y = sy * ay;
+  light.normal = -az / lz;
+  const float rect_area = (sx * lx) * (sy * ly);
+  light.area = light.is_rectangle() ? rect_area : 0.25f * kPi * rect_area;
+  light.radiance = power * color / (4.0f * light.area);
+  return light;
+}
+
+LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u) {
+  LightSample s;
+  if (!(glm::dot(p - light.center, light.normal) > 0.0f)) return s;  // one-sided
+  float pdf = 0.0f;
+  Vec3 q;
+  bool by_area = true;
+  if (use_solid_angle(light)) {
+    const SphericalRectangle rect = SphericalRectangle::make(p, light.corner(), light.edge_x, light.edge_y);
+    if (rect.solid_angle >= SphericalRectangle::kMinSolidAngle) {
+      q = rect.sample(u);
+      pdf = float(1.0 / rect.solid_angle);
+      by_area = false;
+    }
+  }
+  if (by_area) {
+    const Vec2 local = light.is_rectangle() ? u - Vec2(0.5f) : 0.5f * sample_uniform_disk_concentric(u);
+    q = light.center + local.x * light.edge_x + local.y * light.edge_y;
+  }
+  const Vec3 to_light = q - p;
+  const float distance = glm::length(to_light);
+  if (!(distance > 0.0f)) return s;
+  const Vec3 wi = to_light / distance;
+  const float cos_light = -glm::dot(wi, light.normal);
+  if (!(cos_light > 0.0f)) return s;
+  s.point = q;
+  s.wi = wi;
+  s.distance = distance;
+  s.radiance = light.radiance;
+  s.pdf = by_area ? area_pdf(light, distance, cos_light) : pdf;
+  return s;
+}
+
+LightEval evaluate(const AreaLight& light, const Vec3& p, const Vec3& wi) {
+  LightEval e;
+  const float height = glm::dot(p - light.center, light.normal);
+  const float cos_light = -glm::dot(wi, light.normal);
+  if (!(height > 0.0f) || !(cos_light > 0.0f)) return e;
+  const float t = height / cos_light;
+  const Vec3 offset = p + t * wi - light.center;
+  const float a = glm::dot(offset, light.edge_x) / glm::dot(light.edge_x, light.edge_x);
+  const float b = glm::dot(offset, light.edge_y) / glm::dot(light.edge_y, light.edge_y);
+  const bool inside = light.is_rectangle() ? std::fabs(a) <= 0.5f && std::fabs(b) <= 0.5f : a * a + b * b <= 0.25f;
+  if (!inside) return e;
+  e.radiance = light.radiance;
+  e.distance = t;
+  e.pdf = area_pdf(light, t, cos_light);
+  if (use_solid_angle(light)) {
+    const double omega = SphericalRectangle::make(p, light.corner(), light.edge_x, light.edge_y).solid_angle;
+    if (omega >= SphericalRectangle::kMinSolidAngle) e.pdf = float(1.0 / omega);
+  }
+  return e;
+}
+
+float importance(const AreaLight& light, const Vec3& p, const Vec3& n) {
+  const Vec3 from_centre = p - light.center;
+  const float height = glm::dot(from_centre, light.normal);
+  if (!(height > 0.0f)) return 0.0f;
+  const float d2 = glm::dot(from_centre, from_centre);
+  const float d = std::sqrt(d2);
+  const float r2 = 0.25f * (glm::dot(light.edge_x, light.edge_x) + glm::dot(light.edge_y, light.edge_y));
+  // The bounding sphere (radius r, the half diagonal) subtends a cone of half-angle
+  // asin(r / d) from p; a cosine measured from the centre can grow by that much.
+  const float sin_b = std::min(1.0f, std::sqrt(r2) / d);
+  const float cos_b = std::sqrt(std::max(0.0f, 1.0f - sin_b * sin_b));
+  const auto widened = [&](float cos_theta) {
+    if (cos_theta >= cos_b) return 1.0f;
+    const float sin_theta = std::sqrt(std::max(0.0f, 1.0f - cos_theta * cos_theta));
+    return cos_theta * cos_b + sin_theta * sin_b;
+  };
+  // p is in front of the plane, so every point of the light sees it at a positive cosine: keep
+  // the bound positive even where rounding would make it 0.
+  const float cos_emit = std::max(widened(height / d), 1e-6f);
+  float cos_receive = 1.0f;
+  if (n != Vec3(0.0f)) {
+    cos_receive = widened(-glm::dot(n, from_centre) / (d * glm::length(n)));
+    if (cos_receive <= 0.0f) return 0.0f;
+  }
+  const float mean_intensity = (light.radiance.x + light.radiance.y + light.radiance.z) / 3.0f * light.area;
+  return mean_intensity * cos_emit * cos_receive / std::max(d2, r2);
+}
+
+}  // namespace toyrt

@@ -1,0 +1,54 @@
+// Blender's area light in Cycles' units: a one-sided rectangle, square, disk or ellipse emitting
+// along its local -Z with uniform radiance
+//     L = P colour / (4 area)      (not the textbook Lambertian P / (pi area))
+// as measured in BLENDER_UNITS.md: 100 W from a 5 cm square 1 m above a white plane gives a pixel
+// of 7.950 = (1 / pi) L area / 1 m^2, i.e. irradiance P / 4; Cycles' sync scales the power of
+// area lights by 1/4 where point lights get 1 / (4 pi). The size comes from Blender's size
+// (and size_y), times the object's scale, as in Cycles; the power stays the same, so scaling a
+// light up dims its radiance.
+//
+// Sampling: rectangles and squares by either estimator (AreaSampling), disks and ellipses by area.
+#pragma once
+
+#include "lights/light_sample.h"
+#include "sampling/warp.h"
+
+namespace toyrt {
+
+enum class AreaShape { Rectangle, Square, Disk, Ellipse };  // Blender's shape enum
+// Uniform over the light's area (density dist^2 / (area cos) in solid angle), or uniform over the
+// solid angle of the spherical rectangle (Urena et al. 2013; rectangles and squares only).
+enum class AreaSampling { Area, SolidAngle };
+
+struct AreaLight {
+  AreaShape shape = AreaShape::Rectangle;
+  AreaSampling sampling = AreaSampling::SolidAngle;
+  Vec3 center{0.0f};
+  Vec3 edge_x{1.0f, 0.0f, 0.0f}, edge_y{0.0f, 1.0f, 0.0f};  // full extents along local x and y (orthogonal)
+  Vec3 normal{0.0f, 0.0f, -1.0f};  // unit, the emitting side
+  float area = 1.0f;               // m^2 (pi/4 |edge_x| |edge_y| for disks and ellipses)
+  Vec3 radiance{0.0f};             // L = P colour / (4 area), W / (m^2 sr)
+
+  // Blender's settings: shape; size (and size_y for RECTANGLE and ELLIPSE; SQUARE and DISK use
+  // size for both, a disk's size being its diameter); the object's world matrix; power (W);
+  // colour. Throws std::invalid_argument for non-positive sizes, negative power or colour, a
+  // non-finite or non-affine matrix, a zero or sheared scale (the light must stay a rectangle).
+  static AreaLight make(AreaShape shape, float size, float size_y, const Mat4& matrix_world, float power,
+                        const Vec3& color, AreaSampling sampling = AreaSampling::SolidAngle);
+
+  bool is_rectangle() const { return shape == AreaShape::Rectangle || shape == AreaShape::Square; }
+  Vec3 corner() const { return center - 0.5f * edge_x - 0.5f * edge_y; }
+};
+
+// A point on the light seen from shading point p (u: two uniform numbers). No sample when p is
+// behind or in the light's plane.
+LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u);
+// The light along direction wi from p, with the density `sample` would have given wi.
+LightEval evaluate(const AreaLight& light, const Vec3& p, const Vec3& wi);
+// The light's expected contribution at p with normal n (n = 0: no receiver cosine), for light
+// selection: mean (L area) over distance^2, times bounds of the emitter's and the receiver's
+// cosines over the light's bounding sphere. Zero exactly when p is not in front of the light or
+// the whole bounding sphere is below p's tangent plane.
+float importance(const AreaLight& light, const Vec3& p, const Vec3& n);
+
+}  // namespace toyrt

@@ -1,0 +1,32 @@
+#include "lights/light_selector.h"
+
+namespace toyrt {
+
+LightSelection LightSelector::select(const Vec3& p, const Vec3& n, float u) const {
+  float total = 0.0f;
+  for (size_t i = 0; i < count; ++i) total += light_importance(lights[i], p, n);
+  LightSelection chosen;
+  if (!(total > 0.0f)) return chosen;
+  // The second pass repeats the first pass's sums in the same order, so the running sum ends at
+  // exactly `total`; u * total can round up to total, in which case the last candidate is kept.
+  const float target = u * total;
+  float running = 0.0f;
+  for (size_t i = 0; i < count; ++i) {
+    const float w = light_importance(lights[i], p, n);
+    if (w <= 0.0f) continue;
+    running += w;
+    chosen.index = int32_t(i);
+    chosen.probability = w / total;
+    if (target < running) break;
+  }
+  return chosen;
+}
+
+float LightSelector::probability(const Vec3& p, const Vec3& n, size_t index) const {
+  if (index >= count) return 0.0f;
+  float total = 0.0f;
+  for (size_t i = 0; i < count; ++i) total += light_importance(lights[i], p, n);
+  return total > 0.0f ? light_importance(lights[index], p, n) / total : 0.0f;
+}
+
+}  // namespace toyrt

@@ -1,0 +1,79 @@
+#include "materials/refraction.h"
+
+#include "materials/fresnel.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace toyrt {
+namespace {
+
+float checked_ior(float ior) {
+  if (!std::isfinite(ior) || ior <= 0.0f) throw std::invalid_argument("refraction: ior must be positive and finite");
+  return ior;
+}
+
+// The interface seen from wo: normals turned to wo's side, and eta = n_i / n_t.
+struct Interface {
+  Vec3 ng, ns;  // unit, on wo's side
+  float eta;
+  bool entering;
+};
+
+Interface orient(const Vec3& wo, const Vec3& ng, const Vec3& ns, float ior) {
+  Interface f;
+  f.entering = glm::dot(wo, ng) > 0.0f;
+  f.ng = glm::normalize(f.entering ? ng : -ng);
+  Vec3 shading = glm::dot(ns, ng) < 0.0f ? -ns : ns;  // to ng's hemisphere first
+  shading = glm::normalize(f.entering ? shading : -shading);
+  f.ns = glm::dot(wo, shading) > 0.0f ? shading : f.ng;  // wo below ns's tangent plane: use ng
+  f.eta = f.entering ? 1.0f / ior : ior;
+  return f;
+}
+
+// One branch with normal n; `want_reflection` false means refract unless that is impossible.
+SpecularSample scatter(const Vec3& wo, const Interface& f, const Vec3& n, bool want_reflection) {
+  SpecularSample s;
+  s.entering = f.entering;
+  Vec3 wt;
+  if (!want_reflection && refract(wo, n, f.eta, &wt)) {
+    s.wi = wt;
+  } else {
+    s.reflected = true;
+    s.total_internal_reflection = !want_reflection;
+    s.wi = glm::normalize(reflect(wo, n));
+  }
+  return s;
+}
+
+SpecularSample scatter_checked(const Vec3& wo, const Interface& f, bool want_reflection) {
+  SpecularSample s = scatter(wo, f, f.ns, want_reflection);
+  // The shading normal's answer must leave on the right side of the real surface.
+  const float side = glm::dot(s.wi, f.ng);
+  if ((s.reflected && side <= 0.0f) || (!s.reflected && side >= 0.0f)) s = scatter(wo, f, f.ng, want_reflection);
+  s.offset_normal = s.reflected ? f.ng : -f.ng;
+  return s;
+}
+
+}  // namespace
+
+PerfectRefraction PerfectRefraction::make(float ior) { return {checked_ior(ior)}; }
+FresnelDielectric FresnelDielectric::make(float ior) { return {checked_ior(ior)}; }
+
+SpecularSample sample(const PerfectRefraction& m, const Vec3& wo, const Vec3& ng, const Vec3& ns) {
+  return scatter_checked(wo, orient(wo, ng, ns, m.ior), false);
+}
+
+SpecularSample sample(const FresnelDielectric& m, const Vec3& wo, const Vec3& ng, const Vec3& ns, float u) {
+  const Interface f = orient(wo, ng, ns, m.ior);
+  // fresnel_dielectric takes n_t / n_i, the inverse of the interface's eta.
+  const float reflectance = fresnel_dielectric(glm::dot(wo, f.ns), 1.0f / f.eta);
+  const bool reflect_branch = u < reflectance;
+  SpecularSample s = scatter_checked(wo, f, reflect_branch);
+  s.total_internal_reflection = reflectance >= 1.0f;
+  s.probability = s.reflected ? reflectance : 1.0f - reflectance;
+  if (s.reflected && !reflect_branch) s.probability = 1.0f;  // refraction impossible after the fallback
+  return s;
+}
+
+}  // namespace toyrt

@@ -1,0 +1,279 @@
+// Blender's camera against closed forms: the pinhole angles set by lens and sensor fit, shift,
+// pixel aspect, orthographic extent, clip planes, the render border, and a round trip through an
+// independently written pinhole projection.
+#include "camera/camera.h"
+
+#include <gtest/gtest.h>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+using namespace toyrt;
+
+namespace {
+
+float angle_to_axis(const Camera& cam, const Ray& ray) {
+  return std::acos(std::min(1.0f, glm::dot(ray.dir, -cam.axis_z)));
+}
+
+Mat4 some_camera_matrix() {
+  Mat4 m = glm::translate(Mat4(1.0f), Vec3(1.5f, -2.0f, 3.0f));
+  m = glm::rotate(m, 0.7f, glm::normalize(Vec3(0.3f, 1.0f, -0.5f)));
+  return m;
+}
+
+CameraParams landscape() {
+  CameraParams p;
+  p.resolution_x = 640;
+  p.resolution_y = 480;
+  p.lens = 35.0f;
+  return p;
+}
+
+}  // namespace
+
+TEST(Camera, CentrePixelLooksDownMinusZ) {
+  CameraParams p = landscape();
+  p.matrix_world = some_camera_matrix();
+  const Camera cam = Camera::make(p);
+  const Ray ray = cam.generate(320.0f, 240.0f);
+  const Vec3 minus_z = -glm::normalize(Vec3(p.matrix_world[2]));
+  EXPECT_NEAR(glm::length(ray.dir - minus_z), 0.0f, 1e-6f);
+  EXPECT_NEAR(glm::length(ray.org - Vec3(p.matrix_world[3])), 0.0f, 1e-6f);
+  EXPECT_NEAR(glm::length(ray.dir), 1.0f, 1e-6f);
+  // The object's scale does not change the view (Cycles drops it).
+  p.matrix_world = glm::scale(p.matrix_world, Vec3(2.0f, 0.5f, 3.0f));
+  const Ray scaled = Camera::make(p).generate(17.3f, 400.1f);
+  EXPECT_NEAR(glm::length(scaled.dir - cam.generate(17.3f, 400.1f).dir), 0.0f, 1e-6f);
+}
+
+TEST(Camera, HorizontalFitEdgeAngleIsAtanHalfSensorOverLens) {
+  for (auto [w, h] : {std::pair{640, 480}, std::pair{480, 640}}) {  // holds for portrait too
+    CameraParams p = landscape();
+    p.resolution_x = w;
+    p.resolution_y = h;
+    p.sensor_fit = SensorFit::Horizontal;
+    const Camera cam = Camera::make(p);
+    const float expected = std::atan(p.sensor_width / 2.0f / p.lens);
+    EXPECT_NEAR(angle_to_axis(cam, cam.generate(0.0f, h / 2.0f)), expected, 1e-6f);
+    EXPECT_NEAR(angle_to_axis(cam, cam.generate(float(w), h / 2.0f)), expected, 1e-6f);
+    // The vertical extent follows the aspect ratio.
+    EXPECT_NEAR(angle_to_axis(cam, cam.generate(w / 2.0f, 0.0f)),
+                std::atan(p.sensor_width / 2.0f / p.lens * float(h) / float(w)), 1e-6f);
+  }
+}
+
+TEST(Camera, AutoFitOnPortraitFitsVertical) {
+  CameraParams p = landscape();
+  p.resolution_x = 480;
+  p.resolution_y = 640;
+  p.sensor_fit = SensorFit::Auto;
+  const Camera cam = Camera::make(p);
+  // The larger (vertical) dimension spans sensor_width.
+  EXPECT_NEAR(angle_to_axis(cam, cam.generate(240.0f, 0.0f)), std::atan(p.sensor_width / 2.0f / p.lens), 1e-6f);
+  EXPECT_NEAR(angle_to_axis(cam, cam.generate(0.0f, 320.0f)),
+              std::atan(p.sensor_width / 2.0f / p.lens * 480.0f / 640.0f), 1e-6f);
+  // The top row looks up (+Y), the left column left (-X).
+  EXPECT_GT(glm::dot(cam.generate(240.0f, 0.0f).dir, cam.axis_y), 0.0f);
+  EXPECT_LT(glm::dot(cam.generate(0.0f, 320.0f).dir, cam.axis_x), 0.0f);
+}
+
+TEST(Camera, VerticalFitUsesSensorHeight) {
+  CameraParams p = landscape();
+  p.sensor_fit = SensorFit::Vertical;
+  p.sensor_height = 20.0f;
+  const Camera cam = Camera::make(p);
+  EXPECT_NEAR(angle_to_axis(cam, cam.generate(320.0f, 0.0f)), std::atan(10.0f / p.lens), 1e-6f);
+  EXPECT_NEAR(angle_to_axis(cam, cam.generate(0.0f, 240.0f)), std::atan(10.0f / p.lens * 640.0f / 480.0f), 1e-6f);
+}
+
+TEST(Camera, ShiftMovesImageCentreByShiftTimesLargerDimension) {
+  for (auto [w, h] : {std::pair{640, 480}, std::pair{480, 640}}) {
+    CameraParams p = landscape();
+    p.resolution_x = w;
+    p.resolution_y = h;
+    const Camera plain = Camera::make(p);
+    p.shift_x = 0.1f;
+    p.shift_y = -0.25f;
+    const Camera shifted = Camera::make(p);
+    const float larger = float(std::max(w, h));
+    // The shifted image's centre is where the unshifted projection has pixel
+    // (centre + shift_x * larger, centre - shift_y * larger): y rows run downwards.
+    const Ray a = shifted.generate(w / 2.0f, h / 2.0f);
+    const Ray b = plain.generate(w / 2.0f + 0.1f * larger, h / 2.0f + 0.25f * larger);
+    EXPECT_NEAR(glm::length(a.dir - b.dir), 0.0f, 1e-6f) << w << "x" << h;
+    // Shift translates the image: every pixel moves by the same amount.
+    EXPECT_NEAR(glm::length(shifted.generate(3.0f, 7.0f).dir -
+                            plain.generate(3.0f + 0.1f * larger, 7.0f + 0.25f * larger).dir),
+                0.0f, 1e-6f);
+  }
+}
+
+TEST(Camera, PixelAspectStretches) {
+  CameraParams p = landscape();
+  p.resolution_x = 400;
+  p.resolution_y = 400;
+  p.pixel_aspect_x = 1.0f;
+  p.pixel_aspect_y = 2.0f;  // pixels twice as tall as wide: the image is 400 x 800 in square units
+  const Camera cam = Camera::make(p);
+  const float half_tan = p.sensor_width / 2.0f / p.lens;  // AUTO fits the (now larger) height
+  EXPECT_NEAR(angle_to_axis(cam, cam.generate(200.0f, 0.0f)), std::atan(half_tan), 1e-6f);
+  EXPECT_NEAR(angle_to_axis(cam, cam.generate(0.0f, 200.0f)), std::atan(half_tan / 2.0f), 1e-6f);
+  // One pixel step in y covers twice the plane distance of one step in x.
+  const Ray c = cam.generate(200.0f, 200.0f), dx = cam.generate(201.0f, 200.0f), dy = cam.generate(200.0f, 201.0f);
+  const float step_x = glm::length(dx.dir / glm::dot(dx.dir, -cam.axis_z) - c.dir / glm::dot(c.dir, -cam.axis_z));
+  const float step_y = glm::length(dy.dir / glm::dot(dy.dir, -cam.axis_z) - c.dir / glm::dot(c.dir, -cam.axis_z));
+  EXPECT_NEAR(step_y / step_x, 2.0f, 1e-3f);
+}
+
+TEST(Camera, OrthographicRaysAreParallelAndSpanOrthoScale) {
+  for (auto [w, h] : {std::pair{640, 480}, std::pair{480, 640}}) {
+    CameraParams p = landscape();
+    p.type = CameraType::Orthographic;
+    p.ortho_scale = 7.5f;
+    p.resolution_x = w;
+    p.resolution_y = h;
+    p.clip_start = 0.5f;
+    p.clip_end = 40.0f;
+    p.matrix_world = some_camera_matrix();
+    const Camera cam = Camera::make(p);
+    const Vec3 view = -glm::normalize(Vec3(p.matrix_world[2]));
+    for (Vec3 pix : {Vec3(0, 0, 0), Vec3(w, h, 0), Vec3(13.5f, 200.25f, 0)}) {
+      const Ray r = cam.generate(pix.x, pix.y);
+      EXPECT_NEAR(glm::length(r.dir - view), 0.0f, 1e-6f);
+      // Origins on the near plane, rays ending on the far plane.
+      EXPECT_NEAR(glm::dot(r.org - cam.position, view), p.clip_start, 1e-5f);
+      EXPECT_NEAR(glm::dot(r.org + r.tfar * r.dir - cam.position, view), p.clip_end, 1e-4f);
+      EXPECT_EQ(r.tnear, 0.0f);
+    }
+    // The larger dimension spans ortho_scale; the other one in proportion.
+    const float span_x = glm::length(cam.generate(float(w), h / 2.0f).org - cam.generate(0.0f, h / 2.0f).org);
+    const float span_y = glm::length(cam.generate(w / 2.0f, float(h)).org - cam.generate(w / 2.0f, 0.0f).org);
+    EXPECT_NEAR(std::max(span_x, span_y), 7.5f, 1e-5f);
+    EXPECT_NEAR(std::min(span_x, span_y), 7.5f * 480.0f / 640.0f, 1e-5f);
+  }
+}
+
+TEST(Camera, ClipPlanesArePlanes) {
+  CameraParams p = landscape();
+  p.clip_start = 0.25f;
+  p.clip_end = 80.0f;
+  p.matrix_world = some_camera_matrix();
+  const Camera cam = Camera::make(p);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> ux(0.0f, 640.0f), uy(0.0f, 480.0f);
+  for (int i = 0; i < 100; ++i) {
+    const Ray r = cam.generate(ux(rng), uy(rng));
+    const float depth_near = glm::dot(r.tnear * r.dir, -cam.axis_z);
+    const float depth_far = glm::dot(r.tfar * r.dir, -cam.axis_z);
+    EXPECT_NEAR(depth_near, p.clip_start, 1e-6f);
+    EXPECT_NEAR(depth_far, p.clip_end, 1e-4f);
+  }
+}
+
+// A pinhole projection written independently of Camera (focal length in pixels, principal
+// point moved by the shift): the ray generated at the projected pixel must pass through the point.
+TEST(Camera, ProjectedPointRoundTripsThroughGenerate) {
+  CameraParams p = landscape();
+  p.resolution_x = 800;
+  p.resolution_y = 500;
+  p.sensor_fit = SensorFit::Horizontal;
+  p.lens = 42.0f;
+  p.sensor_width = 30.0f;
+  p.shift_x = 0.07f;
+  p.shift_y = -0.12f;
+  p.pixel_aspect_x = 1.0f;
+  p.pixel_aspect_y = 1.25f;
+  p.matrix_world = some_camera_matrix();
+  const Camera cam = Camera::make(p);
+  const Mat4 to_camera = glm::inverse(p.matrix_world);
+  const float fx = p.lens / p.sensor_width * p.resolution_x;  // pixels per unit tangent across x
+  const float fy = fx * p.pixel_aspect_x / p.pixel_aspect_y;  // taller pixels: fewer per unit
+  const float cx = p.resolution_x / 2.0f - p.shift_x * p.resolution_x;
+  const float cy = p.resolution_y / 2.0f + p.shift_y * p.resolution_x * p.pixel_aspect_x / p.pixel_aspect_y;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> sym(-1.0f, 1.0f), depth(1.0f, 50.0f);
+  int tested = 0;
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 local(sym(rng) * 0.4f, sym(rng) * 0.3f, -1.0f);
+    const Vec3 world = Vec3(p.matrix_world * glm::vec4(local * depth(rng), 1.0f));
+    const Vec3 c = Vec3(to_camera * glm::vec4(world, 1.0f));
+    const float px = cx + fx * (c.x / -c.z), py = cy - fy * (c.y / -c.z);
+    if (px < 0 || px >= 800 || py < 0 || py >= 500) continue;
+    ++tested;
+    const Ray r = cam.generate(px, py);
+    const Vec3 to_point = world - r.org;
+    const float t = glm::dot(to_point, r.dir);
+    EXPECT_LT(glm::length(to_point - t * r.dir), 2e-5f * glm::length(to_point)) << px << " " << py;
+  }
+  EXPECT_GT(tested, 100);
+}
+
+TEST(Camera, ResolutionPercentageTruncatesLikeBlenderAndKeepsTheView) {
+  CameraParams p = landscape();
+  p.resolution_x = 1920;
+  p.resolution_y = 1080;
+  const Camera full = Camera::make(p);
+  p.resolution_percentage = 33;
+  const Camera small = Camera::make(p);
+  EXPECT_EQ(small.width, 1920 * 33 / 100);  // 633.6 -> 633
+  EXPECT_EQ(small.height, 1080 * 33 / 100);
+  const Ray a = full.generate(1920.0f * 0.3f, 1080.0f * 0.8f);
+  const Ray b = small.generate(small.width * 0.3f, small.height * 0.8f);
+  // Truncation changes the aspect ratio by at most one pixel in 633.
+  EXPECT_NEAR(glm::length(a.dir - b.dir), 0.0f, 1e-3f);
+}
+
+TEST(Camera, BorderMapsToPixelWindow) {
+  CameraParams p = landscape();
+  p.resolution_x = 200;
+  p.resolution_y = 100;
+  p.use_border = true;
+  p.border_min_x = 0.25f;
+  p.border_max_x = 0.755f;
+  p.border_min_y = 0.1f;
+  p.border_max_y = 0.5f;
+  const Camera cam = Camera::make(p);
+  // Blender truncates border * size; its y counts from the bottom, ours from the top.
+  EXPECT_EQ(cam.window.x0, int(std::floor(0.25f * 200)));
+  EXPECT_EQ(cam.window.x1, int(std::floor(0.755f * 200)));
+  EXPECT_EQ(cam.window.y0, 100 - int(std::floor(0.5f * 100)));
+  EXPECT_EQ(cam.window.y1, 100 - int(std::floor(0.1f * 100)));
+  // The border lies below the image centre, so its rays look down; the full image stays the frame.
+  EXPECT_EQ(cam.width, 200);
+  EXPECT_LT(glm::dot(cam.generate(cam.window.x0 + 0.5f, cam.window.y0 + 0.5f).dir, cam.axis_y), 0.0f);
+  p.border_min_x = p.border_min_y = 0.0f;
+  p.border_max_x = p.border_max_y = 1.0f;
+  const Camera whole = Camera::make(p);
+  EXPECT_EQ(whole.window.x0, 0);
+  EXPECT_EQ(whole.window.y0, 0);
+  EXPECT_EQ(whole.window.x1, 200);
+  EXPECT_EQ(whole.window.y1, 100);
+}
+
+TEST(Camera, RejectsInvalidSettings) {
+  const auto bad = [](auto change) {
+    CameraParams p = landscape();
+    change(p);
+    EXPECT_THROW(Camera::make(p), std::invalid_argument);
+  };
+  bad([](CameraParams& p) { p.resolution_x = 0; });
+  bad([](CameraParams& p) { p.resolution_y = -5; });
+  bad([](CameraParams& p) { p.resolution_percentage = 0; });
+  bad([](CameraParams& p) { p.resolution_x = 1; p.resolution_percentage = 50; });  // 0 pixels
+  bad([](CameraParams& p) { p.lens = 0.0f; });
+  bad([](CameraParams& p) { p.lens = -35.0f; });
+  bad([](CameraParams& p) { p.sensor_width = 0.0f; });
+  bad([](CameraParams& p) { p.type = CameraType::Orthographic; p.ortho_scale = 0.0f; });
+  bad([](CameraParams& p) { p.pixel_aspect_y = 0.0f; });
+  bad([](CameraParams& p) { p.clip_end = p.clip_start; });
+  bad([](CameraParams& p) { p.shift_x = NAN; });
+  bad([](CameraParams& p) { p.matrix_world[3][1] = INFINITY; });
+  bad([](CameraParams& p) { p.matrix_world[0][3] = 0.5f; });  // not affine
+  bad([](CameraParams& p) { p.matrix_world[2] = glm::vec4(0.0f); });
+  bad([](CameraParams& p) { p.use_border = true; p.border_min_x = 0.6f; p.border_max_x = 0.5f; });
+  bad([](CameraParams& p) { p.use_border = true; p.border_min_y = 0.5f; p.border_max_y = 0.501f; });  // no pixel
+  EXPECT_NO_THROW(Camera::make(landscape()));
+}
