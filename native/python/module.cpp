@@ -1,18 +1,22 @@
 // The Python module `toyrt`: a thin binding that checks and converts numpy arrays, releases the
 // GIL, and calls the core. Every misuse raises a Python exception naming what is wrong.
 #include "geometry/offset_ray.h"
+#include "python/render_binding.h"
+#include "render/renderer.h"
 #include "scene/scene.h"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include <cstring>
+#include <variant>
 #include <mutex>
 #include <shared_mutex>
 #include <string>
 
 namespace py = pybind11;
 using namespace toyrt;
+using namespace toyrt::binding;
 
 namespace {
 
@@ -141,16 +145,154 @@ PerRay per_ray(py::handle obj, size_t count, const char* name) {
 // from several threads while another adds geometry get consistent answers, never a crash.
 class PyScene {
  public:
-  uint32_t add_mesh(py::handle vertices, py::handle triangles, py::handle transform) {
+  uint32_t add_mesh(py::handle vertices, py::handle triangles, py::handle transform, py::handle normals,
+                    py::handle uvs, py::handle material_ids) {
     std::vector<Vec3> verts = to_vec3s(as_points(vertices, "vertices"));
     std::vector<Triangle> tris = to_triangles(triangles);
     const Mat4 m = transform.is_none() ? Mat4(1.0f) : to_matrix(transform);
+    MeshShading shading = to_shading(verts.size(), tris, normals, uvs, material_ids);
     std::unique_lock lock(mutex_);
     Scene::checked_inverse(m);  // before the mesh is added, so a bad call leaves the scene unchanged
     const uint32_t id = scene_.add_mesh(std::move(verts), std::move(tris));
     scene_.add_instance(id, m);
+    render_.shading.resize(scene_.mesh_count());
+    render_.shading[id] = std::move(shading);
     return id;
   }
+
+  uint32_t add_material(const std::string& kind, py::handle color, int64_t texture, float ior) {
+    const Vec3 c = to_color(color, "color");
+    std::unique_lock lock(mutex_);
+    if (kind == "diffuse") {
+      if (texture < -1 || texture >= int64_t(render_.textures.size()))
+        throw py::value_error("unknown texture id " + std::to_string(texture) + " (the scene has " +
+                              std::to_string(render_.textures.size()) + " textures)");
+      render_.materials.push_back(Lambert{c, int32_t(texture)});
+    } else if (kind == "refraction") {
+      render_.materials.push_back(PerfectRefraction::make(ior));
+    } else if (kind == "glass") {
+      render_.materials.push_back(FresnelDielectric::make(ior));
+    } else {
+      throw py::value_error("material kind must be 'diffuse', 'refraction' or 'glass', got '" + kind + "'");
+    }
+    return uint32_t(render_.materials.size() - 1);
+  }
+
+  uint32_t add_texture(py::handle pixels, bool srgb) {
+    py::array a;
+    try {
+      a = py::array::ensure(pixels);
+    } catch (const py::error_already_set&) {
+    }
+    if (!a) throw py::type_error("pixels must be an array of shape (height, width, 3 or 4)");
+    if (a.ndim() != 3 || (a.shape(2) != 3 && a.shape(2) != 4))
+      throw py::value_error("pixels must have shape (height, width, 3 or 4), got " + shape_of(a));
+    const int h = int(a.shape(0)), w = int(a.shape(1)), c = int(a.shape(2));
+    const ColorEncoding enc = srgb ? ColorEncoding::Srgb : ColorEncoding::Linear;
+    Texture t;
+    if (a.dtype().kind() == 'u' && a.itemsize() == 1) {
+      auto b = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>::ensure(a);
+      t = Texture::from_bytes(w, h, c, std::vector<uint8_t>(b.data(), b.data() + b.size()), enc);
+    } else if (a.dtype().kind() == 'f') {
+      auto f = FloatArray::ensure(a);
+      t = Texture::from_floats(w, h, c, std::vector<float>(f.data(), f.data() + f.size()), enc);
+    } else {
+      throw py::type_error("pixels must be float (0..1) or uint8, not dtype " + std::string(py::str(a.dtype())));
+    }
+    std::unique_lock lock(mutex_);
+    render_.textures.push_back(std::move(t));
+    return uint32_t(render_.textures.size() - 1);
+  }
+
+  uint32_t add_point_light(py::handle position, float power, py::handle color, float radius) {
+    const PointLight l = PointLight::make(to_point(position, "position"), power, to_color(color, "color"), radius);
+    std::unique_lock lock(mutex_);
+    render_.lights.push_back(l);
+    return uint32_t(render_.lights.size() - 1);
+  }
+
+  uint32_t add_area_light(py::handle matrix, const std::string& shape, float size, py::handle size_y, float power,
+                          py::handle color) {
+    const float sy = size_y.is_none() ? size : size_y.cast<float>();
+    const AreaLight l = AreaLight::make(to_area_shape(shape), size, sy, to_matrix4(matrix, "matrix"), power,
+                                        to_color(color, "color"));
+    std::unique_lock lock(mutex_);
+    render_.lights.push_back(l);
+    return uint32_t(render_.lights.size() - 1);
+  }
+
+  void set_background(py::handle color) {
+    const Vec3 c = to_color(color, "background");
+    std::unique_lock lock(mutex_);
+    render_.background = c;
+  }
+  py::tuple background() {
+    std::shared_lock lock(mutex_);
+    return py::make_tuple(render_.background.x, render_.background.y, render_.background.z);
+  }
+
+  py::array_t<float> render(const py::dict& camera_settings, int samples, uint32_t seed, int max_specular_depth,
+                            const std::string& area_light_sampling, const std::string& light_sampling, int threads,
+                            int tile_size, py::object on_tile, py::object should_cancel) {
+    const Camera camera = Camera::make(to_camera(camera_settings));
+    if (samples < 1) throw py::value_error("samples must be at least 1");
+    if (tile_size < 1) throw py::value_error("tile_size must be at least 1");
+    if (max_specular_depth < 0) throw py::value_error("max_specular_depth must be >= 0");
+    const AreaSampling area = to_area_sampling(area_light_sampling);
+    RenderSettings settings;
+    settings.samples = samples;
+    settings.tile_size = tile_size;
+    settings.threads = check_threads(threads);
+    settings.integrator.seed = seed;
+    settings.integrator.max_specular_depth = max_specular_depth;
+    std::shared_lock lock(mutex_);
+    require_committed();
+    RenderScene rs = render_;  // a private copy: lights take this render's estimator
+    rs.geometry = &scene_;
+    for (Light& l : rs.lights)
+      if (auto* a = std::get_if<AreaLight>(&l)) a->sampling = a->is_rectangle() ? area : AreaSampling::Area;
+    if (light_sampling == "all") settings.integrator.light_sampling = LightSampling::All;
+    else if (light_sampling == "one") settings.integrator.light_sampling = LightSampling::One;
+    else if (light_sampling == "auto")
+      settings.integrator.light_sampling = rs.lights.size() > kAllLightsUpTo ? LightSampling::One : LightSampling::All;
+    else throw py::value_error("light_sampling must be 'auto', 'all' or 'one', got '" + light_sampling + "'");
+    check_material_ids(rs);
+
+    // Tiles and cancel polls arrive on this thread with the GIL released: take it for Python.
+    TileSink sink;
+    if (!on_tile.is_none()) {
+      sink = [&](const Tile& t, const RenderResult& r) {
+        py::gil_scoped_acquire gil;
+        py::array_t<float> pixels({py::ssize_t(t.height), py::ssize_t(t.width), py::ssize_t(4)});
+        float* out = pixels.mutable_data();
+        for (int j = 0; j < t.height; ++j)
+          std::memcpy(out + size_t(j) * t.width * 4, &r.rgba[(size_t(t.y + j) * r.width + t.x) * 4], size_t(t.width) * 4 * sizeof(float));
+        on_tile(t.x, t.y, t.width, t.height, pixels);
+      };
+    }
+    CancelPoll poll = [&]() {
+      py::gil_scoped_acquire gil;
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C cancels too
+      return !should_cancel.is_none() && py::bool_(should_cancel());
+    };
+    RenderResult result;
+    {
+      py::gil_scoped_release release;
+      result = toyrt::render(rs, camera, settings, sink, poll);
+    }
+    last_render_ = py::dict();
+    last_render_["cancelled"] = result.cancelled;
+    last_render_["tiles_done"] = result.tiles_done;
+    last_render_["tiles_total"] = result.tiles_total;
+    last_render_["render_ms"] = result.render_ms;
+    last_render_["samples"] = samples;
+    last_render_["light_sampling"] = settings.integrator.light_sampling == LightSampling::One ? "one" : "all";
+    py::array_t<float> image({py::ssize_t(result.height), py::ssize_t(result.width), py::ssize_t(4)});
+    std::memcpy(image.mutable_data(), result.rgba.data(), result.rgba.size() * sizeof(float));
+    return image;
+  }
+
+  py::dict last_render() { return last_render_; }
 
   uint32_t add_instance(int64_t mesh, py::handle transform) {
     const Mat4 m = to_matrix(transform);
@@ -274,7 +416,85 @@ class PyScene {
                                  : "the scene changed since the last commit(): call commit() before queries");
   }
 
+  // Shading attributes from their Python forms: per corner (M, 3, k) or per vertex (N, k).
+  static MeshShading to_shading(size_t vertex_count, const std::vector<Triangle>& tris, py::handle normals, py::handle uvs,
+                                py::handle material_ids) {
+    MeshShading sh;
+    const size_t m = tris.size();
+    auto corners = [&](py::handle obj, int k, const char* name) {
+      FloatArray a;
+      try {
+        a = FloatArray::ensure(py::array::ensure(obj));
+      } catch (const py::error_already_set&) {
+      }
+      if (!a) throw py::type_error(std::string(name) + " must be an array of numbers");
+      std::vector<float> out(m * 3 * size_t(k));
+      if (a.ndim() == 3 && size_t(a.shape(0)) == m && a.shape(1) == 3 && a.shape(2) == k) {
+        std::memcpy(out.data(), a.data(), out.size() * sizeof(float));
+      } else if (a.ndim() == 2 && size_t(a.shape(0)) == vertex_count && a.shape(1) == k) {
+        for (size_t t = 0; t < m; ++t)
+          for (int c = 0; c < 3; ++c)
+            std::memcpy(&out[(3 * t + size_t(c)) * size_t(k)], a.data() + size_t(tris[t][c]) * size_t(k), size_t(k) * sizeof(float));
+      } else {
+        throw py::value_error(std::string(name) + " must have shape (" + std::to_string(m) + ", 3, " + std::to_string(k) +
+                              ") per corner or (" + std::to_string(vertex_count) + ", " + std::to_string(k) +
+                              ") per vertex, got " + shape_of(a));
+      }
+      for (float x : out)
+        if (!std::isfinite(x)) throw py::value_error(std::string(name) + " holds a non-finite value");
+      return out;
+    };
+    if (!normals.is_none()) {
+      const auto n = corners(normals, 3, "normals");
+      sh.corner_normals.resize(3 * m);
+      std::memcpy(sh.corner_normals.data(), n.data(), n.size() * sizeof(float));
+    }
+    if (!uvs.is_none()) {
+      const auto u = corners(uvs, 2, "uvs");
+      sh.corner_uvs.resize(3 * m);
+      std::memcpy(sh.corner_uvs.data(), u.data(), u.size() * sizeof(float));
+    }
+    if (!material_ids.is_none()) {
+      if (py::isinstance<py::int_>(material_ids)) {
+        const int64_t id = material_ids.cast<int64_t>();
+        if (id < 0 || id > INT32_MAX) throw py::value_error("material_ids must be >= 0");
+        sh.material_ids.assign(m, int32_t(id));
+      } else {
+        py::array a;
+        try {
+          a = py::array::ensure(material_ids);
+        } catch (const py::error_already_set&) {
+        }
+        if (!a || (a.dtype().kind() != 'i' && a.dtype().kind() != 'u'))
+          throw py::type_error("material_ids must be an integer or an integer array of shape (M,)");
+        if (a.ndim() != 1 || size_t(a.shape(0)) != m)
+          throw py::value_error("material_ids must have shape (" + std::to_string(m) + ",), got " + shape_of(a));
+        auto ids = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+        sh.material_ids.resize(m);
+        for (size_t t = 0; t < m; ++t) {
+          if (ids.data()[t] < 0 || ids.data()[t] > INT32_MAX) throw py::value_error("material_ids must be >= 0");
+          sh.material_ids[t] = int32_t(ids.data()[t]);
+        }
+      }
+    }
+    return sh;
+  }
+
+  // Every material id a mesh uses must name a material (no materials at all: all default grey).
+  static void check_material_ids(const RenderScene& rs) {
+    for (size_t mesh = 0; mesh < rs.shading.size(); ++mesh)
+      for (int32_t id : rs.shading[mesh].material_ids)
+        if (size_t(id) >= rs.materials.size() && !(rs.materials.empty() && id == 0))
+          throw py::value_error("mesh " + std::to_string(mesh) + " uses material id " + std::to_string(id) +
+                                " but the scene has " + std::to_string(rs.materials.size()) + " materials");
+  }
+
+  // "auto" light sampling: every light at every hit up to this many lights, one chosen light beyond.
+  static constexpr size_t kAllLightsUpTo = 4;
+
   Scene scene_;
+  RenderScene render_;
+  py::dict last_render_;
   std::shared_mutex mutex_;
 };
 
@@ -300,10 +520,49 @@ PYBIND11_MODULE(toyrt, m) {
   py::class_<PyScene>(m, "Scene", "A two-level scene: meshes stored once, placed by instances.")
       .def(py::init<>())
       .def("add_mesh", &PyScene::add_mesh, py::arg("vertices"), py::arg("triangles"), py::arg("transform") = py::none(),
+           py::arg("normals") = py::none(), py::arg("uvs") = py::none(), py::arg("material_ids") = py::none(),
            "Adds a mesh and one instance of it; returns the mesh id.\n"
            "vertices: (N, 3) numbers (stored as float32), finite. triangles: (M, 3) integer vertex\n"
            "indices. transform: None (identity) or a (4, 4) row-major affine world matrix.\n"
-           "Degenerate (zero-area) triangles are kept but can never be hit.")
+           "Degenerate (zero-area) triangles are kept but can never be hit.\n"
+           "For rendering: normals (M, 3, 3) per corner or (N, 3) per vertex (smooth shading; None: flat),\n"
+           "uvs (M, 3, 2) or (N, 2), material_ids: one int or (M,) ints into the scene's materials.")
+      .def("add_material", &PyScene::add_material, py::arg("kind") = "diffuse",
+           py::arg("color") = py::make_tuple(0.8, 0.8, 0.8), py::arg("texture") = -1, py::arg("ior") = 1.45f,
+           "Adds a material; returns its id. kind: 'diffuse' (Lambert, linear RGB colour or a texture id),\n"
+           "'refraction' (perfect refraction, Blender's Refraction BSDF, with its ior) or 'glass' (Fresnel\n"
+           "reflection and refraction, Blender's Glass BSDF).")
+      .def("add_texture", &PyScene::add_texture, py::arg("pixels"), py::arg("srgb") = true,
+           "Adds an image; returns its id. pixels: (height, width, 3 or 4), float 0..1 or uint8, rows from\n"
+           "the bottom (Blender's Image.pixels order); srgb: decode from sRGB to linear, as Blender does.")
+      .def("add_point_light", &PyScene::add_point_light, py::arg("position"), py::arg("power"),
+           py::arg("color") = py::make_tuple(1.0, 1.0, 1.0), py::arg("radius") = 0.0f,
+           "Adds a point light in Blender's units: power in watts, linear colour, radius in metres (0: hard shadows).")
+      .def("add_area_light", &PyScene::add_area_light, py::arg("matrix"), py::arg("shape") = "SQUARE",
+           py::arg("size") = 1.0f, py::arg("size_y") = py::none(), py::arg("power") = 10.0f,
+           py::arg("color") = py::make_tuple(1.0, 1.0, 1.0),
+           "Adds an area light in Blender's units: the light object's (4, 4) world matrix (it emits along its\n"
+           "local -Z, one-sided), shape 'RECTANGLE', 'SQUARE', 'DISK' or 'ELLIPSE', size (and size_y) in metres,\n"
+           "power in watts (radiance = power / (4 area), as Cycles).")
+      .def_property("background", &PyScene::background, &PyScene::set_background,
+                    "Radiance (linear RGB) of rays that leave the scene: the world colour.")
+      .def("render", &PyScene::render, py::arg("camera"), py::arg("samples") = 16, py::arg("seed") = 0,
+           py::arg("max_specular_depth") = 8, py::arg("area_light_sampling") = "solid_angle",
+           py::arg("light_sampling") = "auto", py::arg("threads") = 0, py::arg("tile_size") = 32,
+           py::arg("on_tile") = py::none(), py::arg("should_cancel") = py::none(),
+           "Renders the committed scene; returns (height, width, 4) float32 linear RGBA, rows from the top, of\n"
+           "the camera's pixel window (the border region, if set).\n"
+           "camera: a dict of Blender's camera and render settings: type ('PERSP', 'ORTHO'), lens, sensor_width,\n"
+           "sensor_height, sensor_fit ('AUTO', 'HORIZONTAL', 'VERTICAL'), shift_x, shift_y, clip_start, clip_end,\n"
+           "ortho_scale, resolution_x, resolution_y, resolution_percentage, pixel_aspect_x, pixel_aspect_y,\n"
+           "use_border, border_min_x/y, border_max_x/y, matrix_world (4, 4).\n"
+           "area_light_sampling: 'solid_angle' (spherical rectangles) or 'area'. light_sampling: 'all' (every\n"
+           "light at every hit), 'one' (one light chosen by expected contribution) or 'auto' ('all' up to 4\n"
+           "lights). on_tile(x, y, width, height, pixels) is called on this thread as tiles finish;\n"
+           "should_cancel() is polled every 10 ms and stops the render when true (so does Ctrl-C).\n"
+           "Results are the same for any thread count and tile size.")
+      .def_property_readonly("last_render", &PyScene::last_render,
+                             "What the last render did: cancelled, tiles_done, tiles_total, render_ms, samples.")
       .def("add_instance", &PyScene::add_instance, py::arg("mesh"), py::arg("transform"),
            "Places mesh `mesh` again with a (4, 4) row-major affine world matrix; returns the instance id.")
       .def("commit", &PyScene::commit, py::arg("builder") = "auto", py::arg("threads") = 0,

@@ -1,0 +1,117 @@
+#include "render/integrator.h"
+
+#include "geometry/offset_ray.h"
+#include "lights/light_selector.h"
+#include "sampling/sobol_owen.h"
+
+namespace toyrt {
+namespace {
+
+// Sample dimensions: 0 is the pixel jitter (the renderer's); each path vertex takes a block.
+constexpr uint32_t kDimsPerVertex = 64;
+uint32_t vertex_dimension(int depth, uint32_t k) { return 1 + uint32_t(depth) * kDimsPerVertex + k; }
+
+struct SurfaceHit {
+  Vec3 p;       // world position, from the barycentrics (more accurate than org + t dir)
+  Vec3 ng;      // unit geometric normal, world space
+  Vec3 ns;      // unit shading normal, world space
+  Vec2 uv{0.0f};
+  int32_t material = -1;
+};
+
+SurfaceHit surface_at(const RenderScene& rs, const Hit& hit) {
+  const Scene& scene = *rs.geometry;
+  const Instance& inst = scene.instance(uint32_t(hit.instance));
+  const Mesh& mesh = scene.mesh(inst.mesh);
+  const Triangle& tri = mesh.triangles()[size_t(hit.prim)];
+  const Vec3 p0 = mesh.vertices()[tri.x], p1 = mesh.vertices()[tri.y], p2 = mesh.vertices()[tri.z];
+  const float w = 1.0f - hit.u - hit.v;
+  SurfaceHit s;
+  const Vec3 local = w * p0 + hit.u * p1 + hit.v * p2;
+  // Normals transform by the inverse transpose; the inverse is the instance's to_object.
+  const glm::mat3 normal_matrix = glm::transpose(glm::mat3(inst.to_object));
+  s.p = inst.identity ? local : Vec3(inst.to_world * glm::vec4(local, 1.0f));
+  s.ng = glm::normalize(normal_matrix * glm::cross(p1 - p0, p2 - p0));
+  s.ns = s.ng;
+  if (inst.mesh < rs.shading.size()) {
+    const MeshShading& sh = rs.shading[inst.mesh];
+    const size_t c = 3 * size_t(hit.prim);
+    if (!sh.corner_normals.empty()) {
+      const Vec3 n = w * sh.corner_normals[c] + hit.u * sh.corner_normals[c + 1] + hit.v * sh.corner_normals[c + 2];
+      const Vec3 world = normal_matrix * n;
+      if (glm::dot(world, world) > 0.0f && is_finite(world)) s.ns = glm::normalize(world);
+    }
+    if (!sh.corner_uvs.empty()) s.uv = w * sh.corner_uvs[c] + hit.u * sh.corner_uvs[c + 1] + hit.v * sh.corner_uvs[c + 2];
+    if (!sh.material_ids.empty()) s.material = sh.material_ids[size_t(hit.prim)];
+  }
+  return s;
+}
+
+// Light arriving at a diffuse point: one sample per light, or one light chosen by contribution.
+Vec3 direct_lighting(const RenderScene& rs, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f,
+                     int depth, uint32_t pixel, uint32_t sample, const IntegratorSettings& settings) {
+  const Vec3 origin = offset_ray_origin(s.p, ng);
+  Vec3 sum(0.0f);
+  auto add = [&](const Light& light, float select_probability, uint32_t dim) {
+    const LightSample ls = sample_light(light, s.p, sobol_owen_2d(pixel, sample, vertex_dimension(depth, dim), settings.seed));
+    if (!ls.valid()) return;
+    const float cos_s = glm::dot(ns, ls.wi);
+    if (cos_s <= 0.0f || glm::dot(ng, ls.wi) <= 0.0f) return;  // below the shading or the true surface
+    // The shadow ray ends where the light sample is: t = 1 with an unnormalised direction.
+    const Ray shadow{origin, 0.0f, ls.point - origin, 1.0f};
+    if (rs.geometry->occluded(shadow)) return;
+    sum += f * ls.radiance * (cos_s / (ls.pdf * select_probability));
+  };
+  if (settings.light_sampling == LightSampling::All || rs.lights.size() == 1) {
+    for (size_t j = 0; j < rs.lights.size(); ++j) add(rs.lights[j], 1.0f, 1 + uint32_t(j));
+  } else {
+    const LightSelector selector(rs.lights);
+    const LightSelection pick = selector.select(s.p, ns, sobol_owen_1d(pixel, sample, vertex_dimension(depth, 0), settings.seed));
+    if (pick.found()) add(rs.lights[size_t(pick.index)], pick.probability, 1);
+  }
+  return sum;
+}
+
+}  // namespace
+
+Vec3 trace_path(const RenderScene& rs, const Ray& camera_ray, uint32_t pixel, uint32_t sample,
+                const IntegratorSettings& settings) {
+  static const Material kDefault = Lambert{};
+  Ray ray = camera_ray;
+  Vec3 throughput(1.0f), radiance(0.0f);
+  for (int depth = 0;; ++depth) {
+    const Hit hit = rs.geometry->intersect(ray);
+    if (!hit.found()) {
+      radiance += throughput * rs.background;
+      break;
+    }
+    const SurfaceHit s = surface_at(rs, hit);
+    const Vec3 wo = -glm::normalize(ray.dir);
+    // The geometric normal decides the side; the shading normal is turned to that side.
+    const bool front = glm::dot(s.ng, wo) > 0.0f;
+    const Vec3 ng = front ? s.ng : -s.ng;
+    const Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;
+    const Material& m = s.material >= 0 && size_t(s.material) < rs.materials.size() ? rs.materials[size_t(s.material)]
+                                                                                      : kDefault;
+    if (const Lambert* lambert = std::get_if<Lambert>(&m)) {
+      const Vec3 f = lambert_f(lambert_albedo(*lambert, rs.textures, s.uv));
+      radiance += throughput * direct_lighting(rs, s, ng, ns, f, depth, pixel, sample, settings);
+      break;
+    }
+    // A specular surface: continue the path, if the depth allows.
+    if (depth >= settings.max_specular_depth) break;
+    SpecularSample next;
+    if (const PerfectRefraction* r = std::get_if<PerfectRefraction>(&m)) {
+      next = toyrt::sample(*r, wo, s.ng, s.ns);
+    } else {
+      const float u = sobol_owen_1d(pixel, sample, vertex_dimension(depth, 0), settings.seed);
+      next = toyrt::sample(std::get<FresnelDielectric>(m), wo, s.ng, s.ns, u);
+    }
+    ray = Ray{offset_ray_origin(s.p, next.offset_normal), 0.0f, next.wi, kInfinity};
+  }
+  // A numerical failure anywhere (it should not happen) must not poison the pixel.
+  if (!is_finite(radiance)) return Vec3(0.0f);
+  return glm::max(radiance, Vec3(0.0f));
+}
+
+}  // namespace toyrt

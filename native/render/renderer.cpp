@@ -1,0 +1,120 @@
+#include "render/renderer.h"
+
+#include "core/parallel.h"
+#include "sampling/sobol_owen.h"
+
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+namespace toyrt {
+
+RenderResult render(const RenderScene& scene, const Camera& camera, const RenderSettings& settings,
+                    const TileSink& on_tile, const CancelPoll& should_cancel) {
+  if (!scene.geometry || !scene.geometry->committed())
+    throw std::logic_error("render: the scene changed since the last commit(): call commit() first");
+  if (settings.samples < 1) throw std::invalid_argument("samples must be at least 1");
+  if (settings.tile_size < 1) throw std::invalid_argument("tile_size must be at least 1");
+  const auto start = std::chrono::steady_clock::now();
+  const PixelWindow win = camera.window;
+  RenderResult result;
+  result.width = win.width();
+  result.height = win.height();
+  result.rgba.assign(size_t(result.width) * size_t(result.height) * 4, 0.0f);
+  std::vector<Tile> tiles;
+  for (int y = 0; y < result.height; y += settings.tile_size)
+    for (int x = 0; x < result.width; x += settings.tile_size)
+      tiles.push_back({x, y, std::min(settings.tile_size, result.width - x), std::min(settings.tile_size, result.height - y)});
+  result.tiles_total = tiles.size();
+
+  std::atomic<bool> cancel{false};
+  std::mutex mutex;
+  std::condition_variable wake;
+  std::deque<size_t> finished;
+  bool done = false;
+  std::exception_ptr failure;
+
+  auto render_tile = [&](const Tile& t) {
+    const float inv = 1.0f / float(settings.samples);
+    for (int j = t.y; j < t.y + t.height; ++j) {
+      if (cancel.load(std::memory_order_relaxed)) return false;
+      for (int i = t.x; i < t.x + t.width; ++i) {
+        // The pixel's index in the full image keys its random numbers: the same whatever the
+        // window, tile size or thread that renders it.
+        const int px = win.x0 + i, py = win.y0 + j;
+        const uint32_t pixel = uint32_t(py) * uint32_t(camera.width) + uint32_t(px);
+        Vec3 sum(0.0f);
+        for (int s = 0; s < settings.samples; ++s) {
+          const Vec2 jitter = sobol_owen_2d(pixel, uint32_t(s), 0, settings.integrator.seed);
+          sum += trace_path(scene, camera.generate(float(px) + jitter.x, float(py) + jitter.y), pixel, uint32_t(s),
+                            settings.integrator);
+        }
+        float* out = &result.rgba[(size_t(j) * size_t(result.width) + size_t(i)) * 4];
+        out[0] = sum.x * inv;
+        out[1] = sum.y * inv;
+        out[2] = sum.z * inv;
+        out[3] = 1.0f;
+      }
+    }
+    return true;
+  };
+
+  // Workers render on their own thread, so this one stays free to hand tiles to the caller and
+  // to poll for a cancel.
+  std::thread driver([&] {
+    try {
+      run_with_threads(settings.threads, [&] {
+        tbb::parallel_for(size_t(0), tiles.size(), [&](size_t k) {
+          if (!render_tile(tiles[k])) return;
+          std::lock_guard lock(mutex);
+          finished.push_back(k);
+          wake.notify_one();
+        });
+      });
+    } catch (...) {
+      std::lock_guard lock(mutex);
+      failure = std::current_exception();
+    }
+    std::lock_guard lock(mutex);
+    done = true;
+    wake.notify_one();
+  });
+
+  std::exception_ptr caller_failure;
+  for (;;) {
+    std::deque<size_t> ready;
+    bool all_done;
+    {
+      std::unique_lock lock(mutex);
+      wake.wait_for(lock, std::chrono::milliseconds(10), [&] { return done || !finished.empty(); });
+      ready.swap(finished);
+      all_done = done;
+    }
+    try {
+      for (size_t k : ready) {
+        ++result.tiles_done;
+        if (on_tile && !cancel) on_tile(tiles[k], result);
+      }
+      if (!cancel && should_cancel && should_cancel()) cancel = true;
+    } catch (...) {
+      // A failing callback cancels the render; the error is raised once every worker is joined.
+      caller_failure = std::current_exception();
+      cancel = true;
+    }
+    if (all_done) break;
+  }
+  driver.join();
+  if (caller_failure) std::rethrow_exception(caller_failure);
+  if (failure) std::rethrow_exception(failure);
+  result.cancelled = cancel;
+  result.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace toyrt
