@@ -285,6 +285,7 @@ class PyScene {
     last_render_["tiles_done"] = result.tiles_done;
     last_render_["tiles_total"] = result.tiles_total;
     last_render_["render_ms"] = result.render_ms;
+    last_render_["cancel_latency_ms"] = result.cancel_latency_ms;
     last_render_["samples"] = samples;
     last_render_["light_sampling"] = settings.integrator.light_sampling == LightSampling::One ? "one" : "all";
     py::array_t<float> image({py::ssize_t(result.height), py::ssize_t(result.width), py::ssize_t(4)});
@@ -562,7 +563,8 @@ PYBIND11_MODULE(toyrt, m) {
            "should_cancel() is polled every 10 ms and stops the render when true (so does Ctrl-C).\n"
            "Results are the same for any thread count and tile size.")
       .def_property_readonly("last_render", &PyScene::last_render,
-                             "What the last render did: cancelled, tiles_done, tiles_total, render_ms, samples.")
+                             "What the last render did: cancelled, cancel_latency_ms, tiles_done, tiles_total, render_ms,\n"
+                             "samples, light_sampling.")
       .def("add_instance", &PyScene::add_instance, py::arg("mesh"), py::arg("transform"),
            "Places mesh `mesh` again with a (4, 4) row-major affine world matrix; returns the instance id.")
       .def("commit", &PyScene::commit, py::arg("builder") = "auto", py::arg("threads") = 0,

@@ -87,6 +87,10 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
   });
 
   std::exception_ptr caller_failure;
+  std::chrono::steady_clock::time_point cancelled_at;
+  auto request_cancel = [&] {
+    if (!cancel.exchange(true)) cancelled_at = std::chrono::steady_clock::now();
+  };
   for (;;) {
     std::deque<size_t> ready;
     bool all_done;
@@ -101,11 +105,11 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
         ++result.tiles_done;
         if (on_tile && !cancel) on_tile(tiles[k], result);
       }
-      if (!cancel && should_cancel && should_cancel()) cancel = true;
+      if (!cancel && should_cancel && should_cancel()) request_cancel();
     } catch (...) {
       // A failing callback cancels the render; the error is raised once every worker is joined.
       caller_failure = std::current_exception();
-      cancel = true;
+      request_cancel();
     }
     if (all_done) break;
   }
@@ -113,6 +117,8 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
   if (caller_failure) std::rethrow_exception(caller_failure);
   if (failure) std::rethrow_exception(failure);
   result.cancelled = cancel;
+  if (result.cancelled)
+    result.cancel_latency_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cancelled_at).count();
   result.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

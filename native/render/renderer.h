@@ -30,6 +30,7 @@ struct RenderResult {
   bool cancelled = false;
   size_t tiles_done = 0, tiles_total = 0;
   double render_ms = 0.0;
+  double cancel_latency_ms = 0.0;  // from the cancel request to every worker stopped (when cancelled)
 };
 
 // Called on the calling thread (never on a worker) for each finished tile, with the image so far:
