@@ -6,6 +6,7 @@
 //   bench_lbvh [--out FILE.md] [--csv FILE.csv] [--runs N] [--quick]
 #include "accel/lbvh_builder.h"
 #include "opencl/device.h"
+#include "bench_util.h"
 #include "core/parallel.h"
 #include "embree_oracle.h"
 #include "scene/scene.h"
@@ -29,6 +30,8 @@
 
 using namespace toyrt;
 using namespace toyrt::testing;
+using toyrt::bench::best_ms;
+using toyrt::bench::cpu_model;
 
 namespace {
 
@@ -36,15 +39,6 @@ double ms_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
 }
 
-double best_ms(int runs, const std::function<void()>& f) {
-  double best = 1e300;
-  for (int i = 0; i < runs; ++i) {
-    const auto start = std::chrono::steady_clock::now();
-    f();
-    best = std::min(best, ms_since(start));
-  }
-  return best;
-}
 
 // Mixed ray set: primary rays, and a diffuse bounce and a shadow ray from each primary hit.
 std::vector<Ray> mixed_rays(const MeshData& m, int width, int height) {
@@ -73,13 +67,6 @@ double trace_ms(const Scene& scene, const std::vector<Ray>& rays, int runs) {
   });
 }
 
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  return "unknown CPU";
-}
 
 struct Row {
   size_t triangles;
@@ -132,16 +119,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%zu triangles\n", m.triangles.size());
     Row row{};
     row.triangles = m.triangles.size();
-    std::vector<BBox> boxes;
-    std::vector<Vec3> centers;
-    for (const Triangle& t : m.triangles) {
-      BBox b;
-      b.extend(m.vertices[t.x]);
-      b.extend(m.vertices[t.y]);
-      b.extend(m.vertices[t.z]);
-      boxes.push_back(b);
-      centers.push_back(b.center());
-    }
+    const PrimitiveBounds prims = triangle_bounds(m);
+    const std::vector<BBox>& boxes = prims.boxes;
+    const std::vector<Vec3>& centers = prims.centers;
     // Builder alone (what differs between them); the collapse to the wide traversal layout that
     // both then share is not included.
     Bvh sah, lbvh, lbvh63;

@@ -3,6 +3,7 @@
 // measured side by side, best of several runs, are what carry over). Writes a Markdown table.
 //
 //   bench_trace [--out FILE] [--runs N] [--quick]
+#include "bench_util.h"
 #include "core/parallel.h"
 #include "embree_oracle.h"
 #include "oracle_compare.h"
@@ -28,18 +29,11 @@
 
 using namespace toyrt;
 using namespace toyrt::testing;
+using toyrt::bench::best_ms;
+using toyrt::bench::cpu_model;
 
 namespace {
 
-double best_ms(int runs, const std::function<void()>& f) {
-  double best = 1e300;
-  for (int i = 0; i < runs; ++i) {
-    const auto start = std::chrono::steady_clock::now();
-    f();
-    best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-  }
-  return best;
-}
 
 struct Flat {  // a ray set as the batch API takes it
   std::vector<float> org, dir, tfar;
@@ -57,13 +51,6 @@ Flat flatten(const std::vector<Ray>& rays) {
   return f;
 }
 
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  return "unknown CPU";
-}
 
 struct Row {
   std::string mesh, rays, threads;

@@ -30,14 +30,9 @@ std::string shape_of(const py::array& a) {
 
 // Any array-like of numbers becomes a C-contiguous float32 array of shape (N, 3).
 FloatArray as_points(py::handle obj, const char* name) {
-  py::array a;
-  try {
-    a = py::array::ensure(obj);
-  } catch (const py::error_already_set&) {
-  }
+  const py::array a = try_array(obj);
   if (!a) throw py::type_error(std::string(name) + " must be an array of shape (N, 3)");
-  const char kind = a.dtype().kind();
-  if (kind != 'f' && kind != 'i' && kind != 'u')
+  if (!is_numeric(a))
     throw py::type_error(std::string(name) + " must hold numbers, not dtype " + std::string(py::str(a.dtype())));
   if (a.ndim() != 2 || a.shape(1) != 3)
     throw py::value_error(std::string(name) + " must have shape (N, 3), got " + shape_of(a));
@@ -51,11 +46,7 @@ std::vector<Vec3> to_vec3s(const FloatArray& a) {
 }
 
 std::vector<Triangle> to_triangles(py::handle obj) {
-  py::array a;
-  try {
-    a = py::array::ensure(obj);
-  } catch (const py::error_already_set&) {
-  }
+  const py::array a = try_array(obj);
   if (!a) throw py::type_error("triangles must be an integer array of shape (M, 3)");
   const char kind = a.dtype().kind();
   if (kind != 'i' && kind != 'u')
@@ -84,12 +75,8 @@ std::vector<Triangle> to_triangles(py::handle obj) {
 
 // A (4, 4) row-major matrix (Blender's matrix_world layout) becomes GLM's column-major Mat4.
 Mat4 to_matrix(py::handle obj) {
-  py::array a;
-  try {
-    a = py::array::ensure(obj);
-  } catch (const py::error_already_set&) {
-  }
-  if (!a || (a.dtype().kind() != 'f' && a.dtype().kind() != 'i' && a.dtype().kind() != 'u'))
+  const py::array a = try_array(obj);
+  if (!a || !is_numeric(a))
     throw py::type_error("transform must be a (4, 4) array of numbers (row-major world matrix)");
   if (a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4)
     throw py::value_error("transform must have shape (4, 4), got " + shape_of(a));
@@ -118,12 +105,8 @@ PerRay per_ray(py::handle obj, size_t count, const char* name) {
   if (py::isinstance<py::float_>(obj) || py::isinstance<py::int_>(obj)) {
     out.scalar = obj.cast<float>();
   } else {
-    py::array a;
-    try {
-      a = py::array::ensure(obj);
-    } catch (const py::error_already_set&) {
-    }
-    if (!a || (a.dtype().kind() != 'f' && a.dtype().kind() != 'i' && a.dtype().kind() != 'u'))
+    const py::array a = try_array(obj);
+    if (!a || !is_numeric(a))
       throw py::type_error(std::string(name) + " must be a number or an array of numbers, one per ray");
     if (a.ndim() == 0) {
       out.scalar = FloatArray::ensure(a).data()[0];
@@ -179,11 +162,7 @@ class PyScene {
   }
 
   uint32_t add_texture(py::handle pixels, bool srgb) {
-    py::array a;
-    try {
-      a = py::array::ensure(pixels);
-    } catch (const py::error_already_set&) {
-    }
+    const py::array a = try_array(pixels);
     if (!a) throw py::type_error("pixels must be an array of shape (height, width, 3 or 4)");
     if (a.ndim() != 3 || (a.shape(2) != 3 && a.shape(2) != 4))
       throw py::value_error("pixels must have shape (height, width, 3 or 4), got " + shape_of(a));
@@ -423,11 +402,8 @@ class PyScene {
     MeshShading sh;
     const size_t m = tris.size();
     auto corners = [&](py::handle obj, int k, const char* name) {
-      FloatArray a;
-      try {
-        a = FloatArray::ensure(py::array::ensure(obj));
-      } catch (const py::error_already_set&) {
-      }
+      const py::array raw = try_array(obj);
+      FloatArray a = raw && is_numeric(raw) ? FloatArray::ensure(raw) : FloatArray();
       if (!a) throw py::type_error(std::string(name) + " must be an array of numbers");
       std::vector<float> out(m * 3 * size_t(k));
       if (a.ndim() == 3 && size_t(a.shape(0)) == m && a.shape(1) == 3 && a.shape(2) == k) {
@@ -461,11 +437,7 @@ class PyScene {
         if (id < 0 || id > INT32_MAX) throw py::value_error("material_ids must be >= 0");
         sh.material_ids.assign(m, int32_t(id));
       } else {
-        py::array a;
-        try {
-          a = py::array::ensure(material_ids);
-        } catch (const py::error_already_set&) {
-        }
+        const py::array a = try_array(material_ids);
         if (!a || (a.dtype().kind() != 'i' && a.dtype().kind() != 'u'))
           throw py::type_error("material_ids must be an integer or an integer array of shape (M,)");
         if (a.ndim() != 1 || size_t(a.shape(0)) != m)

@@ -7,13 +7,8 @@ namespace toyrt::binding {
 
 namespace {
 py::array_t<double, py::array::c_style | py::array::forcecast> numbers(py::handle obj, const char* name) {
-  py::array a;
-  try {
-    a = py::array::ensure(obj);
-  } catch (const py::error_already_set&) {
-  }
-  if (!a || (a.dtype().kind() != 'f' && a.dtype().kind() != 'i' && a.dtype().kind() != 'u'))
-    throw py::type_error(std::string(name) + " must be numbers");
+  const py::array a = try_array(obj);
+  if (!a || !is_numeric(a)) throw py::type_error(std::string(name) + " must be numbers");
   return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
 }
 

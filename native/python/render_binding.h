@@ -14,6 +14,21 @@ namespace toyrt::binding {
 
 namespace py = pybind11;
 
+// The object as a numpy array (converting lists and the like), or a null array when it cannot be.
+inline py::array try_array(py::handle obj) {
+  try {
+    return py::array::ensure(obj);
+  } catch (const py::error_already_set&) {
+    return py::array();
+  }
+}
+
+// Whether an array holds numbers (float, signed or unsigned integer).
+inline bool is_numeric(const py::array& a) {
+  const char k = a.dtype().kind();
+  return k == 'f' || k == 'i' || k == 'u';
+}
+
 Vec3 to_color(py::handle obj, const char* name);
 Vec3 to_point(py::handle obj, const char* name);
 Mat4 to_matrix4(py::handle obj, const char* name);

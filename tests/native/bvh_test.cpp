@@ -14,17 +14,7 @@ using namespace toyrt::testing;
 
 namespace {
 
-std::vector<BBox> triangle_boxes(const MeshData& m) {
-  std::vector<BBox> boxes;
-  for (const Triangle& t : m.triangles) {
-    BBox b;
-    b.extend(m.vertices[t.x]);
-    b.extend(m.vertices[t.y]);
-    b.extend(m.vertices[t.z]);
-    boxes.push_back(b);
-  }
-  return boxes;
-}
+std::vector<BBox> triangle_boxes(const MeshData& m) { return triangle_bounds(m).boxes; }
 
 Mesh built(const MeshData& m, int threads = 0) {
   Mesh mesh(m.vertices, m.triangles);

@@ -18,23 +18,8 @@ using namespace toyrt::testing;
 
 namespace {
 
-struct Prims {
-  std::vector<BBox> boxes;
-  std::vector<Vec3> centers;
-};
-
-Prims prims_of(const MeshData& m) {
-  Prims p;
-  for (const Triangle& t : m.triangles) {
-    BBox b;
-    b.extend(m.vertices[t.x]);
-    b.extend(m.vertices[t.y]);
-    b.extend(m.vertices[t.z]);
-    p.boxes.push_back(b);
-    p.centers.push_back(b.center());
-  }
-  return p;
-}
+using Prims = PrimitiveBounds;
+PrimitiveBounds prims_of(const MeshData& m) { return triangle_bounds(m); }
 
 MeshData copies_of_one_triangle(size_t n) {
   MeshData m;

@@ -17,6 +17,13 @@ def quad_scene(z=0.0):
     return s
 
 
+def random_soup(rng, count, size):
+    """`count` separate triangles of about `size` scattered in the unit cube: (vertices, triangles)."""
+    centres = rng.uniform(0, 1, (count, 1, 3))
+    vertices = (centres + rng.uniform(-size, size, (count, 3, 3))).reshape(-1, 3).astype(np.float32)
+    return vertices, np.arange(3 * count, dtype=np.uint32).reshape(-1, 3)
+
+
 def brute_force(vertices, triangles, origins, directions):
     """Nearest hit of every ray against every triangle, in float64 (Moller-Trumbore)."""
     p0, p1, p2 = (vertices[triangles[:, k]].astype(np.float64) for k in range(3))
@@ -67,9 +74,7 @@ def test_barycentrics_follow_embree_convention():
 
 def test_agrees_with_float64_brute_force_on_a_random_soup():
     rng = np.random.default_rng(7)
-    centres = rng.uniform(0, 1, (300, 1, 3))
-    vertices = (centres + rng.uniform(-0.08, 0.08, (300, 3, 3))).reshape(-1, 3).astype(np.float32)
-    triangles = np.arange(900, dtype=np.uint32).reshape(-1, 3)
+    vertices, triangles = random_soup(rng, 300, 0.08)
     s = toyrt.Scene()
     s.add_mesh(vertices, triangles)
     s.commit()
@@ -202,9 +207,7 @@ def test_offset_ray_origin_moves_off_the_surface_at_any_distance():
 def test_queries_release_the_gil():
     """A long batch in one thread leaves the interpreter free for another."""
     rng = np.random.default_rng(9)
-    centres = rng.uniform(0, 1, (50000, 1, 3))
-    vertices = (centres + rng.uniform(-0.01, 0.01, (50000, 3, 3))).reshape(-1, 3).astype(np.float32)
-    triangles = np.arange(150000, dtype=np.uint32).reshape(-1, 3)
+    vertices, triangles = random_soup(rng, 50000, 0.01)
     s = toyrt.Scene()
     s.add_mesh(vertices, triangles)
     s.commit()
@@ -266,9 +269,7 @@ def test_stats_report_the_trees():
 
 def test_lbvh_builder_gives_the_same_hits_as_sah():
     rng = np.random.default_rng(11)
-    centres = rng.uniform(0, 1, (20000, 1, 3))
-    vertices = (centres + rng.uniform(-0.02, 0.02, (20000, 3, 3))).reshape(-1, 3).astype(np.float32)
-    triangles = np.arange(60000, dtype=np.uint32).reshape(-1, 3)
+    vertices, triangles = random_soup(rng, 20000, 0.02)
     org = rng.uniform(-0.5, 1.5, (20000, 3)).astype(np.float32)
     d = (rng.uniform(0, 1, (20000, 3)) - org).astype(np.float32)
     hits = {}

@@ -97,6 +97,19 @@ BBox bounds_of(const MeshData& mesh) {
   return b;
 }
 
+PrimitiveBounds triangle_bounds(const MeshData& mesh) {
+  PrimitiveBounds p;
+  for (const Triangle& t : mesh.triangles) {
+    BBox b;
+    b.extend(mesh.vertices[t.x]);
+    b.extend(mesh.vertices[t.y]);
+    b.extend(mesh.vertices[t.z]);
+    p.boxes.push_back(b);
+    p.centers.push_back(b.center());
+  }
+  return p;
+}
+
 std::vector<Ray> primary_rays(const BBox& box, int width, int height) {
   const Vec3 center = box.center();
   const float radius = 0.5f * glm::length(box.extent());

@@ -29,6 +29,12 @@ MeshData slivers(size_t count, uint64_t seed);
 // The mesh scaled by `scale` about the origin, then moved by `offset`.
 MeshData transformed(const MeshData& mesh, float scale, const Vec3& offset);
 BBox bounds_of(const MeshData& mesh);
+// Each triangle's box and the box's centre: what the builders take.
+struct PrimitiveBounds {
+  std::vector<BBox> boxes;
+  std::vector<Vec3> centers;
+};
+PrimitiveBounds triangle_bounds(const MeshData& mesh);
 
 // Pinhole-camera rays from outside the box looking at its centre, width x height of them.
 std::vector<Ray> primary_rays(const BBox& box, int width, int height);
