@@ -1,10 +1,12 @@
-# TOYRT add-on for Blender (legacy add-on layout: a package in the user's scripts/addons folder).
+# TOYRT add-on for Blender: a render engine with a fast, exact native core.
 #
-# `make setup` copies this folder there together with the native module built from native/
-# (build/python/toyrt.cpython-311-x86_64-linux-gnu.so), so the module sits beside this file and
-# imports as `render_toyrt.toyrt`. It is built for Debian's Python 3.11, the one Blender 3.4 runs.
+# Installs as a legacy add-on (bl_info, a package in scripts/addons) and as a 4.2+ extension
+# (blender_manifest.toml). `make setup` copies this folder there together with the native module
+# built from native/ (toyrt.cpython-311-x86_64-linux-gnu.so), so the module sits beside this file
+# and imports as `render_toyrt.toyrt`; it is built for Debian's Python 3.11, Blender 3.4's.
 #
-# For now the add-on only loads the native module; the RenderEngine comes with a later issue.
+# The parts: properties.py (settings at scene.toyrt), ui.py (panels), export.py (depsgraph to
+# numpy arrays and the native scene), engine.py (the render loop). No rendering logic in Python.
 
 bl_info = {
     "name": "TOYRT",
@@ -38,8 +40,13 @@ def native():
 
 
 def register():
+    from . import engine, properties, ui
+
+    properties.register()
+    engine.register()
+    ui.register()
     # Load the native module now so a broken install shows up at once, but never let it stop
-    # Blender or the add-on from loading: print the reason and carry on.
+    # Blender or the add-on from loading: the engine reports the error when asked to render.
     try:
         native()
     except Exception as err:  # ImportError above, or anything the module's own init raises
@@ -47,6 +54,9 @@ def register():
 
 
 def unregister():
-    # Nothing registered with Blender yet. An extension module cannot be unloaded from a
-    # running Python, so the native module stays imported until Blender exits.
-    pass
+    from . import engine, properties, ui
+
+    ui.unregister()
+    engine.unregister()
+    properties.unregister()
+    # An extension module cannot be unloaded from a running Python: it stays imported until exit.

@@ -569,6 +569,23 @@ PYBIND11_MODULE(toyrt, m) {
       .def_property_readonly("build_ms", &PyScene::build_ms, "Wall time of the last commit in milliseconds.");
 
   m.def(
+      "camera_window",
+      [](const py::dict& camera) {
+        const Camera c = Camera::make(to_camera(camera));
+        py::dict d;
+        d["width"] = c.width;
+        d["height"] = c.height;
+        d["x0"] = c.window.x0;
+        d["y0"] = c.window.y0;
+        d["x1"] = c.window.x1;
+        d["y1"] = c.window.y1;
+        return d;
+      },
+      py::arg("camera"),
+      "The image size (resolution times percentage) and the pixel window render() fills (the border,\n"
+      "or the whole image), rows counted from the top: dict of width, height, x0, y0, x1, y1.");
+
+  m.def(
       "offset_ray_origin",
       [](py::handle points, py::handle normals) {
         FloatArray p = as_points(points, "points"), n = as_points(normals, "normals");

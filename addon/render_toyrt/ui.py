@@ -1,0 +1,55 @@
+"""The TOYRT panel in Render Properties, and Blender's standard panels opened to TOYRT."""
+import bpy
+
+# Blender's own panels that work unchanged with TOYRT (as Blender's custom-engine example does).
+COMPATIBLE_PANELS = (
+    "RENDER_PT_format", "RENDER_PT_frame_range", "RENDER_PT_output", "RENDER_PT_encoding",
+    "RENDER_PT_color_management", "RENDER_PT_color_management_curves", "RENDER_PT_post_processing",
+    "DATA_PT_camera", "DATA_PT_lens", "DATA_PT_camera_display", "DATA_PT_context_camera",
+    "DATA_PT_light", "DATA_PT_EEVEE_light", "DATA_PT_context_light",
+    "MATERIAL_PT_preview", "EEVEE_MATERIAL_PT_context_material", "EEVEE_MATERIAL_PT_surface",
+    "WORLD_PT_context_world", "EEVEE_WORLD_PT_surface",
+)
+
+
+class RENDER_PT_toyrt(bpy.types.Panel):
+    bl_label = "TOYRT"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+    COMPAT_ENGINES = {"TOYRT"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        settings = context.scene.toyrt
+        layout.prop(settings, "samples")
+        layout.prop(settings, "area_light_sampling")
+        layout.prop(settings, "light_sampling")
+        layout.prop(settings, "builder")
+        layout.prop(settings, "max_specular_depth")
+        layout.prop(settings, "seed")
+        layout.label(text=f"Threads: {context.scene.render.threads} (Performance settings)")
+
+
+def _panels():
+    for name in COMPATIBLE_PANELS:
+        panel = getattr(bpy.types, name, None)
+        if panel is not None and hasattr(panel, "COMPAT_ENGINES"):
+            yield panel
+
+
+def register():
+    bpy.utils.register_class(RENDER_PT_toyrt)
+    for panel in _panels():
+        panel.COMPAT_ENGINES.add("TOYRT")
+
+
+def unregister():
+    for panel in _panels():
+        panel.COMPAT_ENGINES.discard("TOYRT")
+    bpy.utils.unregister_class(RENDER_PT_toyrt)
