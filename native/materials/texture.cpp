@@ -16,18 +16,20 @@ void check_shape(int width, int height, int channels, size_t size) {
 }
 
 template <class T, class ToUnit>
-Texture make(int width, int height, int channels, const std::vector<T>& data, ColorEncoding encoding, ToUnit to_unit) {
+Texture make(int width, int height, int channels, const std::vector<T>& data, ColorEncoding encoding, ToUnit to_unit,
+             bool decode_after_filter) {
   check_shape(width, height, channels, data.size());
   Texture t;
   t.width = width;
   t.height = height;
   t.channels = channels;
   t.texels.resize(data.size());
+  t.decode_after_filter = decode_after_filter && encoding == ColorEncoding::Srgb;
   for (size_t i = 0; i < data.size(); ++i) {
     const float v = to_unit(data[i]);
     if (!std::isfinite(v)) throw std::invalid_argument("texture: values must be finite");
     const bool alpha = channels == 4 && i % 4 == 3;
-    t.texels[i] = encoding == ColorEncoding::Srgb && !alpha ? srgb_to_linear(v) : v;
+    t.texels[i] = encoding == ColorEncoding::Srgb && !alpha && !t.decode_after_filter ? srgb_to_linear(v) : v;
   }
   return t;
 }
@@ -41,17 +43,25 @@ int wrap(int i, int n) {
 }  // namespace
 
 Texture Texture::from_floats(int width, int height, int channels, const std::vector<float>& data, ColorEncoding encoding) {
-  return make(width, height, channels, data, encoding, [](float v) { return v; });
+  return make(width, height, channels, data, encoding, [](float v) { return v; }, false);
 }
 
 Texture Texture::from_bytes(int width, int height, int channels, const std::vector<uint8_t>& data, ColorEncoding encoding) {
-  return make(width, height, channels, data, encoding, [](uint8_t v) { return float(v) / 255.0f; });
+  return make(width, height, channels, data, encoding, [](uint8_t v) { return float(v) / 255.0f; }, true);
 }
 
-glm::vec4 Texture::texel(int x, int y) const {
-  const float* t = &texels[(size_t(y) * width + x) * channels];
-  return glm::vec4(t[0], t[1], t[2], channels == 4 ? t[3] : 1.0f);
+namespace {
+glm::vec4 stored(const Texture& tex, int x, int y) {
+  const float* t = &tex.texels[(size_t(y) * tex.width + x) * tex.channels];
+  return glm::vec4(t[0], t[1], t[2], tex.channels == 4 ? t[3] : 1.0f);
 }
+glm::vec4 decoded(const Texture& tex, glm::vec4 c) {
+  if (!tex.decode_after_filter) return c;
+  return glm::vec4(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z), c.w);  // alpha stays linear
+}
+}  // namespace
+
+glm::vec4 Texture::texel(int x, int y) const { return decoded(*this, stored(*this, x, y)); }
 
 glm::vec4 Texture::lookup(const Vec2& uv) const {
   float u = std::isfinite(uv.x) ? uv.x : 0.0f, v = std::isfinite(uv.y) ? uv.y : 0.0f;
@@ -63,9 +73,9 @@ glm::vec4 Texture::lookup(const Vec2& uv) const {
   const float tx = x - fx, ty = y - fy;
   const int x0 = wrap(int(fx), width), x1 = wrap(int(fx) + 1, width);
   const int y0 = wrap(int(fy), height), y1 = wrap(int(fy) + 1, height);
-  const glm::vec4 bottom = texel(x0, y0) * (1.0f - tx) + texel(x1, y0) * tx;
-  const glm::vec4 top = texel(x0, y1) * (1.0f - tx) + texel(x1, y1) * tx;
-  return bottom * (1.0f - ty) + top * ty;
+  const glm::vec4 bottom = stored(*this, x0, y0) * (1.0f - tx) + stored(*this, x1, y0) * tx;
+  const glm::vec4 top = stored(*this, x0, y1) * (1.0f - tx) + stored(*this, x1, y1) * tx;
+  return decoded(*this, bottom * (1.0f - ty) + top * ty);
 }
 
 }  // namespace toyrt

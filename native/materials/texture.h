@@ -21,14 +21,20 @@ enum class ColorEncoding { Linear, Srgb };
 
 struct Texture {
   int width = 0, height = 0, channels = 0;  // channels: 3 or 4
-  std::vector<float> texels;                // linear, width * height * channels, row 0 at the bottom
+  // width * height * channels, row 0 at the bottom: linear, or, for 8-bit sRGB images, still
+  // sRGB-encoded (decode_after_filter).
+  std::vector<float> texels;
+  // 8-bit sRGB images are filtered in their encoded values and decoded afterwards, as Cycles does
+  // (measured: halfway between a black and a white texel Cycles gives srgb_to_linear(0.5) = 0.214,
+  // not 0.5). Float images are decoded at load.
+  bool decode_after_filter = false;
 
   // Throw std::invalid_argument for non-positive sizes, channels other than 3 or 4, a data size
   // that does not match, or non-finite floats.
   static Texture from_floats(int width, int height, int channels, const std::vector<float>& data, ColorEncoding encoding);
   static Texture from_bytes(int width, int height, int channels, const std::vector<uint8_t>& data, ColorEncoding encoding);
 
-  glm::vec4 texel(int x, int y) const;  // column x, row y from the bottom; alpha 1 for RGB
+  glm::vec4 texel(int x, int y) const;  // column x, row y from the bottom, linear; alpha 1 for RGB
   glm::vec4 lookup(const Vec2& uv) const;
 };
 

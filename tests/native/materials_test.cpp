@@ -303,3 +303,19 @@ TEST(LambertMaterial, TexturedAlbedoComesFromTheTexture) {
   const Material m = textured;
   EXPECT_TRUE(std::holds_alternative<Lambert>(m));
 }
+
+TEST(Texture, EightBitSrgbIsFilteredBeforeDecodingAsCycles) {
+  // A black and a white texel: halfway between them Cycles returns the decoded average of the
+  // encoded values, srgb_to_linear(0.5), not the average of the decoded ones (0.5).
+  const Texture t = Texture::from_bytes(2, 1, 3, {0, 0, 0, 255, 255, 255}, ColorEncoding::Srgb);
+  const glm::vec4 mid = t.lookup(Vec2(0.5f, 0.5f));  // the seam between the two texel centres
+  EXPECT_NEAR(mid.x, srgb_to_linear(0.5f), 1e-6f);
+  EXPECT_NEAR(mid.y, srgb_to_linear(0.5f), 1e-6f);
+  // Texel centres are exact, and decoded.
+  EXPECT_NEAR(t.lookup(Vec2(0.25f, 0.5f)).x, 0.0f, 1e-6f);
+  EXPECT_NEAR(t.lookup(Vec2(0.75f, 0.5f)).x, 1.0f, 1e-6f);
+  EXPECT_NEAR(t.texel(1, 0).x, 1.0f, 1e-6f);
+  // Float images are decoded at load and filtered linearly.
+  const Texture f = Texture::from_floats(2, 1, 3, {0, 0, 0, 1, 1, 1}, ColorEncoding::Srgb);
+  EXPECT_NEAR(f.lookup(Vec2(0.5f, 0.5f)).x, 0.5f, 1e-6f);
+}

@@ -1,0 +1,520 @@
+# Runs inside Blender:  blender -b --python-exit-code 1 --python tests/blender/test_cycles_parity.py
+# (`make test` runs it). No --factory-startup: the native module comes from the installed add-on
+# (render_toyrt.native()); the exporter is loaded from this repository (addon/render_toyrt/export.py).
+#
+# TOYRT against Cycles on scenes built here with bpy: one point light with a hard shadow, three
+# coloured point lights, a rectangular area light with soft shadows, a glass sphere over a textured
+# floor (8-bit checker image), and the same with a float checker image. Cycles is restricted to TOYRT's light transport (max bounces 0; for the glass scene only
+# transmission/specular chains), Box filter of width 1, no denoising, no adaptive sampling,
+# Standard view transform, float EXR output read back linear.
+#
+# Metrics per scene (Blender's own render tests use the second): mean |TOYRT - Cycles| over the
+# mean of Cycles (<= 1 %), and the fraction of pixels where a channel differs by more than 0.016
+# after clamping both to [0, 1] (<= 1 %). The converged Cycles references are cached under
+# build/parity-cache/, keyed by a hash of the scene parameters, this file (scene building and
+# Cycles settings) and the Blender version, so only the first run pays for them (about 10 s).
+# Results go to docs/parity.md; images of the last run to build/parity-cache/last-run/.
+import hashlib
+import importlib.util
+import json
+import math
+import os
+import sys
+import time
+import traceback
+from pathlib import Path
+
+import bpy
+import numpy as np
+from mathutils import Vector
+
+REPO = Path(__file__).resolve().parents[2]
+CACHE = REPO / "build" / "parity-cache"
+DOC = REPO / "docs" / "parity.md"
+
+WIDTH, HEIGHT = 80, 60
+CYCLES_SAMPLES = int(os.environ.get("TOYRT_PARITY_CYCLES_SAMPLES", "1024"))
+TOYRT_SAMPLES = int(os.environ.get("TOYRT_PARITY_TOYRT_SAMPLES", "1024"))
+MEAN_LIMIT = 0.01        # mean |difference| / mean(reference)
+PIXEL_FAIL = 0.016       # Blender's render tests: a pixel fails above this difference ...
+PIXEL_LIMIT = 0.01       # ... and the image fails when more than 1 % of pixels fail
+SCENES = os.environ.get("TOYRT_PARITY_SCENES", "")  # comma-separated subset, for development
+
+
+def load_export():
+    spec = importlib.util.spec_from_file_location("toyrt_export_under_test", REPO / "addon" / "render_toyrt" / "export.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+# ---- scene building ---------------------------------------------------------------------------
+
+def clear_scene():
+    scene = bpy.context.scene
+    for obj in list(scene.collection.all_objects):
+        bpy.data.objects.remove(obj, do_unlink=True)
+    for coll in list(scene.collection.children):
+        bpy.data.collections.remove(coll)
+    for datablocks in (bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras,
+                       bpy.data.images, bpy.data.worlds):
+        for block in list(datablocks):
+            if block.name != "Render Result":
+                try:
+                    datablocks.remove(block)
+                except (RuntimeError, ReferenceError):
+                    pass
+    return scene
+
+
+def link(obj):
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
+def diffuse_material(name, color):
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nodes = mat.node_tree.nodes
+    nodes.clear()
+    out = nodes.new("ShaderNodeOutputMaterial")
+    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+    bsdf.inputs["Color"].default_value = (*color, 1.0)
+    mat.node_tree.links.new(bsdf.outputs[0], out.inputs["Surface"])
+    return mat
+
+
+def glass_material(name, ior):
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nodes = mat.node_tree.nodes
+    nodes.clear()
+    out = nodes.new("ShaderNodeOutputMaterial")
+    bsdf = nodes.new("ShaderNodeBsdfGlass")
+    bsdf.distribution = "SHARP"
+    bsdf.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    bsdf.inputs["IOR"].default_value = ior
+    mat.node_tree.links.new(bsdf.outputs[0], out.inputs["Surface"])
+    return mat
+
+
+def checker_material(name, n, c0, c1, float_buffer=False):
+    """A diffuse material with an n x n checker image (packed, sRGB-encoded values), 8-bit or float."""
+    image = bpy.data.images.new(name, n, n, alpha=False, float_buffer=float_buffer)
+    ij = np.add.outer(np.arange(n), np.arange(n)) % 2
+    px = np.where(ij[..., None] == 0, np.float32(c0), np.float32(c1))
+    rgba = np.concatenate([np.broadcast_to(px, (n, n, 1)).repeat(3, axis=2), np.ones((n, n, 1), np.float32)], axis=2)
+    image.pixels.foreach_set(rgba.astype(np.float32).ravel())
+    image.pack()
+    image.colorspace_settings.name = "sRGB"
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nodes = mat.node_tree.nodes
+    nodes.clear()
+    out = nodes.new("ShaderNodeOutputMaterial")
+    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+    tex = nodes.new("ShaderNodeTexImage")
+    tex.image = image
+    tex.interpolation = "Linear"
+    tex.extension = "REPEAT"
+    mat.node_tree.links.new(tex.outputs["Color"], bsdf.inputs["Color"])
+    mat.node_tree.links.new(bsdf.outputs[0], out.inputs["Surface"])
+    return mat
+
+
+def plane(name, size, material, uv_repeat=1.0):
+    h = size / 2
+    me = bpy.data.meshes.new(name)
+    me.from_pydata([(-h, -h, 0), (h, -h, 0), (h, h, 0), (-h, h, 0)], [], [(0, 1, 2, 3)])
+    uv = me.uv_layers.new(name="UVMap")
+    uv.data.foreach_set("uv", np.array([0, 0, 1, 0, 1, 1, 0, 1], np.float32) * uv_repeat)
+    me.materials.append(material)
+    me.update()
+    return link(bpy.data.objects.new(name, me))
+
+
+def cube(name, size, location, material):
+    h = size / 2
+    v = [(x, y, z) for x in (-h, h) for y in (-h, h) for z in (-h, h)]
+    f = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    me = bpy.data.meshes.new(name)
+    me.from_pydata(v, [], f)
+    me.materials.append(material)
+    me.update()
+    obj = link(bpy.data.objects.new(name, me))
+    obj.location = location
+    return obj
+
+
+def uv_sphere(name, radius, location, material, segments=48, rings=24):
+    bm_v = [(0.0, 0.0, radius)]
+    for i in range(1, rings):
+        th = math.pi * i / rings
+        for j in range(segments):
+            ph = 2 * math.pi * j / segments
+            bm_v.append((radius * math.sin(th) * math.cos(ph), radius * math.sin(th) * math.sin(ph), radius * math.cos(th)))
+    bm_v.append((0.0, 0.0, -radius))
+    faces = []
+    ring = lambda i, j: 1 + (i - 1) * segments + j % segments  # noqa: E731
+    for j in range(segments):
+        faces.append((0, ring(1, j), ring(1, j + 1)))
+    for i in range(1, rings - 1):
+        for j in range(segments):
+            faces.append((ring(i, j), ring(i + 1, j), ring(i + 1, j + 1), ring(i, j + 1)))
+    last = len(bm_v) - 1
+    for j in range(segments):
+        faces.append((ring(rings - 1, j), last, ring(rings - 1, j + 1)))
+    me = bpy.data.meshes.new(name)
+    me.from_pydata(bm_v, [], faces)
+    me.polygons.foreach_set("use_smooth", [True] * len(me.polygons))
+    me.materials.append(material)
+    me.update()
+    obj = link(bpy.data.objects.new(name, me))
+    obj.location = location
+    return obj
+
+
+def look_at(obj, target):
+    direction = Vector(target) - obj.location
+    obj.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
+
+
+def camera(location, target, lens=35.0):
+    cam = bpy.data.cameras.new("Camera")
+    cam.lens = lens
+    cam.sensor_fit = "AUTO"
+    cam.clip_start, cam.clip_end = 0.1, 100.0
+    obj = link(bpy.data.objects.new("Camera", cam))
+    obj.location = location
+    look_at(obj, target)
+    bpy.context.scene.camera = obj
+    return obj
+
+
+def point_light(name, location, power, color=(1, 1, 1), radius=0.0):
+    light = bpy.data.lights.new(name, "POINT")
+    light.energy, light.color, light.shadow_soft_size = power, color, radius
+    obj = link(bpy.data.objects.new(name, light))
+    obj.location = location
+    return obj
+
+
+def area_light(name, location, target, power, shape="RECTANGLE", size=1.0, size_y=1.0):
+    light = bpy.data.lights.new(name, "AREA")
+    light.energy, light.shape, light.size, light.size_y = power, shape, size, size_y
+    obj = link(bpy.data.objects.new(name, light))
+    obj.location = location
+    look_at(obj, target)
+    return obj
+
+
+def world(color, lights_diffuse=True):
+    w = bpy.data.worlds.new("World")
+    w.use_nodes = True
+    bg = w.node_tree.nodes.get("Background")
+    bg.inputs["Color"].default_value = (*color, 1.0)
+    bg.inputs["Strength"].default_value = 1.0
+    if not lights_diffuse:
+        # Cycles samples the world as a light at diffuse hits; TOYRT's background is only seen by
+        # rays that leave the scene. Camera, glossy and transmission rays still see it.
+        w.cycles_visibility.diffuse = False
+    bpy.context.scene.world = w
+
+
+# The scenes: each a function of its parameters (the parameters also key the Cycles cache).
+
+def scene_point(p):
+    white = diffuse_material("white", (1.0, 1.0, 1.0))
+    grey = diffuse_material("grey", (0.5, 0.5, 0.5))
+    plane("floor", 8.0, white)
+    cube("occluder", 0.6, (0.0, 0.0, 0.5), grey)
+    point_light("lamp", p["light"], p["power"], radius=p["radius"])
+    camera(p["camera"], (0, 0, 0))
+    world((0, 0, 0))
+
+
+def scene_rgb(p):
+    white = diffuse_material("white", (0.9, 0.9, 0.9))
+    grey = diffuse_material("grey", (0.6, 0.6, 0.6))
+    plane("floor", 8.0, white)
+    cube("occluder", 0.7, (0.0, 0.2, 0.35), grey)
+    for i, (loc, power, color) in enumerate(p["lights"]):
+        point_light(f"lamp{i}", loc, power, color=color)
+    camera(p["camera"], (0, 0, 0))
+    world((0, 0, 0))
+
+
+def scene_area(p):
+    white = diffuse_material("white", (0.8, 0.8, 0.8))
+    red = diffuse_material("red", (0.7, 0.2, 0.1))
+    plane("floor", 8.0, white)
+    cube("occluder", 0.6, (0.2, -0.1, 0.6), red)
+    area_light("panel", p["light"], p["light_target"], p["power"], shape="RECTANGLE", size=p["size"], size_y=p["size_y"])
+    camera(p["camera"], (0, 0, 0))
+    world((0, 0, 0))
+
+
+def scene_glass(p):
+    floor = checker_material("checker", 8, p["checker"][0], p["checker"][1], float_buffer=p["float_texture"])
+    plane("floor", 6.0, floor, uv_repeat=p["uv_repeat"])
+    uv_sphere("ball", 0.7, (0.0, 0.0, 0.75), glass_material("glass", p["ior"]))
+    lamp = area_light("panel", p["light"], (0, 0, 0), p["power"], shape="RECTANGLE", size=1.5, size_y=1.0)
+    if p["hide_light_from_specular"]:
+        # TOYRT's lights are not hit by rays (only sampled); make Cycles' lights the same.
+        lamp.visible_glossy = lamp.visible_transmission = lamp.visible_camera = False
+    camera(p["camera"], (0, 0, 0.4))
+    world(p["world"], lights_diffuse=p["world_lights_diffuse"])
+
+
+SCENES_SPEC = [
+    ("point", scene_point, dict(light=(1.0, 1.2, 2.5), power=150.0, radius=0.0, camera=(0.0, -6.0, 4.5)), 0),
+    ("three_rgb_points", scene_rgb, dict(lights=[((-1.5, -1.0, 2.0), 60.0, (1.0, 0.1, 0.1)),
+                                                 ((1.5, -1.0, 2.0), 60.0, (0.1, 1.0, 0.1)),
+                                                 ((0.0, 1.2, 2.0), 60.0, (0.1, 0.1, 1.0))],
+                                         camera=(0.0, -6.0, 4.5)), 0),
+    ("area_soft_shadow", scene_area, dict(light=(-0.5, 0.5, 2.2), light_target=(0.0, 0.0, 0.0), power=80.0,
+                                          size=1.6, size_y=0.8, camera=(0.0, -6.0, 4.5)), 0),
+    ("glass_sphere", scene_glass, dict(light=(1.0, -1.0, 3.0), power=120.0, ior=1.45, uv_repeat=4.0,
+                                       checker=(0.15, 0.85), world=(0.05, 0.05, 0.05),
+                                       hide_light_from_specular=True, world_lights_diffuse=False, float_texture=False,
+                                       camera=(0.0, -5.0, 2.5)), 8),
+    # The same with a float image holding the same sRGB-encoded values: Cycles decodes float images
+    # when it loads them, and 8-bit sRGB images only after filtering (see docs/parity.md).
+    ("glass_sphere_float_texture", scene_glass, dict(light=(1.0, -1.0, 3.0), power=120.0, ior=1.45, uv_repeat=4.0,
+                                                     checker=(0.15, 0.85), world=(0.05, 0.05, 0.05),
+                                                     hide_light_from_specular=True, world_lights_diffuse=False,
+                                                     float_texture=True,
+                                                     camera=(0.0, -5.0, 2.5)), 8),
+]
+
+
+# ---- Cycles ------------------------------------------------------------------------------------
+
+def setup_output(scene):
+    """Resolution and film settings: part of the scene, read by both engines."""
+    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = WIDTH, HEIGHT, 100
+    scene.render.pixel_aspect_x = scene.render.pixel_aspect_y = 1.0
+    scene.render.use_border = False
+    scene.render.film_transparent = False
+
+
+def setup_cycles(scene, samples, transmission):
+    scene.render.engine = "CYCLES"
+    c = scene.cycles
+    c.device = "CPU"
+    c.samples = samples
+    c.use_denoising = False
+    c.use_adaptive_sampling = False
+    c.seed = 0
+    c.pixel_filter_type = "BOX"
+    c.filter_width = 1.0
+    c.light_sampling_threshold = 0.0     # no probabilistic light termination (unbiased, but noisier)
+    c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
+    c.blur_glossy = 0.0
+    c.caustics_reflective = c.caustics_refractive = True
+    if transmission:
+        c.max_bounces = transmission
+        c.diffuse_bounces = 0
+        # Glass reflection is a glossy bounce in Cycles; TOYRT's Fresnel dielectric reflects too.
+        c.glossy_bounces = transmission
+        c.transmission_bounces = transmission
+        c.transparent_max_bounces = transmission
+    else:
+        c.max_bounces = 0
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    scene.view_settings.exposure = 0.0
+    scene.view_settings.gamma = 1.0
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    scene.render.image_settings.color_mode = "RGBA"
+
+
+def render_cycles(scene, path):
+    """Render with Cycles to an EXR; (rows from the top, (h, w, 4) float32, seconds)."""
+    scene.render.filepath = str(path)
+    t0 = time.perf_counter()
+    bpy.ops.render.render(write_still=True)
+    seconds = time.perf_counter() - t0
+    image = bpy.data.images.load(str(path), check_existing=False)
+    try:
+        w, h = image.size[:]
+        buf = np.empty(w * h * 4, np.float32)
+        image.pixels.foreach_get(buf)
+    finally:
+        bpy.data.images.remove(image)
+    return buf.reshape(h, w, 4)[::-1].copy(), seconds
+
+
+def cache_key(name, params, transmission, samples):
+    # This file's text is part of the key: any change to how scenes are built or how Cycles is
+    # set up renders the references again (about 10 s for all of them).
+    source = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
+    blob = json.dumps(dict(name=name, params=params, transmission=transmission, samples=samples,
+                           size=(WIDTH, HEIGHT), blender=bpy.app.version_string, source=source), sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+
+def cycles_reference(name, params, transmission, samples):
+    CACHE.mkdir(parents=True, exist_ok=True)
+    key = cache_key(name, params, transmission, samples)
+    npy, meta = CACHE / f"{name}-{key}.npy", CACHE / f"{name}-{key}.json"
+    if npy.exists() and meta.exists():
+        return np.load(npy), json.loads(meta.read_text())["seconds"], True
+    setup_cycles(bpy.context.scene, samples, transmission)
+    img, seconds = render_cycles(bpy.context.scene, CACHE / f"{name}-{key}.exr")
+    for stale in list(CACHE.glob(f"{name}-*.npy")) + list(CACHE.glob(f"{name}-*.json")):
+        stale.unlink()  # references of older versions of this scene
+    np.save(npy, img)
+    meta.write_text(json.dumps(dict(seconds=seconds, samples=samples, blender=bpy.app.version_string)))
+    (CACHE / f"{name}-{key}.exr").unlink(missing_ok=True)
+    return img, seconds, False
+
+
+# ---- comparison ----------------------------------------------------------------------------------
+
+def compare(toyrt_img, ref):
+    a, b = toyrt_img[..., :3].astype(np.float64), ref[..., :3].astype(np.float64)
+    mean_rel = float(np.abs(a - b).mean() / max(b.mean(), 1e-12))
+    d = np.abs(np.clip(a, 0, 1) - np.clip(b, 0, 1)).max(axis=2)
+    frac = float((d > PIXEL_FAIL).mean())
+    bias = float((a - b).mean() / max(b.mean(), 1e-12))  # signed: TOYRT brighter when > 0
+    return mean_rel, frac, bias
+
+
+def save_png(path, img):
+    """An sRGB PNG of a linear image (for looking at failures), rows from the top."""
+    h, w = img.shape[:2]
+    image = bpy.data.images.new(path.stem, w, h, alpha=True)
+    try:
+        rgba = np.ones((h, w, 4), np.float32)
+        rgba[..., :3] = np.clip(img[..., :3], 0, 1)
+        image.pixels.foreach_set(rgba[::-1].ravel())  # linear float -> byte with sRGB on save
+        image.filepath_raw = str(path)
+        image.file_format = "PNG"
+        image.save()
+    finally:
+        bpy.data.images.remove(image)
+
+
+def main():
+    import render_toyrt
+
+    toyrt = render_toyrt.native()
+    export = load_export()
+    wanted = {s for s in SCENES.split(",") if s}
+    results, failures = [], []
+    out_dir = CACHE / "last-run"
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for name, build, params, transmission in SCENES_SPEC:
+        if wanted and name not in wanted:
+            continue
+        print(f"parity: {name}", flush=True)
+        clear_scene()
+        build(params)
+        setup_output(bpy.context.scene)
+        bpy.context.view_layer.update()
+        ref, cycles_s, cached = cycles_reference(name, params, transmission, CYCLES_SAMPLES)
+
+        warnings = []
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        t0 = time.perf_counter()
+        scene_t, cam, stats = export.export_scene(depsgraph, toyrt, report=lambda kind, msg: warnings.append(msg))
+        scene_t.commit()
+        t1 = time.perf_counter()
+        img = scene_t.render(cam, samples=TOYRT_SAMPLES, seed=0, max_specular_depth=max(transmission, 0))
+        toyrt_s = time.perf_counter() - t1
+        assert img.shape == ref.shape, f"{name}: TOYRT {img.shape} vs Cycles {ref.shape}"
+        mean_rel, frac, bias = compare(img, ref)
+        ok = mean_rel <= MEAN_LIMIT and frac <= PIXEL_LIMIT
+        save_png(out_dir / f"{name}-toyrt.png", img)
+        save_png(out_dir / f"{name}-cycles.png", ref)
+        np.save(out_dir / f"{name}-toyrt.npy", img)
+        np.save(out_dir / f"{name}-cycles.npy", ref)
+        print(f"  mean |diff| / mean = {mean_rel * 100:.3f} % (signed {bias * 100:+.3f} %), "
+              f"pixels > {PIXEL_FAIL}: {frac * 100:.3f} %  -> {'ok' if ok else 'FAIL'}", flush=True)
+        print(f"  TOYRT {TOYRT_SAMPLES} spp: {toyrt_s:.2f} s render (+{t1 - t0:.3f} s export+commit); "
+              f"Cycles {CYCLES_SAMPLES} spp: {cycles_s:.2f} s{' (cached)' if cached else ''}; "
+              f"export: {stats['meshes']} meshes, {stats['instances']} instances, {stats['lights']} lights, "
+              f"approximated: {stats['approximated'] or 'nothing'}", flush=True)
+        if warnings:
+            print(f"  warning: {warnings}", flush=True)
+        results.append(dict(name=name, mean_rel=mean_rel, frac=frac, bias=bias, ok=ok, toyrt_s=toyrt_s,
+                            export_s=t1 - t0, cycles_s=cycles_s, mean_ref=float(ref[..., :3].mean())))
+        if not ok:
+            failures.append(name)
+    write_doc(results)
+    return results, failures
+
+
+def write_doc(results):
+    if not results or len(results) != len(SCENES_SPEC):
+        return  # a partial run (TOYRT_PARITY_SCENES) does not rewrite the report
+    cpu = os.cpu_count()
+    lines = [
+        "# Parity with Cycles",
+        "",
+        "Generated by `tests/blender/test_cycles_parity.py` (run by `make test`), on Blender "
+        f"{bpy.app.version_string}, {WIDTH}x{HEIGHT} pixels, {cpu} cores.",
+        "",
+        "Each scene is built with bpy, rendered by Cycles restricted to TOYRT's light transport (max bounces 0; "
+        "for the glass scene transmission and glossy bounces 8 with diffuse bounces 0, so only specular chains "
+        "through the glass; Box filter of width 1, no denoising, no adaptive sampling, light threshold 0, Standard "
+        f"view transform, float EXR) at {CYCLES_SAMPLES} samples per pixel, and by TOYRT through the add-on's "
+        f"exporter (`addon/render_toyrt/export.py`) at {TOYRT_SAMPLES} samples per pixel.",
+        "",
+        f"Pass: mean |TOYRT - Cycles| / mean(Cycles) <= {MEAN_LIMIT * 100:g} %, and at most {PIXEL_LIMIT * 100:g} % "
+        f"of pixels with a channel differing by more than {PIXEL_FAIL} after clamping to [0, 1] (the rule of "
+        "Blender's own render tests). Signed: mean (TOYRT - Cycles) / mean(Cycles).",
+        "",
+        "| scene | mean \\|diff\\| / mean | signed | pixels > 0.016 | result | TOYRT render | Cycles render |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in results:
+        lines.append(f"| {r['name']} | {r['mean_rel'] * 100:.3f} % | {r['bias'] * 100:+.3f} % | {r['frac'] * 100:.3f} % | "
+                     f"{'pass' if r['ok'] else 'FAIL'} | {r['toyrt_s']:.2f} s ({TOYRT_SAMPLES} spp) | "
+                     f"{r['cycles_s']:.2f} s ({CYCLES_SAMPLES} spp) |")
+    lines += [
+        "",
+        "Times are wall-clock seconds of the render call alone (Cycles: `bpy.ops.render.render`, including its "
+        "scene sync; a cached reference keeps the time of the run that made it).",
+        "",
+        "Notes:",
+        "- The point lights have radius 0: Cycles 3.4 renders a point light of radius R as a disk facing the "
+        "shading point, TOYRT as a sphere (they differ by about R^2/d^2; see docs/render.md).",
+        "- TOYRT's lights are only sampled, never hit by rays: the lights are kept out of the camera's view and "
+        "the glass scenes' area light is made invisible to Cycles' camera, glossy and transmission rays. With "
+        "Cycles' defaults the light's reflection and refraction show in the sphere: measured on "
+        "glass_sphere_float_texture at 512 spp, TOYRT is 5.1 % darker (mean |diff| 5.3 %, 1.1 % of pixels "
+        "over 0.016).",
+        "- Cycles lights diffuse surfaces with the world (it samples the background as a light); TOYRT's "
+        "background is only seen by rays that leave the scene. The glass scenes' dim world is made invisible "
+        "to Cycles' diffuse rays; with it visible TOYRT is 7.4 % darker (33 % of pixels over 0.016). Scenes 1-3 "
+        "have a black world.",
+        "- Glass: TOYRT's Fresnel dielectric reflects as well as refracts, so Cycles runs with glossy bounces "
+        "equal to the transmission bounces (8; diffuse bounces 0). With glossy bounces 0 Cycles drops the "
+        "reflections: TOYRT +0.6 % (1.25 % of pixels over 0.016).",
+        "- **glass_sphere fails: 8-bit sRGB textures.** Cycles filters an 8-bit sRGB image in its sRGB values "
+        "and decodes to linear after the bilinear lookup (its 'compress as sRGB' byte textures); TOYRT's core "
+        "decodes every texel when the texture is added and filters linear values. Between texels of different "
+        "colour the results differ: on a 2x2 black/white checker, a pixel at u = 0.22 is 0.883 in TOYRT "
+        "(the linear mix) and 0.757 in Cycles (srgb_to_linear(0.883)). On the glass scene's 8x8 checker, "
+        "magnified, TOYRT is +42 % brighter. Float images are kept linear by Blender and filtered linear by both "
+        "(glass_sphere_float_texture passes). The fix belongs in the native core: keep 8-bit sRGB textures "
+        "(the exporter passes them as uint8) encoded and decode after filtering.",
+        "",
+    ]
+    DOC.write_text("\n".join(lines))
+    print(f"parity: wrote {DOC}", flush=True)
+
+
+if __name__ == "__main__":
+    try:
+        results, failures = main()
+    except BaseException:  # any way out but success is a failure
+        traceback.print_exc()
+        print("parity: 0 passed, 1 failed (error)", flush=True)
+        sys.exit(1)
+    print(f"parity: {len(results) - len(failures)} passed, {len(failures)} failed"
+          + (f" ({', '.join(failures)})" if failures else ""), flush=True)
+    sys.exit(1 if failures else 0)

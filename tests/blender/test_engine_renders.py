@@ -1,0 +1,113 @@
+# Runs inside Blender:  blender -b --python-exit-code 1 --python tests/blender/test_engine_renders.py
+# The TOYRT engine end to end, as a user meets it: a bpy-built scene rendered with F12's operator
+# and from the command line (`blender -b file.blend -E TOYRT -f 1`), checked against the closed
+# form of a point light over a white Diffuse plane in Blender's units; a render error must fail
+# the command (non-zero exit, no image), as a render farm needs.
+import os
+import subprocess
+import sys
+import tempfile
+import traceback
+
+import bpy
+import numpy as np
+
+RESULTS = []
+
+
+def check(cond, what):
+    RESULTS.append(bool(cond))
+    print(("  ok: " if cond else "  FAIL: ") + what, flush=True)
+
+
+def build_scene(with_camera=True):
+    for o in list(bpy.data.objects):
+        bpy.data.objects.remove(o)
+    s = bpy.context.scene
+    bpy.ops.mesh.primitive_plane_add(size=10)
+    plane = bpy.context.object
+    mat = bpy.data.materials.new("white_diffuse")
+    mat.use_nodes = True
+    nodes = mat.node_tree.nodes
+    for n in list(nodes):
+        if n.type != "OUTPUT_MATERIAL":
+            nodes.remove(n)
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (1, 1, 1, 1)
+    mat.node_tree.links.new(diffuse.outputs[0], nodes["Material Output"].inputs["Surface"])
+    plane.data.materials.append(mat)
+    light = bpy.data.lights.new("point", "POINT")
+    light.energy = 100.0
+    light.shadow_soft_size = 0.0
+    lo = bpy.data.objects.new("point", light)
+    lo.location = (0, 0, 1)
+    s.collection.objects.link(lo)
+    if with_camera:
+        cam = bpy.data.cameras.new("cam")
+        cam.type = "ORTHO"
+        cam.ortho_scale = 2.0
+        co = bpy.data.objects.new("cam", cam)
+        co.location = (0, 0, 5)
+        s.collection.objects.link(co)
+        s.camera = co
+    else:
+        s.camera = None
+    s.render.engine = "TOYRT"
+    s.render.resolution_x = s.render.resolution_y = 32
+    s.render.resolution_percentage = 100
+    s.toyrt.samples = 16
+    s.world = None
+    return s
+
+
+def expected_image(n=32, size=2.0, power=100.0, height=1.0, sub=8):
+    """Pixel averages of albedo/pi * P/(4 pi) * cos / r^2 (rows from the bottom, as Blender)."""
+    c = (np.arange(n * sub) + 0.5) / (n * sub) * size - size / 2
+    x, y = np.meshgrid(c, c)
+    r2 = x * x + y * y + height * height
+    v = 1 / np.pi * power / (4 * np.pi) * (height / np.sqrt(r2)) / r2
+    return v.reshape(n, sub, n, sub).mean(axis=(1, 3))
+
+
+def main():
+    engines = {cls.bl_idname for cls in bpy.types.RenderEngine.__subclasses__()}
+    check("TOYRT" in engines, "the TOYRT engine is registered")
+    s = build_scene()
+    check(hasattr(s, "toyrt") and s.toyrt.samples == 16, "settings live at scene.toyrt")
+    out = os.path.join(tempfile.mkdtemp(), "f12.exr")
+    s.render.filepath = out
+    s.render.image_settings.file_format = "OPEN_EXR"
+    bpy.ops.render.render(write_still=True)
+    img = bpy.data.images.load(out)
+    px = np.array(img.pixels[:], dtype=np.float32).reshape(32, 32, 4)
+    err = np.abs(px[..., 0] - expected_image()).max() / expected_image().max()
+    check(err < 0.01, f"F12 render matches I cos / r^2 in Blender's units (max error {err:.4f} of the peak)")
+
+    # The command line a farm runs, on a saved file.
+    blend = os.path.join(tempfile.mkdtemp(), "scene.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=blend)
+    frame_out = os.path.join(os.path.dirname(blend), "frame_")
+    run = subprocess.run([bpy.app.binary_path, "-b", blend, "-E", "TOYRT", "-o", frame_out, "-F", "PNG", "-f", "1"],
+                         capture_output=True, text=True)
+    check(run.returncode == 0 and os.path.exists(frame_out + "0001.png"), "blender -b file.blend -E TOYRT -f 1 writes the frame")
+
+    # A render error (no camera) fails the command and writes nothing.
+    build_scene(with_camera=False)
+    bad = os.path.join(tempfile.mkdtemp(), "nocam.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=bad)
+    bad_out = os.path.join(os.path.dirname(bad), "frame_")
+    run = subprocess.run([bpy.app.binary_path, "-b", bad, "-E", "TOYRT", "-o", bad_out, "-F", "PNG", "-f", "1"],
+                         capture_output=True, text=True)
+    check(run.returncode != 0 and not os.path.exists(bad_out + "0001.png"),
+          f"a scene without a camera fails the frame (exit {run.returncode}) and saves no image")
+    check("camera" in (run.stdout + run.stderr).lower(), "the error says what is wrong")
+
+
+try:
+    main()
+except Exception:
+    traceback.print_exc()
+    RESULTS.append(False)
+failed = RESULTS.count(False)
+print(f"engine: {len(RESULTS) - failed} passed, {failed} failed", flush=True)
+sys.exit(1 if failed else 0)
