@@ -494,14 +494,10 @@ def write_doc(results):
         "- Glass: TOYRT's Fresnel dielectric reflects as well as refracts, so Cycles runs with glossy bounces "
         "equal to the transmission bounces (8; diffuse bounces 0). With glossy bounces 0 Cycles drops the "
         "reflections: TOYRT +0.6 % (1.25 % of pixels over 0.016).",
-        "- **glass_sphere fails: 8-bit sRGB textures.** Cycles filters an 8-bit sRGB image in its sRGB values "
-        "and decodes to linear after the bilinear lookup (its 'compress as sRGB' byte textures); TOYRT's core "
-        "decodes every texel when the texture is added and filters linear values. Between texels of different "
-        "colour the results differ: on a 2x2 black/white checker, a pixel at u = 0.22 is 0.883 in TOYRT "
-        "(the linear mix) and 0.757 in Cycles (srgb_to_linear(0.883)). On the glass scene's 8x8 checker, "
-        "magnified, TOYRT is +42 % brighter. Float images are kept linear by Blender and filtered linear by both "
-        "(glass_sphere_float_texture passes). The fix belongs in the native core: keep 8-bit sRGB textures "
-        "(the exporter passes them as uint8) encoded and decode after filtering.",
+        "- 8-bit sRGB textures: Cycles filters an 8-bit sRGB image in its sRGB values and decodes to linear "
+        "after the bilinear lookup; TOYRT does the same (Texture.EightBitSrgbIsFilteredBeforeDecodingAsCycles). "
+        "Before that fix, decoding every texel at load made glass_sphere's magnified 8x8 checker +42 % too "
+        "bright. Float images are kept linear by Blender and filtered linear by both (glass_sphere_float_texture).",
         "",
     ]
     DOC.write_text("\n".join(lines))
