@@ -367,13 +367,18 @@ def _export_light(scene, obj, matrix, approx):
         what = f"light '{obj.name}': node setup (its colour and power)"
         if what not in approx:
             approx.append(what)
+    # Ray visibility of the light object (Blender 3.0+; all visible by default, as in Cycles):
+    # TOYRT's specular rays are Cycles' glossy and transmission rays.
+    visible = dict(visible_camera=bool(getattr(obj, "visible_camera", True)),
+                   visible_specular=bool(getattr(obj, "visible_glossy", True) and getattr(obj, "visible_transmission", True)))
     if light.type == "POINT":
-        scene.add_point_light(tuple(matrix[:3, 3]), power, color=color, radius=float(light.shadow_soft_size))
+        scene.add_point_light(tuple(matrix[:3, 3]), power, color=color, radius=float(light.shadow_soft_size), **visible)
         return True
     if light.type == "AREA":
         shape = light.shape
         size_y = float(light.size_y) if shape in ("RECTANGLE", "ELLIPSE") else None
-        scene.add_area_light(matrix, shape=shape, size=float(light.size), size_y=size_y, power=power, color=color)
+        scene.add_area_light(matrix, shape=shape, size=float(light.size), size_y=size_y, power=power, color=color,
+                             **visible)
         return True
     what = f"{light.type.lower()} light '{obj.name}' (skipped)"
     if what not in approx:

@@ -183,20 +183,23 @@ class PyScene {
     return uint32_t(render_.textures.size() - 1);
   }
 
-  uint32_t add_point_light(py::handle position, float power, py::handle color, float radius) {
+  uint32_t add_point_light(py::handle position, float power, py::handle color, float radius, bool visible_camera,
+                           bool visible_specular) {
     const PointLight l = PointLight::make(to_point(position, "position"), power, to_color(color, "color"), radius);
     std::unique_lock lock(mutex_);
     render_.lights.push_back(l);
+    render_.light_visibility.push_back({visible_camera, visible_specular});
     return uint32_t(render_.lights.size() - 1);
   }
 
   uint32_t add_area_light(py::handle matrix, const std::string& shape, float size, py::handle size_y, float power,
-                          py::handle color) {
+                          py::handle color, bool visible_camera, bool visible_specular) {
     const float sy = size_y.is_none() ? size : size_y.cast<float>();
     const AreaLight l = AreaLight::make(to_area_shape(shape), size, sy, to_matrix4(matrix, "matrix"), power,
                                         to_color(color, "color"));
     std::unique_lock lock(mutex_);
     render_.lights.push_back(l);
+    render_.light_visibility.push_back({visible_camera, visible_specular});
     return uint32_t(render_.lights.size() - 1);
   }
 
@@ -509,14 +512,18 @@ PYBIND11_MODULE(toyrt, m) {
            "Adds an image; returns its id. pixels: (height, width, 3 or 4), float 0..1 or uint8, rows from\n"
            "the bottom (Blender's Image.pixels order); srgb: decode from sRGB to linear, as Blender does.")
       .def("add_point_light", &PyScene::add_point_light, py::arg("position"), py::arg("power"),
-           py::arg("color") = py::make_tuple(1.0, 1.0, 1.0), py::arg("radius") = 0.0f,
-           "Adds a point light in Blender's units: power in watts, linear colour, radius in metres (0: hard shadows).")
+           py::arg("color") = py::make_tuple(1.0, 1.0, 1.0), py::arg("radius") = 0.0f, py::arg("visible_camera") = true,
+           py::arg("visible_specular") = true,
+           "Adds a point light in Blender's units: power in watts, linear colour, radius in metres (0: hard shadows).\n"
+           "visible_camera / visible_specular: whether camera rays / rays through glass see the sphere itself.")
       .def("add_area_light", &PyScene::add_area_light, py::arg("matrix"), py::arg("shape") = "SQUARE",
            py::arg("size") = 1.0f, py::arg("size_y") = py::none(), py::arg("power") = 10.0f,
-           py::arg("color") = py::make_tuple(1.0, 1.0, 1.0),
+           py::arg("color") = py::make_tuple(1.0, 1.0, 1.0), py::arg("visible_camera") = true,
+           py::arg("visible_specular") = true,
            "Adds an area light in Blender's units: the light object's (4, 4) world matrix (it emits along its\n"
            "local -Z, one-sided), shape 'RECTANGLE', 'SQUARE', 'DISK' or 'ELLIPSE', size (and size_y) in metres,\n"
-           "power in watts (radiance = power / (4 area), as Cycles).")
+           "power in watts (radiance = power / (4 area), as Cycles). visible_camera / visible_specular: whether\n"
+           "camera rays / rays through glass see the light's surface (Cycles' defaults: both).")
       .def_property("background", &PyScene::background, &PyScene::set_background,
                     "Radiance (linear RGB) of rays that leave the scene: the world colour.")
       .def("render", &PyScene::render, py::arg("camera"), py::arg("samples") = 16, py::arg("seed") = 0,

@@ -72,6 +72,23 @@ Vec3 direct_lighting(const RenderScene& rs, const SurfaceHit& s, const Vec3& ng,
   return sum;
 }
 
+// The nearest light a camera (depth 0) or specular ray sees before distance `limit` (in units of
+// the unit direction), if it is visible to that kind of ray: its radiance, or nothing.
+bool visible_light(const RenderScene& rs, const Vec3& org, const Vec3& unit_dir, float from, float limit, bool camera,
+                   Vec3& radiance) {
+  bool seen = false;
+  for (size_t j = 0; j < rs.lights.size(); ++j) {
+    const RenderScene::LightVisibility v = j < rs.light_visibility.size() ? rs.light_visibility[j] : RenderScene::LightVisibility{};
+    if (!(camera ? v.camera : v.specular)) continue;
+    const LightEval e = evaluate_light(rs.lights[j], org, unit_dir);
+    if (!e.hit() || !(e.distance >= from) || !(e.distance < limit)) continue;
+    limit = e.distance;
+    radiance = e.radiance;
+    seen = true;
+  }
+  return seen;
+}
+
 }  // namespace
 
 Vec3 trace_path(const RenderScene& rs, const Ray& camera_ray, uint32_t pixel, uint32_t sample,
@@ -81,6 +98,16 @@ Vec3 trace_path(const RenderScene& rs, const Ray& camera_ray, uint32_t pixel, ui
   Vec3 throughput(1.0f), radiance(0.0f);
   for (int depth = 0;; ++depth) {
     const Hit hit = rs.geometry->intersect(ray);
+    if (!rs.lights.empty()) {
+      // A light nearer than the surface (or than nothing): the ray sees the light and ends there.
+      const float length = glm::length(ray.dir);
+      Vec3 seen;
+      if (visible_light(rs, ray.org, ray.dir / length, ray.tnear * length, std::min(hit.t, ray.tfar) * length, depth == 0,
+                        seen)) {
+        radiance += throughput * seen;
+        break;
+      }
+    }
     if (!hit.found()) {
       radiance += throughput * rs.background;
       break;

@@ -26,6 +26,14 @@ struct RenderScene {
   std::vector<Material> materials;     // empty: every surface is Lambert with albedo 0.8
   std::vector<Texture> textures;
   std::vector<Light> lights;
+  // Per light: whether camera rays, and rays continuing through refraction or reflection, see
+  // the light itself (Blender's ray visibility of the light object; Cycles shows lights to both
+  // by default). Point lights of radius 0 can never be seen.
+  struct LightVisibility {
+    bool camera = true;
+    bool specular = true;
+  };
+  std::vector<LightVisibility> light_visibility;  // parallel to lights
   Vec3 background{0.0f};               // radiance of rays that leave the scene (the world colour)
 };
 
