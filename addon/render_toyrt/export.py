@@ -391,6 +391,9 @@ def _export_world(scene, bl_scene, approx):
     if world is None:
         scene.background = (0.0, 0.0, 0.0)
         return
+    # Cycles lights diffuse surfaces with the world unless its diffuse ray visibility is off.
+    visibility = getattr(world, "cycles_visibility", None)
+    scene.background_lighting = bool(getattr(visibility, "diffuse", True))
     if not getattr(world, "use_nodes", False) or world.node_tree is None:
         scene.background = _rgb(world.color)
         return

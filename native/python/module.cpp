@@ -208,6 +208,14 @@ class PyScene {
     std::unique_lock lock(mutex_);
     render_.background = c;
   }
+  void set_background_lighting(bool on) {
+    std::unique_lock lock(mutex_);
+    render_.background_lights_surfaces = on;
+  }
+  bool background_lighting() {
+    std::shared_lock lock(mutex_);
+    return render_.background_lights_surfaces;
+  }
   py::tuple background() {
     std::shared_lock lock(mutex_);
     return py::make_tuple(render_.background.x, render_.background.y, render_.background.z);
@@ -526,6 +534,8 @@ PYBIND11_MODULE(toyrt, m) {
            "camera rays / rays through glass see the light's surface (Cycles' defaults: both).")
       .def_property("background", &PyScene::background, &PyScene::set_background,
                     "Radiance (linear RGB) of rays that leave the scene: the world colour.")
+      .def_property("background_lighting", &PyScene::background_lighting, &PyScene::set_background_lighting,
+                    "Whether the background also lights diffuse surfaces, as Cycles' world does (default True).")
       .def("render", &PyScene::render, py::arg("camera"), py::arg("samples") = 16, py::arg("seed") = 0,
            py::arg("max_specular_depth") = 8, py::arg("area_light_sampling") = "solid_angle",
            py::arg("light_sampling") = "auto", py::arg("threads") = 0, py::arg("tile_size") = 32,

@@ -2,7 +2,9 @@
 
 #include "geometry/offset_ray.h"
 #include "lights/light_selector.h"
+#include "sampling/frame.h"
 #include "sampling/sobol_owen.h"
+#include "sampling/warp.h"
 
 namespace toyrt {
 namespace {
@@ -62,6 +64,14 @@ Vec3 direct_lighting(const RenderScene& rs, const SurfaceHit& s, const Vec3& ng,
     if (rs.geometry->occluded(shadow)) return;
     sum += f * ls.radiance * (cos_s / (ls.pdf * select_probability));
   };
+  // The world as a light: a constant background seen over the hemisphere. A cosine-distributed
+  // direction makes the estimate f L cos / pdf = albedo L when nothing blocks it.
+  if (rs.background_lights_surfaces && rs.background != Vec3(0.0f)) {
+    const Vec3 local = sample_cosine_hemisphere(sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 1), settings.seed));
+    const Vec3 wi = Frame::from_normal(ns).to_world(local);
+    if (glm::dot(ng, wi) > 0.0f && !rs.geometry->occluded(Ray{origin, 0.0f, wi, kInfinity}))
+      sum += f * rs.background * kPi;  // f = albedo / pi
+  }
   if (settings.light_sampling == LightSampling::All || rs.lights.size() == 1) {
     for (size_t j = 0; j < rs.lights.size(); ++j) add(rs.lights[j], 1.0f, 1 + uint32_t(j));
   } else {

@@ -35,6 +35,9 @@ struct RenderScene {
   };
   std::vector<LightVisibility> light_visibility;  // parallel to lights
   Vec3 background{0.0f};               // radiance of rays that leave the scene (the world colour)
+  // Whether the background also lights diffuse surfaces (Cycles samples the world as a light;
+  // Blender's world ray visibility for diffuse rays turns it off).
+  bool background_lights_surfaces = true;
 };
 
 }  // namespace toyrt

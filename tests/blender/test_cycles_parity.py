@@ -215,8 +215,8 @@ def world(color, lights_diffuse=True):
     bg.inputs["Color"].default_value = (*color, 1.0)
     bg.inputs["Strength"].default_value = 1.0
     if not lights_diffuse:
-        # Cycles samples the world as a light at diffuse hits; TOYRT's background is only seen by
-        # rays that leave the scene. Camera, glossy and transmission rays still see it.
+        # The world seen by camera, glossy and transmission rays but not lighting diffuse surfaces
+        # (the exporter passes the flag on).
         w.cycles_visibility.diffuse = False
     bpy.context.scene.world = w
 
@@ -286,10 +286,10 @@ SCENES_SPEC = [
                                                      float_texture=True,
                                                      camera=(0.0, -5.0, 2.5)), 8),
     # Cycles' defaults: the light is seen through and in the glass (camera, glossy and transmission
-    # rays see it), as TOYRT's camera and specular rays do.
+    # rays see it), and the world lights the floor, as in TOYRT.
     ("glass_sphere_visible_light", scene_glass, dict(light=(1.0, -1.0, 3.0), power=120.0, ior=1.45, uv_repeat=4.0,
                                                      checker=(0.15, 0.85), world=(0.05, 0.05, 0.05),
-                                                     hide_light_from_specular=False, world_lights_diffuse=False,
+                                                     hide_light_from_specular=False, world_lights_diffuse=True,
                                                      float_texture=False, camera=(0.0, -5.0, 2.5), sample_factor=4), 8),
 ]
 
@@ -498,10 +498,9 @@ def write_doc(results):
         "exporter passes on): glass_sphere_visible_light keeps Cycles' defaults and passes at 4x the samples "
         "(the light's image through the sphere is the noisiest part of both renders); glass_sphere and "
         "glass_sphere_float_texture hide the light from camera, glossy and transmission rays in both.",
-        "- Cycles lights diffuse surfaces with the world (it samples the background as a light); TOYRT's "
-        "background is only seen by rays that leave the scene. The glass scenes' dim world is made invisible "
-        "to Cycles' diffuse rays; with it visible TOYRT is 7.4 % darker (33 % of pixels over 0.016). Scenes 1-3 "
-        "have a black world.",
+        "- The world lights diffuse surfaces in both (TOYRT samples the constant background over the "
+        "hemisphere) unless the world's diffuse ray visibility is off, which the exporter passes on: "
+        "glass_sphere_visible_light keeps it on; the other glass scenes turn it off in both.",
         "- Glass: TOYRT's Fresnel dielectric reflects as well as refracts, so Cycles runs with glossy bounces "
         "equal to the transmission bounces (8; diffuse bounces 0). With glossy bounces 0 Cycles drops the "
         "reflections: TOYRT +0.6 % (1.25 % of pixels over 0.016).",

@@ -213,3 +213,15 @@ def test_render_input_errors_are_clear():
     s.commit()
     with pytest.raises(ValueError, match="material id 7"):
         s.render(camera_above())
+
+
+def test_a_uniform_background_lights_an_open_plane_with_albedo_times_its_radiance():
+    """Under a constant sky of radiance L, an unoccluded Lambert plane reflects albedo * L (the
+    cosine-weighted hemisphere integrates to pi, and f = albedo / pi)."""
+    s = floor_scene(albedo=0.6, half=50.0)
+    s.background = (0.5, 1.0, 2.0)
+    s.commit()
+    img = s.render(camera_above(size=0.5, resolution=4), samples=256)
+    np.testing.assert_allclose(img[..., :3].mean(axis=(0, 1)), [0.3, 0.6, 1.2], rtol=2e-3)
+    s.background_lighting = False
+    assert (s.render(camera_above(size=0.5, resolution=4), samples=4)[..., :3] == 0).all()
