@@ -146,22 +146,47 @@ class PyScene {
   uint32_t add_material(const std::string& kind, py::handle color, int64_t texture, float ior) {
     const Vec3 c = to_color(color, "color");
     std::unique_lock lock(mutex_);
+    render_.materials.push_back(make_material(kind, c, texture, ior));
+    return uint32_t(render_.materials.size() - 1);
+  }
+
+  // In place, so the meshes using material `material` pick up the edit without re-export.
+  void set_material(int64_t material, const std::string& kind, py::handle color, int64_t texture, float ior) {
+    const Vec3 c = to_color(color, "color");
+    std::unique_lock lock(mutex_);
+    if (material < 0 || size_t(material) >= render_.materials.size())
+      throw py::value_error("unknown material id " + std::to_string(material));
+    render_.materials[size_t(material)] = make_material(kind, c, texture, ior);
+  }
+
+  Material make_material(const std::string& kind, const Vec3& c, int64_t texture, float ior) const {
     if (kind == "diffuse") {
       if (texture < -1 || texture >= int64_t(render_.textures.size()))
         throw py::value_error("unknown texture id " + std::to_string(texture) + " (the scene has " +
                               std::to_string(render_.textures.size()) + " textures)");
-      render_.materials.push_back(Lambert{c, int32_t(texture)});
-    } else if (kind == "refraction") {
-      render_.materials.push_back(PerfectRefraction::make(ior));
-    } else if (kind == "glass") {
-      render_.materials.push_back(FresnelDielectric::make(ior));
-    } else {
-      throw py::value_error("material kind must be 'diffuse', 'refraction' or 'glass', got '" + kind + "'");
+      return Lambert{c, int32_t(texture)};
     }
-    return uint32_t(render_.materials.size() - 1);
+    if (kind == "refraction") return PerfectRefraction::make(ior);
+    if (kind == "glass") return FresnelDielectric::make(ior);
+    throw py::value_error("material kind must be 'diffuse', 'refraction' or 'glass', got '" + kind + "'");
   }
 
   uint32_t add_texture(py::handle pixels, bool srgb) {
+    Texture t = make_texture(pixels, srgb);
+    std::unique_lock lock(mutex_);
+    render_.textures.push_back(std::move(t));
+    return uint32_t(render_.textures.size() - 1);
+  }
+
+  void set_texture(int64_t texture, py::handle pixels, bool srgb) {
+    Texture t = make_texture(pixels, srgb);
+    std::unique_lock lock(mutex_);
+    if (texture < 0 || size_t(texture) >= render_.textures.size())
+      throw py::value_error("unknown texture id " + std::to_string(texture));
+    render_.textures[size_t(texture)] = std::move(t);
+  }
+
+  static Texture make_texture(py::handle pixels, bool srgb) {
     const py::array a = try_array(pixels);
     if (!a) throw py::type_error("pixels must be an array of shape (height, width, 3 or 4)");
     if (a.ndim() != 3 || (a.shape(2) != 3 && a.shape(2) != 4))
@@ -178,9 +203,40 @@ class PyScene {
     } else {
       throw py::type_error("pixels must be float (0..1) or uint8, not dtype " + std::string(py::str(a.dtype())));
     }
+    return t;
+  }
+
+  // Lights are re-sent as a whole on an edit: they are few and cheap.
+  void clear_lights() {
     std::unique_lock lock(mutex_);
-    render_.textures.push_back(std::move(t));
-    return uint32_t(render_.textures.size() - 1);
+    render_.lights.clear();
+    render_.light_visibility.clear();
+  }
+
+  void replace_mesh(int64_t mesh, py::handle vertices, py::handle triangles, py::handle normals, py::handle uvs,
+                    py::handle material_ids) {
+    std::vector<Vec3> verts = to_vec3s(as_points(vertices, "vertices"));
+    std::vector<Triangle> tris = to_triangles(triangles);
+    MeshShading shading = to_shading(verts.size(), tris, normals, uvs, material_ids);
+    std::unique_lock lock(mutex_);
+    if (mesh < 0 || size_t(mesh) >= scene_.mesh_count())
+      throw py::value_error("unknown mesh id " + std::to_string(mesh) + " (the scene has " +
+                            std::to_string(scene_.mesh_count()) + " meshes)");
+    scene_.replace_mesh(uint32_t(mesh), std::move(verts), std::move(tris));
+    render_.shading.resize(scene_.mesh_count());
+    render_.shading[size_t(mesh)] = std::move(shading);
+  }
+
+  void set_instance_transform(int64_t instance, py::handle transform) {
+    const Mat4 m = to_matrix(transform);
+    std::unique_lock lock(mutex_);
+    if (instance < 0) throw py::value_error("unknown instance id " + std::to_string(instance));
+    scene_.set_instance_transform(uint32_t(instance), m);
+  }
+
+  void clear_instances() {
+    std::unique_lock lock(mutex_);
+    scene_.clear_instances();
   }
 
   uint32_t add_point_light(py::handle position, float power, py::handle color, float radius, bool visible_camera,
@@ -223,14 +279,16 @@ class PyScene {
 
   py::array_t<float> render(const py::dict& camera_settings, int samples, uint32_t seed, int max_specular_depth,
                             const std::string& area_light_sampling, const std::string& light_sampling, int threads,
-                            int tile_size, py::object on_tile, py::object should_cancel) {
+                            int tile_size, py::object on_tile, py::object should_cancel, int first_sample) {
     const Camera camera = Camera::make(to_camera(camera_settings));
     if (samples < 1) throw py::value_error("samples must be at least 1");
+    if (first_sample < 0) throw py::value_error("first_sample must be >= 0");
     if (tile_size < 1) throw py::value_error("tile_size must be at least 1");
     if (max_specular_depth < 0) throw py::value_error("max_specular_depth must be >= 0");
     const AreaSampling area = to_area_sampling(area_light_sampling);
     RenderSettings settings;
     settings.samples = samples;
+    settings.first_sample = first_sample;
     settings.tile_size = tile_size;
     settings.threads = check_threads(threads);
     settings.integrator.seed = seed;
@@ -277,6 +335,7 @@ class PyScene {
     last_render_["render_ms"] = result.render_ms;
     last_render_["cancel_latency_ms"] = result.cancel_latency_ms;
     last_render_["samples"] = samples;
+    last_render_["first_sample"] = first_sample;
     last_render_["light_sampling"] = settings.integrator.light_sampling == LightSampling::One ? "one" : "all";
     py::array_t<float> image({py::ssize_t(result.height), py::ssize_t(result.width), py::ssize_t(4)});
     std::memcpy(image.mutable_data(), result.rgba.data(), result.rgba.size() * sizeof(float));
@@ -498,6 +557,8 @@ PYBIND11_MODULE(toyrt, m) {
         PyErr_SetString(PyExc_RuntimeError, e.what());
     } catch (const std::bad_alloc&) {
       PyErr_SetString(PyExc_MemoryError, "toyrt: out of memory");
+    } catch (const RenderTooLarge& e) {
+      PyErr_SetString(PyExc_MemoryError, e.what());  // refused before allocating
     }
   });
 
@@ -539,7 +600,7 @@ PYBIND11_MODULE(toyrt, m) {
       .def("render", &PyScene::render, py::arg("camera"), py::arg("samples") = 16, py::arg("seed") = 0,
            py::arg("max_specular_depth") = 8, py::arg("area_light_sampling") = "solid_angle",
            py::arg("light_sampling") = "auto", py::arg("threads") = 0, py::arg("tile_size") = 32,
-           py::arg("on_tile") = py::none(), py::arg("should_cancel") = py::none(),
+           py::arg("on_tile") = py::none(), py::arg("should_cancel") = py::none(), py::arg("first_sample") = 0,
            "Renders the committed scene; returns (height, width, 4) float32 linear RGBA, rows from the top, of\n"
            "the camera's pixel window (the border region, if set).\n"
            "camera: a dict of Blender's camera and render settings: type ('PERSP', 'ORTHO'), lens, sensor_width,\n"
@@ -550,10 +611,29 @@ PYBIND11_MODULE(toyrt, m) {
            "light at every hit), 'one' (one light chosen by expected contribution) or 'auto' ('all' up to 4\n"
            "lights). on_tile(x, y, width, height, pixels) is called on this thread as tiles finish;\n"
            "should_cancel() is polled every 10 ms and stops the render when true (so does Ctrl-C).\n"
-           "Results are the same for any thread count and tile size.")
+           "Results are the same for any thread count and tile size.\n"
+           "first_sample: render samples [first_sample, first_sample + samples) of the same sequence, the\n"
+           "mean of that pass: passes weighted by their sample counts average to one render of them all\n"
+           "(progressive rendering). A window too large for the memory available raises MemoryError\n"
+           "before anything is allocated.")
       .def_property_readonly("last_render", &PyScene::last_render,
                              "What the last render did: cancelled, cancel_latency_ms, tiles_done, tiles_total, render_ms,\n"
                              "samples, light_sampling.")
+      .def("set_material", &PyScene::set_material, py::arg("material"), py::arg("kind") = "diffuse",
+           py::arg("color") = py::make_tuple(0.8, 0.8, 0.8), py::arg("texture") = -1, py::arg("ior") = 1.45f,
+           "Replaces material `material` in place (same arguments as add_material); meshes keep their ids.")
+      .def("set_texture", &PyScene::set_texture, py::arg("texture"), py::arg("pixels"), py::arg("srgb") = true,
+           "Replaces texture `texture` in place (same arguments as add_texture).")
+      .def("clear_lights", &PyScene::clear_lights, "Removes every light (to send them again after an edit).")
+      .def("replace_mesh", &PyScene::replace_mesh, py::arg("mesh"), py::arg("vertices"), py::arg("triangles"),
+           py::arg("normals") = py::none(), py::arg("uvs") = py::none(), py::arg("material_ids") = py::none(),
+           "Replaces mesh `mesh`'s geometry and shading (arguments as add_mesh, without a transform); its\n"
+           "instances stay, the next commit rebuilds its BVH. Empty arrays free a mesh no longer used.")
+      .def("set_instance_transform", &PyScene::set_instance_transform, py::arg("instance"), py::arg("transform"),
+           "Moves instance `instance` ((4, 4) row-major affine world matrix); the next commit rebuilds only\n"
+           "the top level.")
+      .def("clear_instances", &PyScene::clear_instances,
+           "Removes every instance (meshes stay, with their BVHs), to place them again.")
       .def("add_instance", &PyScene::add_instance, py::arg("mesh"), py::arg("transform"),
            "Places mesh `mesh` again with a (4, 4) row-major affine world matrix; returns the instance id.")
       .def("commit", &PyScene::commit, py::arg("builder") = "auto", py::arg("threads") = 0,

@@ -5,7 +5,12 @@
 
 #include <tbb/parallel_for.h>
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <condition_variable>
 #include <deque>
 #include <exception>
@@ -15,14 +20,57 @@
 
 namespace toyrt {
 
+namespace {
+std::string format_bytes(size_t bytes) {
+  char buf[32];
+  const double b = double(bytes);
+  if (b >= 1e12) std::snprintf(buf, sizeof buf, "%.1f TB", b / 1e12);
+  else if (b >= 1e9) std::snprintf(buf, sizeof buf, "%.1f GB", b / 1e9);
+  else std::snprintf(buf, sizeof buf, "%.1f MB", b / 1e6);
+  return buf;
+}
+}  // namespace
+
+size_t render_memory_estimate(const Camera& camera, const RenderSettings& settings) {
+  // Sizes in double: a window of 1e6 x 1e6 pixels must not wrap around before it is refused.
+  const double w = std::max(0, camera.window.width()), h = std::max(0, camera.window.height());
+  const double pixels = w * h;
+  const double tile = std::max(1, settings.tile_size);
+  const double tiles = std::ceil(w / tile) * std::ceil(h / tile);
+  const double threads = settings.threads > 0 ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
+  // Framebuffer and the caller's copy (RGBA float each); a Tile and a queue slot per tile; a
+  // worker's stack and TBB's bookkeeping (1 MB is generous: the integrator keeps its state on the stack).
+  const double bytes = pixels * 4 * sizeof(float) * 2 + tiles * (sizeof(Tile) + sizeof(size_t)) + threads * 1e6;
+  return bytes >= 1.8e19 ? SIZE_MAX : size_t(bytes);
+}
+
+size_t available_memory_bytes() {
+  if (std::FILE* f = std::fopen("/proc/meminfo", "r")) {
+    char line[256];
+    unsigned long long kb = 0;
+    bool found = false;
+    while (!found && std::fgets(line, sizeof line, f)) found = std::sscanf(line, "MemAvailable: %llu kB", &kb) == 1;
+    std::fclose(f);
+    if (found) return size_t(kb) * 1024;
+  }
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page > 0 ? size_t(pages) * size_t(page) : SIZE_MAX;
+}
+
 RenderResult render(const RenderScene& scene, const Camera& camera, const RenderSettings& settings,
                     const TileSink& on_tile, const CancelPoll& should_cancel) {
   if (!scene.geometry || !scene.geometry->committed())
     throw std::logic_error("render: the scene changed since the last commit(): call commit() first");
   if (settings.samples < 1) throw std::invalid_argument("samples must be at least 1");
+  if (settings.first_sample < 0) throw std::invalid_argument("first_sample must be >= 0");
   if (settings.tile_size < 1) throw std::invalid_argument("tile_size must be at least 1");
   const auto start = std::chrono::steady_clock::now();
   const PixelWindow win = camera.window;
+  const size_t needed = render_memory_estimate(camera, settings), available = available_memory_bytes();
+  if (needed > available)
+    throw RenderTooLarge("render: a " + std::to_string(win.width()) + " x " + std::to_string(win.height()) +
+                         " image needs " + format_bytes(needed) + " but only " + format_bytes(available) +
+                         " of memory is available; lower the resolution or the resolution percentage");
   RenderResult result;
   result.width = win.width();
   result.height = win.height();
@@ -42,6 +90,7 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
 
   auto render_tile = [&](const Tile& t) {
     const float inv = 1.0f / float(settings.samples);
+    const int first = settings.first_sample, last = settings.first_sample + settings.samples;
     for (int j = t.y; j < t.y + t.height; ++j) {
       if (cancel.load(std::memory_order_relaxed)) return false;
       for (int i = t.x; i < t.x + t.width; ++i) {
@@ -50,7 +99,11 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
         const int px = win.x0 + i, py = win.y0 + j;
         const uint32_t pixel = uint32_t(py) * uint32_t(camera.width) + uint32_t(px);
         Vec3 sum(0.0f);
-        for (int s = 0; s < settings.samples; ++s) {
+        for (int s = first; s < last; ++s) {
+          // A relaxed load every few samples costs nothing next to a path, and bounds the cancel
+          // latency by a few samples whatever the sample count.
+          if ((s - first) % kCancelCheckSamples == kCancelCheckSamples - 1 && cancel.load(std::memory_order_relaxed))
+            return false;
           const Vec2 jitter = sobol_owen_2d(pixel, uint32_t(s), 0, settings.integrator.seed);
           sum += trace_path(scene, camera.generate(float(px) + jitter.x, float(py) + jitter.y), pixel, uint32_t(s),
                             settings.integrator);

@@ -8,12 +8,17 @@
 
 #include <atomic>
 #include <functional>
+#include <stdexcept>
 #include <vector>
 
 namespace toyrt {
 
 struct RenderSettings {
   int samples = 16;        // per pixel, on a Sobol-Owen pattern, box filter of one pixel
+  // The first sample index: a pass renders samples [first_sample, first_sample + samples) of the
+  // same sequence, so passes of n1 and n2 samples averaged with weights n1 and n2 equal one
+  // render of n1 + n2 samples (the viewport accumulates this way).
+  int first_sample = 0;
   int tile_size = 32;      // pixels
   int threads = 0;         // 0: all cores
   IntegratorSettings integrator;
@@ -33,10 +38,24 @@ struct RenderResult {
   double cancel_latency_ms = 0.0;  // from the cancel request to every worker stopped (when cancelled)
 };
 
+// A render refused before allocating: its image would not fit in memory (Python: MemoryError).
+struct RenderTooLarge : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Bytes a render of `camera`'s pixel window will allocate: its framebuffer, a copy for the
+// caller (the binding returns one), the tile list and a per-thread allowance.
+size_t render_memory_estimate(const Camera& camera, const RenderSettings& settings);
+// Memory the system can give now (Linux MemAvailable; the physical memory elsewhere), in bytes.
+size_t available_memory_bytes();
+
 // Called on the calling thread (never on a worker) for each finished tile, with the image so far:
 // the tile's pixels are final. `should_cancel` is polled on the calling thread every few
-// milliseconds; when it returns true, workers stop at their next pixel row and render() returns
-// with cancelled set. Either callback may be empty.
+// milliseconds; when it returns true, workers stop within a few samples (the flag is read every
+// kCancelCheckSamples samples inside a pixel, so even 100,000 samples per pixel stop at once)
+// and render() returns with cancelled set; the pixels they were on are left unfinished. Either callback may be empty.
+constexpr int kCancelCheckSamples = 8;
+
 using TileSink = std::function<void(const Tile&, const RenderResult&)>;
 using CancelPoll = std::function<bool()>;
 

@@ -57,6 +57,33 @@ uint32_t Scene::add_instance(uint32_t mesh, const Mat4& to_world) {
   return uint32_t(instances_.size() - 1);
 }
 
+void Scene::replace_mesh(uint32_t mesh, std::vector<Vec3> vertices, std::vector<Triangle> triangles) {
+  if (mesh >= meshes_.size())
+    throw std::invalid_argument("unknown mesh id " + std::to_string(mesh) + " (the scene has " +
+                                std::to_string(meshes_.size()) + " meshes)");
+  // Built before the swap, so a refused mesh leaves the old one in place.
+  auto replacement = std::make_unique<Mesh>(std::move(vertices), std::move(triangles));
+  meshes_[mesh] = std::move(replacement);
+  committed_ = false;
+}
+
+void Scene::set_instance_transform(uint32_t instance, const Mat4& to_world) {
+  if (instance >= instances_.size())
+    throw std::invalid_argument("unknown instance id " + std::to_string(instance) + " (the scene has " +
+                                std::to_string(instances_.size()) + " instances)");
+  const Mat4 to_object = checked_inverse(to_world);
+  Instance& inst = instances_[instance];
+  inst.to_world = to_world;
+  inst.to_object = to_object;
+  inst.identity = to_world == Mat4(1.0f);
+  committed_ = false;
+}
+
+void Scene::clear_instances() {
+  instances_.clear();  // keeps the capacity: a re-sync adds about as many again
+  committed_ = false;
+}
+
 void Scene::commit(const CommitOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   stats_ = {};

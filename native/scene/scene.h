@@ -72,6 +72,13 @@ class Scene {
   // id. Throws std::invalid_argument for an unknown mesh, a non-finite, non-affine (last row not
   // 0 0 0 1) or singular matrix.
   uint32_t add_instance(uint32_t mesh, const Mat4& to_world);
+  // Edits for interactive updates (the viewport), each leaving the scene uncommitted; ids stay
+  // valid. replace_mesh swaps a mesh's geometry (its BVH is rebuilt by the next commit, the
+  // instances placing it stay); set_instance_transform moves one instance (the next commit
+  // rebuilds only the top level); clear_instances removes every instance (meshes stay).
+  void replace_mesh(uint32_t mesh, std::vector<Vec3> vertices, std::vector<Triangle> triangles);
+  void set_instance_transform(uint32_t instance, const Mat4& to_world);
+  void clear_instances();
   // The transform checks of add_instance alone; returns the inverse.
   static Mat4 checked_inverse(const Mat4& to_world);
 
