@@ -6,6 +6,7 @@
 #   make demo         renders the seed's Cornell box with TOYRT -> out/demo_0001.png
 #   make bench-trace  ray-tracing benchmark against Embree -> docs/bench-trace.md
 #   make bench-lbvh   builders (LBVH, SAH, Embree) from 10K to 4M triangles -> docs/lbvh-bench.md, lbvh.png
+#   make bench-blender TOYRT against Cycles in Blender: time to Cycles' 64-spp error, peak memory -> docs/blender.md
 #   make clean        remove build/ (and its stamps);  make distclean: also .venv
 
 SHELL := /bin/bash
@@ -30,7 +31,7 @@ VENV_STAMP  := $(VENV)/.stamp-requirements
 
 BLENDER_TESTS := $(sort $(wildcard tests/blender/test_*.py))
 
-.PHONY: help setup apt venv configure native addon test test-native test-python test-blender \
+.PHONY: help setup apt venv configure native addon test test-native test-python test-blender test-bpy bench-blender \
 	demo bench-trace bench-lbvh clean distclean
 
 help:
@@ -72,7 +73,7 @@ addon: native
 
 # ---- tests ------------------------------------------------------------------------------------------
 test: setup
-	@$(MAKE) --no-print-directory test-native test-python test-blender
+	@$(MAKE) --no-print-directory test-native test-python test-blender test-bpy
 
 test-native:
 	ctest --test-dir $(BUILD) --output-on-failure --no-tests=error
@@ -86,9 +87,19 @@ test-blender:
 	@[ -n "$(BLENDER_TESTS)" ] || { echo "no tests/blender/test_*.py found" >&2; exit 1; }
 	@passed=0; for t in $(BLENDER_TESTS); do \
 		echo "blender: $$t"; \
-		$(BLENDER) -b --python-exit-code 1 --python $$t || { echo "FAILED: $$t" >&2; echo "blender: $$passed passed, 1 failed"; exit 1; }; \
+		TOYRT_BUILD_DIR=$(abspath $(BUILD)) $(BLENDER) -b --python-exit-code 1 --python $$t || { echo "FAILED: $$t" >&2; echo "blender: $$passed passed, 1 failed"; exit 1; }; \
 		passed=$$((passed + 1)); \
 	done; echo "blender: $$passed passed, 0 failed"
+
+# The same tests under a current Blender: the bpy module from PyPI (requirements-test.txt), one
+# process per file, the add-on and the module copied into a temporary user folder
+# (tests/blender/run_with_bpy.py). Command-line parts are skipped there (no blender executable).
+test-bpy:
+	@passed=0; for t in $(BLENDER_TESTS); do \
+		echo "bpy: $$t"; \
+		$(VENV)/bin/python tests/blender/run_with_bpy.py $$t --build $(BUILD) || { echo "FAILED (bpy): $$t" >&2; echo "bpy: $$passed passed, 1 failed"; exit 1; }; \
+		passed=$$((passed + 1)); \
+	done; echo "bpy: $$passed passed, 0 failed"
 
 # ---- the rest ---------------------------------------------------------------------------------------
 demo: setup

@@ -45,7 +45,8 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             return
 
         # The native renderer fills the camera's pixel window (the border, if any) with rows from
-        # the top; Blender's result is full size with rows from the bottom.
+        # the top; Blender's result covers that window only (the border: Blender places it in the
+        # full image itself when not cropping), with rows from the bottom.
         tiles_done = [0]
         tile = 32
         tiles_total = max(1, -(-width // tile) * -(-height // tile))
@@ -53,9 +54,9 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         frame = scene.frame_current
 
         def on_tile(x, y, w, h, pixels):
-            bottom = window["height"] - (window["y0"] + y + h)
-            result = self.begin_result(window["x0"] + x, bottom, w, h)
-            result.layers[0].passes["Combined"].rect.foreach_set(np.ascontiguousarray(pixels[::-1]).reshape(-1, 4))
+            bottom = height - (y + h)
+            result = self.begin_result(x, bottom, w, h)
+            _set_rect(result.layers[0].passes["Combined"].rect, np.ascontiguousarray(pixels[::-1]))
             self.end_result(result)
             tiles_done[0] += 1
             self.update_progress(tiles_done[0] / tiles_total)
@@ -84,6 +85,22 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
     def _threads(scene):
         # Blender's own render-threads setting: 0 (auto) means all cores.
         return 0 if scene.render.threads_mode == "AUTO" else scene.render.threads
+
+
+_RECT_FLAT = [None]  # does this Blender's pass.rect.foreach_set take a flat buffer? (found on first use)
+
+
+def _set_rect(rect, pixels):
+    """One foreach_set of an (h, w, 4) tile: Blender 3.x wants it as (N, 4), 5.0 as a flat
+    buffer of N * 4 floats (each refuses the other's shape); tried once, then remembered."""
+    if _RECT_FLAT[0] is None:
+        try:
+            rect.foreach_set(pixels.reshape(-1, 4))
+            _RECT_FLAT[0] = False
+            return
+        except (TypeError, RuntimeError, ValueError):
+            _RECT_FLAT[0] = True
+    rect.foreach_set(pixels.ravel() if _RECT_FLAT[0] else pixels.reshape(-1, 4))
 
 
 def register():

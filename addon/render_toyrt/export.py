@@ -270,8 +270,13 @@ class _Materials:
 # meshes
 
 def _mesh_arrays(mesh):
-    """Vertices (N,3) f32, triangles (M,3) u32, corner normals (M,3,3) f32, corner UVs (M,3,2) f32
-    or None, material indices (M,) i32, from an evaluated mesh, through foreach_get."""
+    """Vertices (N,3) f32, triangles (M,3) u32, normals, corner UVs (M,3,2) f32 or None, material
+    indices (M,) i32, from an evaluated mesh, through foreach_get.
+
+    Normals come in the cheapest form that says the same thing (see _mesh_normals): None when
+    every face is flat (the core then uses each triangle's own normal, as Cycles does for flat
+    faces), (N,3) per vertex when every face is smooth without custom or auto-smooth normals,
+    (M,3,3) per corner otherwise. Measured on a 1M-triangle mesh, see docs/blender.md."""
     mesh.calc_loop_triangles()
     nv = len(mesh.vertices)
     nt = len(mesh.loop_triangles)
@@ -281,48 +286,49 @@ def _mesh_arrays(mesh):
     # storage (4x faster than int32 here: 0.03 s against 0.14 s per million triangles).
     tris = np.empty(nt * 3, np.uint32)
     mesh.loop_triangles.foreach_get("vertices", tris)
-    loops = np.empty(nt * 3, np.uint32)
-    mesh.loop_triangles.foreach_get("loops", loops)
+    verts, tris = verts.reshape(nv, 3), tris.reshape(nt, 3)
+    if nt == 0:
+        return verts, tris, None, None, np.zeros(0, np.int32)
 
-    # Per-corner normals: split normals already equal the face normal on flat faces, the
-    # (auto-smoothed / custom) vertex normals on smooth ones.
-    normals = None
-    if nt and hasattr(mesh, "corner_normals"):                     # 4.1+
-        cn = np.empty(len(mesh.loops) * 3, np.float32)
-        mesh.corner_normals.foreach_get("vector", cn)
-        normals = cn.reshape(-1, 3)[loops]
-    elif nt:
-        if hasattr(mesh, "calc_normals_split"):                     # 3.x, 4.0: compute first
-            mesh.calc_normals_split()
-        normals = np.empty(nt * 9, np.float32)
-        mesh.loop_triangles.foreach_get("split_normals", normals)
-    if normals is not None:
-        normals = normals.reshape(nt, 3, 3)
-        if not np.isfinite(normals).all():
-            normals = None
+    loops = None  # triangle corners -> mesh loops, read only when something per corner needs it
+
+    def corner_loops():
+        nonlocal loops
+        if loops is None:
+            loops = np.empty(nt * 3, np.uint32)
+            mesh.loop_triangles.foreach_get("loops", loops)
+        return loops
+
+    normals = _mesh_normals(mesh, nt, corner_loops)
 
     uvs = None
     layers = mesh.uv_layers
-    if nt and len(layers):
+    if len(layers):
         # Cycles' Image Texture without a Vector link reads the render-active UV map.
         layer = next((l for l in layers if getattr(l, "active_render", False)), None) or layers.active
         if layer is not None and len(layer.data) == len(mesh.loops):
             uv = np.empty(len(mesh.loops) * 2, np.float32)
             layer.data.foreach_get("uv", uv)
-            uvs = uv.reshape(-1, 2)[loops].reshape(nt, 3, 2)
+            # np.take, not uv[...] fancy indexing: 3x faster on a million triangles.
+            uvs = np.take(uv.reshape(-1, 2), corner_loops(), axis=0).reshape(nt, 3, 2)
 
-    mat_idx = np.zeros(nt, np.uint32)
-    if nt:
+    if len(getattr(mesh, "materials", ())) <= 1:
+        # One slot or none: every index maps to slot 0 (the caller clips), no need to read them.
+        mat_idx = np.zeros(nt, np.int32)
+    else:
+        mat_idx = np.empty(nt, np.uint32)
         try:
             mesh.loop_triangles.foreach_get("material_index", mat_idx)
         except (AttributeError, TypeError, RuntimeError):
             # Newer versions: from the polygons' material_index through the triangles' polygons.
-            poly = np.empty(nt, np.uint32)
-            mesh.loop_triangles.foreach_get("polygon_index", poly)
             pm = np.zeros(len(mesh.polygons), np.int32)
             mesh.polygons.foreach_get("material_index", pm)
-            mat_idx = pm[poly]
-    return verts.reshape(nv, 3), tris.reshape(nt, 3), normals, uvs, mat_idx.astype(np.int64)
+            mat_idx = pm[_triangle_polygons(mesh, nt)]
+        mat_idx = mat_idx.view(np.int32) if mat_idx.dtype == np.uint32 else mat_idx
+
+    if not np.isfinite(verts).all():
+        verts, tris, normals, uvs, mat_idx = _drop_nonfinite(verts, tris, normals, uvs, mat_idx)
+    return verts, tris, normals, uvs, mat_idx
 
 
 def _mesh_key(obj):
@@ -361,8 +367,8 @@ def _object_materials(obj, mesh, materials):
 
 def _export_light(scene, obj, matrix, approx):
     light = obj.data
-    color = _rgb(light.color)
-    power = float(light.energy)
+    color = _light_color(light)             # Blender 4.x: colour temperature (helper at the end)
+    power = _light_power(light, matrix)     # Blender 4.x: exposure, area-light units, normalize
     if getattr(light, "use_nodes", False):
         what = f"light '{obj.name}': node setup (its colour and power)"
         if what not in approx:
@@ -521,3 +527,115 @@ def _add_mesh(scene, obj, matrix, materials, depsgraph):
         return (mid, len(tris))
     finally:
         obj.to_mesh_clear()
+
+
+# ---------------------------------------------------------------------------------------------
+# mesh helpers (for _mesh_arrays)
+
+def _triangle_polygons(mesh, nt):
+    """(M,) polygon index of each loop triangle (4.1+ keeps them in loop_triangle_polygons)."""
+    poly = np.empty(nt, np.uint32)
+    if hasattr(mesh, "loop_triangle_polygons"):
+        mesh.loop_triangle_polygons.foreach_get("value", poly.view(np.int32))
+    else:
+        mesh.loop_triangles.foreach_get("polygon_index", poly)
+    return poly
+
+
+def _mesh_normals(mesh, nt, corner_loops):
+    """The shading normals of a mesh: None (all faces flat), (N,3) per vertex (all smooth, no
+    custom or auto-smooth normals) or (M,3,3) per corner; None also if Blender's are not finite.
+
+    Blender 4.1+ says which with normals_domain (FACE, POINT, CORNER). Before, flat/smooth is
+    per polygon (use_smooth), and custom normals or auto smooth make them per corner."""
+    domain = getattr(mesh, "normals_domain", None)                 # 4.1+
+    if domain is None:
+        custom = bool(getattr(mesh, "has_custom_normals", False))
+        auto = bool(getattr(mesh, "use_auto_smooth", False))
+        smooth = np.empty(len(mesh.polygons), bool)
+        mesh.polygons.foreach_get("use_smooth", smooth)
+        if not smooth.any() and not custom:
+            domain = "FACE"       # auto smooth only ever smooths faces marked smooth
+        elif smooth.all() and not custom and not auto:
+            domain = "POINT"
+        else:
+            domain = "CORNER"
+    if domain == "FACE":
+        return None
+    if domain == "POINT":
+        normals = np.empty(len(mesh.vertices) * 3, np.float32)
+        if hasattr(mesh, "vertex_normals"):                        # 3.5+
+            mesh.vertex_normals.foreach_get("vector", normals)
+        else:
+            mesh.vertices.foreach_get("normal", normals)
+        normals = normals.reshape(-1, 3)
+    elif hasattr(mesh, "corner_normals"):                           # 4.1+
+        cn = np.empty(len(mesh.loops) * 3, np.float32)
+        mesh.corner_normals.foreach_get("vector", cn)
+        normals = np.take(cn.reshape(-1, 3), corner_loops(), axis=0).reshape(nt, 3, 3)
+    else:
+        if hasattr(mesh, "calc_normals_split"):                     # 3.x, 4.0: compute first
+            mesh.calc_normals_split()
+        normals = np.empty(nt * 9, np.float32)
+        mesh.loop_triangles.foreach_get("split_normals", normals)
+        normals = normals.reshape(nt, 3, 3)
+    return normals if np.isfinite(normals).all() else None
+
+
+def _drop_nonfinite(verts, tris, normals, uvs, mat_idx):
+    """Blender can hold NaN or infinite coordinates (a script, a driver, a modifier dividing by
+    zero), which the core refuses: drop the triangles that use such a vertex and park the vertex
+    at the origin (unused), so the rest of the mesh still renders."""
+    bad_vertex = ~np.isfinite(verts).all(axis=1)
+    keep = ~bad_vertex[tris].any(axis=1)
+    verts = np.where(bad_vertex[:, None], np.float32(0.0), verts)
+    tris = np.ascontiguousarray(tris[keep])
+    if normals is not None and normals.ndim == 3:
+        normals = np.ascontiguousarray(normals[keep])
+    elif normals is not None:
+        normals = np.where(bad_vertex[:, None], np.float32(0.0), normals)
+    if uvs is not None:
+        uvs = np.ascontiguousarray(uvs[keep])
+    return verts, tris, normals, uvs, np.ascontiguousarray(mat_idx[keep])
+
+
+# ---------------------------------------------------------------------------------------------
+# light units across Blender versions (for _export_light)
+
+def _blender_version():
+    try:
+        import bpy
+        return tuple(bpy.app.version)
+    except ImportError:      # outside Blender (the exporter's arrays are also used by scripts)
+        return (3, 4, 0)
+
+
+def _light_color(light):
+    """The light's colour, times its blackbody colour when "use temperature" is on (4.5+)."""
+    color = _rgb(light.color)
+    if getattr(light, "use_temperature", False):
+        color = tuple(a * b for a, b in zip(color, _rgb(light.temperature_color)))
+    return color
+
+
+def _light_power(light, matrix):
+    """The power to give the core, whose area light has Blender 3.x's radiance P / (4 area)
+    (docs/render.md).
+
+    Measured against Cycles on the same scene (bpy 4.2.0, 4.5.4 and 5.0.1 against Debian's
+    3.4.1): from 4.x on, Cycles' area lights of every shape are 4 / pi brighter at the same power,
+    i.e. radiance P / (pi area), a Lambertian emitter of exitance P / area; so 4.x's watts become
+    4 / pi times as many in 3.x's units. 4.x also scales every light by 2^exposure, and an area
+    light with "normalize" off is not divided by its area (its power is per square metre)."""
+    power = float(light.energy) * 2.0 ** float(getattr(light, "exposure", 0.0))
+    if light.type == "AREA":
+        if _blender_version() >= (4, 0, 0):
+            power *= 4.0 / np.pi
+        if not getattr(light, "normalize", True):
+            sx = float(np.linalg.norm(matrix[:3, 0]))
+            sy = float(np.linalg.norm(matrix[:3, 1]))
+            w = float(light.size)
+            h = float(light.size_y) if light.shape in ("RECTANGLE", "ELLIPSE") else w
+            area = w * h * (np.pi / 4.0 if light.shape in ("DISK", "ELLIPSE") else 1.0)
+            power *= area * sx * sy
+    return power

@@ -29,8 +29,12 @@ import numpy as np
 from mathutils import Vector
 
 REPO = Path(__file__).resolve().parents[2]
-CACHE = REPO / "build" / "parity-cache"
-DOC = REPO / "docs" / "parity.md"
+# The build folder of this run (`make test-blender BUILD=...` and run_with_bpy.py set it).
+CACHE = Path(os.environ.get("TOYRT_BUILD_DIR", REPO / "build")) / "parity-cache"
+# Debian's Blender 3.4 writes docs/parity.md; a current Blender through the bpy module
+# (tests/blender/run_with_bpy.py) writes its own report beside it.
+DOC = REPO / "docs" / ("parity.md" if bpy.app.version < (4, 0, 0) else
+                       f"parity-blender-{bpy.app.version[0]}.{bpy.app.version[1]}.md")
 
 WIDTH, HEIGHT = 80, 60
 CYCLES_SAMPLES = int(os.environ.get("TOYRT_PARITY_CYCLES_SAMPLES", "1024"))
@@ -91,7 +95,9 @@ def glass_material(name, ior):
     nodes.clear()
     out = nodes.new("ShaderNodeOutputMaterial")
     bsdf = nodes.new("ShaderNodeBsdfGlass")
-    bsdf.distribution = "SHARP"
+    if "SHARP" in bsdf.bl_rna.properties["distribution"].enum_items.keys():
+        bsdf.distribution = "SHARP"      # 3.x; 4.0 removed it: GGX at roughness 0 is sharp there
+    bsdf.inputs["Roughness"].default_value = 0.0
     bsdf.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
     bsdf.inputs["IOR"].default_value = ior
     mat.node_tree.links.new(bsdf.outputs[0], out.inputs["Surface"])

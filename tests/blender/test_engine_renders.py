@@ -70,7 +70,8 @@ def expected_image(n=32, size=2.0, power=100.0, height=1.0, sub=8):
 
 
 def main():
-    engines = {cls.bl_idname for cls in bpy.types.RenderEngine.__subclasses__()}
+    # getattr: 4.x registers abstract engine bases (HydraRenderEngine) without a bl_idname.
+    engines = {getattr(cls, "bl_idname", None) for cls in bpy.types.RenderEngine.__subclasses__()}
     check("TOYRT" in engines, "the TOYRT engine is registered")
     s = build_scene()
     check(hasattr(s, "toyrt") and s.toyrt.samples == 16, "settings live at scene.toyrt")
@@ -83,7 +84,11 @@ def main():
     err = np.abs(px[..., 0] - expected_image()).max() / expected_image().max()
     check(err < 0.01, f"F12 render matches I cos / r^2 in Blender's units (max error {err:.4f} of the peak)")
 
-    # The command line a farm runs, on a saved file.
+    # The command line a farm runs, on a saved file. The bpy module from PyPI has no blender
+    # executable (tests/blender/run_with_bpy.py sets TOYRT_NO_BLENDER_BINARY).
+    if os.environ.get("TOYRT_NO_BLENDER_BINARY") or not bpy.app.binary_path:
+        print("  skipped: the command-line checks (bpy module: no blender executable of this version)", flush=True)
+        return
     blend = os.path.join(tempfile.mkdtemp(), "scene.blend")
     bpy.ops.wm.save_as_mainfile(filepath=blend)
     frame_out = os.path.join(os.path.dirname(blend), "frame_")
