@@ -7,6 +7,8 @@
 #   make bench-trace  ray-tracing benchmark against Embree -> docs/bench-trace.md
 #   make bench-lbvh   builders (LBVH, SAH, Embree) from 10K to 4M triangles -> docs/lbvh-bench.md, lbvh.png
 #   make bench-blender TOYRT against Cycles in Blender: time to Cycles' 64-spp error, peak memory -> docs/blender.md
+#   make fuzz         libFuzzer over scene building and ray queries (FUZZ_SECONDS=60) -> docs/robustness.md
+#   make sanitize     C++ and Python tests on an AddressSanitizer + UBSan build (build-asan/)
 #   make clean        remove build/ (and its stamps);  make distclean: also .venv
 
 SHELL := /bin/bash
@@ -24,7 +26,7 @@ CMAKE_ARGS ?=
 
 APT_PACKAGES := cmake g++ make libglm-dev pybind11-dev python3-dev python3-numpy python3-venv \
 	libembree-dev libtbb-dev libgtest-dev googletest ocl-icd-opencl-dev opencl-headers \
-	pocl-opencl-icd clinfo blender python3-matplotlib
+	pocl-opencl-icd clinfo blender python3-matplotlib clang libclang-rt-14-dev
 # The stamp's name carries a hash of the list, so adding a package re-runs the check.
 APT_STAMP   := $(BUILD)/.stamp-apt-$(firstword $(shell printf '%s' '$(APT_PACKAGES)' | md5sum))
 VENV_STAMP  := $(VENV)/.stamp-requirements
@@ -32,10 +34,10 @@ VENV_STAMP  := $(VENV)/.stamp-requirements
 BLENDER_TESTS := $(sort $(wildcard tests/blender/test_*.py))
 
 .PHONY: help setup apt venv configure native addon test test-native test-python test-blender test-bpy bench-blender \
-	demo bench-trace bench-lbvh clean distclean
+	demo bench-trace bench-lbvh clean distclean fuzz sanitize
 
 help:
-	@sed -n '2,10p' Makefile | sed 's/^# \{0,1\}//'
+	@sed -n '2,12p' Makefile | sed 's/^# \{0,1\}//'
 
 # ---- setup ------------------------------------------------------------------------------------------
 setup: apt venv native addon
@@ -117,6 +119,37 @@ bench-trace: native
 bench-lbvh: native
 	$(if $(filter /%,$(BUILD)),,./)$(BUILD)/bench/bench_lbvh --out docs/lbvh-bench.md --csv docs/lbvh.csv
 	$(SYS_PY) bench/plot_lbvh.py docs/lbvh.csv docs/lbvh.png
+
+# ---- robustness: fuzzing and sanitizers (docs/robustness.md) ----------------------------------------
+# Both use their own build directories: a clang build for libFuzzer, a sanitizer build of everything.
+FUZZ_BUILD   ?= build-fuzz
+FUZZ_SECONDS ?= 60
+SAN_BUILD    ?= build-asan
+SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+# UBSan stops at the first finding; Python's interpreter keeps memory until exit, so leak checks are
+# for the C++ tests only.
+SAN_ENV := UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
+	LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitize/lsan.supp:print_suppressions=0
+
+fuzz: apt
+	@[ -f $(FUZZ_BUILD)/CMakeCache.txt ] || CC=clang CXX=clang++ cmake -S tests/fuzz -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+		|| { rm -f $(FUZZ_BUILD)/CMakeCache.txt; exit 1; }
+	@env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL cmake --build $(FUZZ_BUILD) -j$(JOBS) --target scene_fuzzer
+	@mkdir -p $(FUZZ_BUILD)/corpus
+	@# New inputs go to the build's corpus; the seeds in tests/fuzz/corpus are only read.
+	TOYRT_OPENCL=off $(FUZZ_BUILD)/scene_fuzzer -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 \
+		-artifact_prefix=$(FUZZ_BUILD)/ $(FUZZ_BUILD)/corpus tests/fuzz/corpus
+
+sanitize: apt venv
+	@[ -f $(SAN_BUILD)/CMakeCache.txt ] || cmake -S . -B $(SAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+		-DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
+		-DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" $(CMAKE_ARGS) || { rm -f $(SAN_BUILD)/CMakeCache.txt; exit 1; }
+	@env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL cmake --build $(SAN_BUILD) -j$(JOBS)
+	$(SAN_ENV) ctest --test-dir $(SAN_BUILD) --output-on-failure --no-tests=error
+	@# The interpreter is not built with ASan: its runtime must be loaded first. --noconftest: the
+	@# conftest would put build/python (not the sanitized module) first on the path.
+	$(SAN_ENV) ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 LD_PRELOAD=$$(g++ -print-file-name=libasan.so) \
+		PYTHONPATH=$(SAN_BUILD)/python $(VENV)/bin/python -m pytest tests/python -q --noconftest -p no:cacheprovider
 
 clean:
 	rm -rf $(BUILD)

@@ -65,8 +65,11 @@ class Builder {
   }
 
   int bin_of(const Vec3& c, int axis, const BBox& centers, const Vec3& scale) const {
-    const int k = int((c[axis] - centers.lo[axis]) * scale[axis]);
-    return std::clamp(k, 0, cfg_.bins - 1);
+    // Clamped before the cast: centroids spanning more than FLT_MAX give inf * 0 = NaN here, and
+    // a denormal extent an infinite scale; converting either to int is undefined (found by the
+    // fuzzer, tests/fuzz). Such ranges all land in bin 0 and are split at the median.
+    const float k = (c[axis] - centers.lo[axis]) * scale[axis];
+    return k >= 1.0f ? int(std::min(k, float(cfg_.bins - 1))) : 0;
   }
 
   Vec3 bin_scale(const BBox& centers) const {

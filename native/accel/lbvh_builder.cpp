@@ -37,7 +37,9 @@ uint64_t spread_bits(uint64_t v, uint32_t bits) {
 uint64_t morton_code(const Vec3& c, const MortonFrame& f) {
   const float cells = float((1u << f.bits) - 1u);
   uint64_t q[3];
-  for (int a = 0; a < 3; ++a) q[a] = uint64_t(std::min(std::max((c[a] - f.lo[a]) * f.scale[a], 0.0f), cells));
+  // fmin/fmax as in the kernel: they drop the NaN of 0 * inf (a denormal extent gives an infinite
+  // scale), where std::min/max would pass it on to an undefined cast (found by tests/fuzz).
+  for (int a = 0; a < 3; ++a) q[a] = uint64_t(std::fmin(std::fmax((c[a] - f.lo[a]) * f.scale[a], 0.0f), cells));
   return (spread_bits(q[0], f.bits) << 2) | (spread_bits(q[1], f.bits) << 1) | spread_bits(q[2], f.bits);
 }
 

@@ -51,7 +51,8 @@ inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear
   const vfloat ox = splat(ray.org.x), oy = splat(ray.org.y), oz = splat(ray.org.z);
   const vfloat ix = splat(ray.inv_dir.x), iy = splat(ray.inv_dir.y), iz = splat(ray.inv_dir.z);
   const vfloat start = splat(tnear);
-  const vfloat widen = splat(1.0f + 2.0f * gamma(3));  // conservative far distance, as in intersect_box
+  // Conservative distances, as in intersect_box: exits moved out, negative entries moved back.
+  const vfloat widen = splat(1.0f + 2.0f * gamma(3)), shrink = splat(1.0f - 2.0f * gamma(3));
 
   struct Entry { uint32_t child, count; float tentry; };
   Entry stack[(kWidth - 1) * kMaxBvhDepth + 1];
@@ -64,16 +65,20 @@ inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear
       const vfloat tnx = (load(n.bounds[ray.near[0]]) - ox) * ix, tfx = (load(n.bounds[ray.far[0]]) - ox) * ix;
       const vfloat tny = (load(n.bounds[ray.near[1]]) - oy) * iy, tfy = (load(n.bounds[ray.far[1]]) - oy) * iy;
       const vfloat tnz = (load(n.bounds[ray.near[2]]) - oz) * iz, tfz = (load(n.bounds[ray.far[2]]) - oz) * iz;
-      const vfloat tmin = max_keep(max_keep(max_keep(start, tnx), tny), tnz);
-      vfloat tmax = min_keep(min_keep(min_keep(splat(kInfinity), tfx), tfy), tfz) * widen;
+      vfloat tmin = max_keep(max_keep(max_keep(start, tnx), tny), tnz);
+      tmin = tmin < 0.0f ? tmin * widen : tmin;
+      vfloat tmax = min_keep(min_keep(min_keep(splat(kInfinity), tfx), tfy), tfz);
+      tmax = tmax * (tmax < 0.0f ? shrink : widen);
       tmax = min_keep(tmax, splat(tfar));
       uint32_t mask = mask_of(tmin <= tmax);
       if (mask != 0 && AnyHit) {
         // Any hit ends the walk, so order matters little: no sort, visit the first child hit.
-        current = Entry{n.child[__builtin_ctz(mask)], n.count[__builtin_ctz(mask)], 0.0f};
+        // Entry tnear, never popped as "beyond tfar" (an entry of 0 was, for segments ending
+        // before 0: occluded() missed what intersect() found; found by tests/fuzz).
+        current = Entry{n.child[__builtin_ctz(mask)], n.count[__builtin_ctz(mask)], tnear};
         for (mask &= mask - 1; mask; mask &= mask - 1) {
           const int i = __builtin_ctz(mask);
-          stack[sp++] = Entry{n.child[i], n.count[i], 0.0f};
+          stack[sp++] = Entry{n.child[i], n.count[i], tnear};
           if (n.count[i] == 0) __builtin_prefetch(&bvh.nodes[n.child[i]]);
         }
         continue;

@@ -14,7 +14,8 @@ struct BBox {
   void extend(const Vec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
   void extend(const BBox& b) { lo = glm::min(lo, b.lo); hi = glm::max(hi, b.hi); }
   bool empty() const { return lo.x > hi.x || lo.y > hi.y || lo.z > hi.z; }
-  Vec3 center() const { return 0.5f * (lo + hi); }
+  // Halved before the sum, so boxes near +-FLT_MAX have a finite centre (halving is exact).
+  Vec3 center() const { return 0.5f * lo + 0.5f * hi; }
   Vec3 extent() const { return hi - lo; }
   // Half the surface area: SAH costs only ever compare areas, so the factor 2 is dropped.
   float half_area() const {
@@ -55,14 +56,19 @@ inline RayBoxData make_ray_box_data(const Vec3& org, const Vec3& dir) {
 // safe_max (near) or safe_min (far), which treats the ray as inside that slab, as it is.
 // Conservative: the far distance is scaled by 1 + 2 gamma(3) so that rounding never makes a box
 // miss a ray the watertight triangle test would hit inside it (Ize 2013, "Robust BVH Ray
-// Traversal"). Returns the entry distance, or +inf when the box is missed within [tnear, tfar].
+// Traversal"). Ize's bound assumes distances >= 0; rays may start at a negative tnear, so a
+// negative exit is scaled by 1 - 2 gamma(3) and a negative entry by 1 + 2 gamma(3): both move
+// outwards by at least the rounding error of either (the fuzzer found a box missed at t = -1).
+// With tnear >= 0 this is exactly Ize's test. Returns the entry distance, or +inf when the box is
+// missed within [tnear, tfar].
 inline float intersect_box(const RayBoxData& r, const float* bounds, float tnear, float tfar) {
   float tmin = tnear, tmax = kInfinity;
   for (int a = 0; a < 3; ++a) {
     tmin = safe_max(tmin, (bounds[r.near[a]] - r.org[a]) * r.inv_dir[a]);
     tmax = safe_min(tmax, (bounds[r.far[a]] - r.org[a]) * r.inv_dir[a]);
   }
-  tmax = std::min(tmax * (1.0f + 2.0f * gamma(3)), tfar);
+  if (tmin < 0.0f) tmin *= 1.0f + 2.0f * gamma(3);
+  tmax = std::min(tmax * (tmax < 0.0f ? 1.0f - 2.0f * gamma(3) : 1.0f + 2.0f * gamma(3)), tfar);
   return tmin <= tmax ? tmin : kInfinity;
 }
 

@@ -2,6 +2,7 @@
 
 #include "accel/wide_traverse.h"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -105,6 +106,7 @@ void Mesh::finish(Bvh bvh, const std::vector<uint32_t>& valid) {
 template <bool AnyHit>
 bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v,
                  int32_t& prim) const {
+  const float segment_end = tfar;
   const RayBoxData box_ray = make_ray_box_data(org, dir);
   const WatertightRay tri_ray = make_watertight_ray(org, dir);
   const TriangleBlock* blocks = blocks_.data();
@@ -129,6 +131,10 @@ bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, flo
     if (found) {
       const TriangleBlock& b = blocks[found_block];
       refine_hit(org, dir, b.vertex(found_lane, 0), b.vertex(found_lane, 1), b.vertex(found_lane, 2), tnear, tfar, u, v);
+      // The float test put the hit before the segment's end, but its double-precision distance
+      // can round onto it (t = tfar = 0 in the fuzzer's case): keep the promise t < tfar. A hit
+      // implies tnear < segment_end, so the result stays >= tnear.
+      if (!(tfar < segment_end)) tfar = std::nextafter(segment_end, -kInfinity);
       prim = int32_t(b.prim[found_lane]);
     }
   }
