@@ -1,0 +1,350 @@
+"""The bad-input catalogue of the native API (issue 7; table in docs/robustness.md): one test per
+case, each pinning its outcome. Invalid input is refused with a ValueError or TypeError naming the
+argument, and the scene is left as it was; input a batch API can answer (a zero direction, a NaN
+origin, an empty batch) gets an answer: those rays miss. Nothing crashes or hangs.
+tests/python/test_bad_input.py holds the older cases (shapes, dtypes, matrices, query arguments)."""
+import threading
+
+import numpy as np
+import pytest
+import toyrt
+
+# A unit right triangle in z = 0 and a ray straight down onto it at (0.25, 0.25).
+TRI_V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
+TRI_T = np.array([[0, 1, 2]], np.uint32)
+DOWN_ORG = np.array([[0.25, 0.25, 1.0]], np.float32)
+DOWN_DIR = np.array([[0.0, 0.0, -1.0]], np.float32)
+
+
+def committed(*meshes):
+    s = toyrt.Scene()
+    for v, t in meshes or [(TRI_V, TRI_T)]:
+        s.add_mesh(v, t)
+    s.commit()
+    return s
+
+
+def assert_misses(hits, blocked):
+    assert np.all(np.isinf(hits["t"])) and np.all(hits["prim"] == -1) and np.all(hits["instance"] == -1)
+    assert not np.any(blocked)
+
+
+def refused(call, error, words):
+    with pytest.raises(error) as info:
+        call()
+    assert words in str(info.value), str(info.value)
+
+
+# ---- meshes -----------------------------------------------------------------------------------------
+
+def test_nan_vertex_is_refused_naming_the_vertex():
+    s = committed()
+    v = TRI_V.copy()
+    v[2, 1] = np.nan
+    refused(lambda: s.add_mesh(v, TRI_T), ValueError, "vertex 2 is not finite")
+    assert s.mesh_count == 1 and s.committed
+
+
+def test_infinite_vertex_is_refused_naming_the_vertex():
+    s = committed()
+    v = TRI_V.copy()
+    v[1, 0] = -np.inf
+    refused(lambda: s.add_mesh(v, TRI_T), ValueError, "vertex 1 is not finite")
+
+
+def test_float64_vertex_beyond_float32_range_is_refused_as_infinite():
+    # Vertices are stored as float32: 1e39 would become inf, so it is refused, not silently kept.
+    v = TRI_V.astype(np.float64)
+    v[0, 0] = 1e39
+    with np.errstate(over="ignore"):  # numpy's cast warns; the module must refuse, which is the point
+        refused(lambda: toyrt.Scene().add_mesh(v, TRI_T), ValueError, "vertex 0 is not finite")
+
+
+def test_index_past_the_last_vertex_is_refused():
+    refused(lambda: toyrt.Scene().add_mesh(TRI_V, [[0, 1, 3]]), ValueError, "triangle 0 indexes a vertex out of range")
+
+
+def test_negative_index_is_refused():
+    refused(lambda: toyrt.Scene().add_mesh(TRI_V, np.array([[0, 1, 2], [0, -2, 1]])), ValueError,
+            "triangle 1 has a negative vertex index")
+
+
+def test_float_indices_are_refused_as_not_integers():
+    refused(lambda: toyrt.Scene().add_mesh(TRI_V, TRI_T.astype(np.float32)), TypeError, "triangles must be an integer array")
+
+
+def test_complex_vertices_are_refused_as_not_numbers():
+    refused(lambda: toyrt.Scene().add_mesh(TRI_V.astype(np.complex64), TRI_T), TypeError, "vertices must hold numbers")
+
+
+def test_none_inside_a_vertex_list_is_refused():
+    refused(lambda: toyrt.Scene().add_mesh([[0, 0, 0], [1, 0, None], [0, 1, 0]], TRI_T), TypeError, "vertices")
+
+
+def test_vertices_of_shape_n_by_4_are_refused_with_the_shape():
+    refused(lambda: toyrt.Scene().add_mesh(np.zeros((3, 4)), TRI_T), ValueError, "vertices must have shape (N, 3), got (3, 4)")
+
+
+def test_triangles_of_shape_m_by_4_are_refused_with_the_shape():
+    refused(lambda: toyrt.Scene().add_mesh(TRI_V, [[0, 1, 2, 0]]), ValueError, "triangles must have shape (M, 3), got (1, 4)")
+
+
+def test_lists_work_like_arrays():
+    from_lists = committed((TRI_V.tolist(), TRI_T.tolist()))
+    hits = from_lists.intersect(DOWN_ORG.tolist(), DOWN_DIR.tolist())
+    assert hits["t"][0] == 1.0 and hits["prim"][0] == 0
+
+
+def test_non_contiguous_and_fortran_arrays_give_the_answers_of_contiguous_ones():
+    rng = np.random.default_rng(7)
+    v = rng.uniform(-1, 1, (60, 3)).astype(np.float32)
+    t = rng.integers(0, 60, (80, 3)).astype(np.int64)
+    org = rng.uniform(-2, 2, (500, 3)).astype(np.float32)
+    dirs = rng.normal(size=(500, 3)).astype(np.float32)
+    wide = np.zeros((60, 6), np.float32)
+    wide[:, ::2] = v                            # every other column: a strided view
+    t_fortran = np.asfortranarray(t)            # column-major
+    org_strided = np.repeat(org, 2, axis=0)[::2]  # every other row
+    dirs_reversed = dirs[::-1].copy()[::-1]       # negative stride
+    a = committed((v, t)).intersect(org, dirs)
+    b = committed((wide[:, ::2], t_fortran)).intersect(org_strided, dirs_reversed)
+    assert not wide[:, ::2].flags.c_contiguous and not t_fortran.flags.c_contiguous
+    assert np.any(a["prim"] >= 0)  # the comparison is about real hits
+    for key in a:
+        np.testing.assert_array_equal(a[key], b[key])
+
+
+def test_mesh_without_triangles_is_accepted_and_never_hit():
+    s = committed((TRI_V, np.zeros((0, 3), np.uint32)), (np.zeros((0, 3), np.float32), np.zeros((0, 3), np.int32)))
+    assert s.mesh_count == 2 and s.triangle_count == 0
+    assert_misses(s.intersect(DOWN_ORG, DOWN_DIR), s.occluded(DOWN_ORG, DOWN_DIR))
+
+
+def test_empty_scene_commits_and_every_ray_misses():
+    s = toyrt.Scene()
+    s.commit()
+    assert_misses(s.intersect(DOWN_ORG, DOWN_DIR), s.occluded(DOWN_ORG, DOWN_DIR))
+
+
+def test_degenerate_triangles_keep_their_index_and_are_never_hit():
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [2, 0, 0], [3, 0, 0], [4, 0, 0]], np.float32)
+    # 0: two equal vertices (x 2..3); 1: three collinear ones (x 2..4); 2: the real one (stays prim 2).
+    t = np.array([[3, 3, 4], [3, 4, 5], [0, 1, 2]], np.uint32)
+    s = committed((v, t))
+    hits = s.intersect(np.array([[0.25, 0.25, 1], [2.5, 0, 1], [3.5, 0, 1]], np.float32), np.tile(DOWN_DIR, (3, 1)))
+    assert list(hits["prim"]) == [2, -1, -1]
+
+
+# ---- rays -------------------------------------------------------------------------------------------
+
+def test_zero_direction_misses():
+    s = committed()
+    assert_misses(s.intersect(DOWN_ORG, np.zeros((1, 3))), s.occluded(DOWN_ORG, np.zeros((1, 3))))
+
+
+def test_nan_or_infinite_origin_or_direction_misses_and_other_rays_still_hit():
+    s = committed()
+    org = np.repeat(DOWN_ORG, 4, axis=0)
+    dirs = np.repeat(DOWN_DIR, 4, axis=0)
+    org[0, 0] = np.nan
+    org[1, 2] = np.inf
+    dirs[2, 1] = np.nan
+    hits = s.intersect(org, dirs)
+    assert list(hits["prim"]) == [-1, -1, -1, 0]
+    assert list(s.occluded(org, dirs)) == [False, False, False, True]
+
+
+def test_tnear_greater_than_tfar_misses():
+    s = committed()
+    assert_misses(s.intersect(DOWN_ORG, DOWN_DIR, tnear=2.0, tfar=0.5),
+                  s.occluded(DOWN_ORG, DOWN_DIR, tnear=2.0, tfar=0.5))
+
+
+def test_nan_in_per_ray_tfar_misses_that_ray_only():
+    s = committed()
+    hits = s.intersect(np.repeat(DOWN_ORG, 2, axis=0), np.repeat(DOWN_DIR, 2, axis=0), tfar=np.array([np.nan, 5.0]))
+    assert list(hits["prim"]) == [-1, 0]
+
+
+def test_nan_scalar_tnear_is_refused():
+    refused(lambda: committed().intersect(DOWN_ORG, DOWN_DIR, tnear=float("nan")), ValueError, "tnear is NaN")
+
+
+def test_zero_rays_give_empty_results():
+    s = committed()
+    hits = s.intersect(np.zeros((0, 3)), np.zeros((0, 3)))
+    assert all(a.shape == (0,) for a in hits.values())
+    assert s.occluded(np.zeros((0, 3)), np.zeros((0, 3))).shape == (0,)
+
+
+def test_segments_before_the_origin_are_found_by_both_queries():
+    # Regression (fuzzer): with tfar < 0, occluded() skipped the subtrees intersect() found hits in.
+    rng = np.random.default_rng(3)
+    centres = rng.uniform(-20, 20, (300, 3)).astype(np.float32)
+    v = (centres[:, None, :] + np.float32([[0, 0, 0], [0.3, 0, 0], [0, 0.3, 0]])).reshape(-1, 3)
+    s = committed((v, np.arange(900, dtype=np.uint32).reshape(300, 3)))
+    org = centres + np.float32([0.05, 0.05, 30.0])
+    dirs = np.tile(np.float32([0, 0, 1]), (300, 1))  # pointing away: every hit is at t = -30
+    hits = s.intersect(org, dirs, tnear=-1e3, tfar=-1.0)
+    assert np.all(hits["prim"] >= 0)
+    np.testing.assert_allclose(hits["t"], -30.0, rtol=1e-5)
+    assert np.all(s.occluded(org, dirs, tnear=-1e3, tfar=-1.0))
+
+
+# ---- instances --------------------------------------------------------------------------------------
+
+def test_singular_instance_matrix_is_refused():
+    refused(lambda: committed().add_instance(0, np.diag([2.0, 2.0, 0.0, 1.0])), ValueError, "singular")
+
+
+def test_non_finite_instance_matrix_is_refused():
+    m = np.eye(4)
+    m[0, 3] = np.inf
+    refused(lambda: committed().add_instance(0, m), ValueError, "not finite")
+
+
+def test_projective_instance_matrix_is_refused():
+    m = np.eye(4)
+    m[3, 2] = 0.5
+    refused(lambda: committed().add_instance(0, m), ValueError, "affine")
+
+
+def test_unknown_mesh_id_is_refused_with_the_mesh_count():
+    s = committed()
+    refused(lambda: s.add_instance(1, np.eye(4)), ValueError, "unknown mesh id 1 (the scene has 1 meshes)")
+    assert s.instance_count == 1 and s.committed
+
+
+# ---- camera, lights, textures -----------------------------------------------------------------------
+
+def camera(**settings):
+    m = np.eye(4)
+    m[2, 3] = 5.0
+    cam = dict(type="ORTHO", ortho_scale=2.0, resolution_x=8, resolution_y=8, matrix_world=m)
+    cam.update(settings)
+    return cam
+
+
+def test_resolution_zero_is_refused():
+    refused(lambda: toyrt.camera_window(camera(resolution_x=0)), ValueError, "resolution_x and resolution_y must be positive")
+    refused(lambda: committed().render(camera(resolution_y=0)), ValueError, "resolution")
+
+
+def test_resolution_percentage_that_rounds_to_zero_pixels_is_refused():
+    refused(lambda: toyrt.camera_window(camera(resolution_x=1, resolution_percentage=50)), ValueError, "render size")
+
+
+def test_render_larger_than_memory_is_refused_before_allocating():
+    # 1e6 x 1e6 RGBA float pixels: 16 TB for the framebuffer alone; refused by an estimate first.
+    with pytest.raises(MemoryError) as info:
+        committed().render(camera(resolution_x=1_000_000, resolution_y=1_000_000))
+    assert "1000000 x 1000000" in str(info.value)
+
+
+@pytest.mark.parametrize("power", [-1.0, float("nan"), float("inf")])
+def test_negative_or_non_finite_point_light_power_is_refused(power):
+    refused(lambda: toyrt.Scene().add_point_light((0, 0, 1), power), ValueError, "power must be finite and >= 0")
+
+
+@pytest.mark.parametrize("power", [-1.0, float("nan")])
+def test_negative_or_nan_area_light_power_is_refused(power):
+    refused(lambda: toyrt.Scene().add_area_light(np.eye(4), power=power), ValueError, "power must be finite and >= 0")
+
+
+@pytest.mark.parametrize("size, size_y", [(0.0, None), (1.0, 0.0), (-1.0, None), (float("nan"), None)])
+def test_zero_size_area_light_is_refused(size, size_y):
+    refused(lambda: toyrt.Scene().add_area_light(np.eye(4), shape="RECTANGLE", size=size, size_y=size_y), ValueError,
+            "size must be positive and finite")
+
+
+def test_zero_power_light_is_accepted_and_lights_nothing():
+    s = toyrt.Scene()
+    s.add_mesh(np.float32([[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]]), [[0, 1, 2], [0, 2, 3]])
+    s.add_point_light((0, 0, 1), 0.0)
+    s.background = (0, 0, 0)
+    s.commit()
+    assert np.all(s.render(camera(), samples=1)[..., :3] == 0.0)
+
+
+@pytest.mark.parametrize("shape", [(0, 4, 3), (4, 0, 4), (0, 0, 3)])
+def test_texture_of_size_zero_is_refused(shape):
+    refused(lambda: toyrt.Scene().add_texture(np.zeros(shape, np.float32)), ValueError, "width and height must be positive")
+
+
+@pytest.mark.parametrize("channels", [1, 2, 5])
+def test_texture_with_other_than_3_or_4_channels_is_refused(channels):
+    refused(lambda: toyrt.Scene().add_texture(np.zeros((2, 2, channels), np.float32)), ValueError, "3 or 4")
+
+
+def test_texture_of_16_bit_integers_is_refused_with_the_dtype():
+    refused(lambda: toyrt.Scene().add_texture(np.zeros((2, 2, 3), np.uint16)), TypeError, "uint16")
+
+
+def test_texture_with_nan_texels_is_refused():
+    px = np.zeros((2, 2, 4), np.float32)
+    px[1, 1, 2] = np.nan
+    refused(lambda: toyrt.Scene().add_texture(px), ValueError, "finite")
+
+
+# ---- several Python threads at once -----------------------------------------------------------------
+
+def test_eight_threads_querying_while_another_commits_get_single_threaded_answers():
+    rng = np.random.default_rng(11)
+    v = rng.uniform(-1, 1, (400, 3)).astype(np.float32)
+    t = rng.integers(0, 400, (600, 3)).astype(np.uint32)
+    org = rng.uniform(-2, 2, (2000, 3)).astype(np.float32)
+    dirs = rng.normal(size=(2000, 3)).astype(np.float32)
+    s = committed((v, t))
+    expected_hits, expected_blocked = s.intersect(org, dirs, threads=1), s.occluded(org, dirs, threads=1)
+    assert np.any(expected_hits["prim"] >= 0)
+
+    far = np.eye(4)
+    failures, answered, stop = [], [0] * 8, threading.Event()
+
+    def reader(k):
+        while not stop.is_set() or answered[k] == 0:
+            try:
+                hits, blocked = s.intersect(org, dirs), s.occluded(org, dirs)
+            except RuntimeError as e:  # between the writer's add_instance and its commit
+                if "commit" not in str(e):
+                    failures.append(repr(e))
+                continue
+            for key in hits:
+                if not np.array_equal(hits[key], expected_hits[key]):
+                    failures.append(f"{key} differs")
+            if not np.array_equal(blocked, expected_blocked):
+                failures.append("occluded differs")
+            answered[k] += 1
+
+    def writer():
+        for i in range(20):
+            far[0, 3] = 1000.0 + 10 * i  # new instances far from every ray: the answers stay the same
+            s.add_instance(0, far)
+            s.commit()
+        stop.set()
+
+    threads = [threading.Thread(target=reader, args=(k,)) for k in range(8)] + [threading.Thread(target=writer)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    assert not failures, failures[:5]
+    assert s.instance_count == 21 and all(n > 0 for n in answered)
+
+
+def test_eight_threads_adding_meshes_get_distinct_ids():
+    s = toyrt.Scene()
+    ids, lock = [], threading.Lock()
+
+    def add():
+        for _ in range(10):
+            i = s.add_mesh(TRI_V, TRI_T)
+            with lock:
+                ids.append(i)
+
+    threads = [threading.Thread(target=add) for _ in range(8)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    assert sorted(ids) == list(range(80)) and s.mesh_count == 80 and s.instance_count == 80
