@@ -205,6 +205,9 @@ void fuzz_scene(FuzzedDataProvider& in) {
     r.tfar = in.ConsumeBool() ? kInfinity : fuzz_float(in);
     const Hit h = scene.intersect(r);
     const bool blocked = scene.occluded(r);
+    // TOYRT_FUZZ_DUMP=1 prints every scene and ray: how a saved input becomes a readable test.
+    static const bool dump_all = std::getenv("TOYRT_FUZZ_DUMP") != nullptr;
+    if (dump_all) dump(scene, r, h);
     if (h.found() != blocked) dump(scene, r, h);
     FUZZ_CHECK(h.found() == blocked);
     if (h.found()) {

@@ -1,0 +1,129 @@
+// Regression tests for what the fuzzer (tests/fuzz) found, with its inputs written out (hex
+// floats are exact). The builder cases were undefined behaviour that happened to work on x86:
+// they fail under `make sanitize` (UBSan aborts) and otherwise check the trees stay valid.
+#include "accel/binned_sah_builder.h"
+#include "accel/lbvh_builder.h"
+#include "scene/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cfloat>
+#include <vector>
+
+using namespace toyrt;
+
+namespace {
+
+struct Boxes {
+  std::vector<BBox> boxes;
+  std::vector<Vec3> centers;
+  void add(const Vec3& a, const Vec3& b) {
+    BBox box;
+    box.extend(a);
+    box.extend(b);
+    boxes.push_back(box);
+    centers.push_back(box.center());
+  }
+};
+
+// A scene of one triangle placed `instances` times at the identity (2 or more: the top level runs).
+Scene one_triangle(const Vec3& p0, const Vec3& p1, const Vec3& p2, int instances) {
+  Scene s;
+  s.add_mesh({p0, p1, p2}, {Triangle(0, 1, 2)});
+  for (int i = 0; i < instances; ++i) s.add_instance(0, Mat4(1.0f));
+  s.commit();
+  return s;
+}
+
+}  // namespace
+
+TEST(BBox, CentreOfABoxAtFloatMaxIsFinite) {
+  BBox b;
+  b.extend(Vec3(FLT_MAX));
+  EXPECT_EQ(b.center(), Vec3(FLT_MAX));  // (lo + hi) / 2 overflowed to inf
+}
+
+TEST(BinnedSah, CentroidsSpanningMoreThanFloatMaxGiveAValidTree) {
+  Boxes p;
+  for (int i = 0; i < 20; ++i) p.add(Vec3(i % 2 ? FLT_MAX : -FLT_MAX, float(i), 0.0f), Vec3(i % 2 ? FLT_MAX : -FLT_MAX, float(i) + 1, 1.0f));
+  p.add(Vec3(0.0f), Vec3(1.0f));
+  const Bvh bvh = build_binned_sah(p.boxes.data(), p.centers.data(), p.boxes.size());
+  EXPECT_EQ(bvh.validate(p.boxes.data(), p.boxes.size()), "");
+}
+
+TEST(BinnedSah, DenormalCentroidExtentGivesAValidTree) {
+  Boxes p;
+  for (int i = 0; i < 20; ++i) p.add(Vec3(float(i % 3) * 1e-45f, 0.0f, 0.0f), Vec3(float(i % 3) * 1e-45f, 1.0f, 1.0f));
+  const Bvh bvh = build_binned_sah(p.boxes.data(), p.centers.data(), p.boxes.size());
+  EXPECT_EQ(bvh.validate(p.boxes.data(), p.boxes.size()), "");
+}
+
+TEST(LbvhReference, DenormalCentroidExtentGivesAValidTree) {
+  // cells / 1e-45 is an infinite scale, and 0 * inf a NaN Morton coordinate before the fix.
+  Boxes p;
+  for (int i = 0; i < 20; ++i) p.add(Vec3(float(i % 3) * 1e-45f, float(i), 0.0f), Vec3(float(i % 3) * 1e-45f, float(i), 1.0f));
+  for (MortonBits bits : {MortonBits::k30, MortonBits::k63}) {
+    const Bvh bvh = build_lbvh_reference(p.boxes.data(), p.centers.data(), p.boxes.size(), LbvhConfig{bits});
+    EXPECT_EQ(bvh.validate(p.boxes.data(), p.boxes.size()), "");
+  }
+}
+
+TEST(Scene, ABoxBehindTheOriginIsNotMissedByRounding) {
+  // The ray passes through the triangle's vertex at the origin, at t = -1, which is also a corner
+  // of the instance's box. Ize's widening (exit * (1 + 2 gamma)) narrows a negative exit: the top
+  // level missed the box, so intersect() found nothing while a brute-force test hits.
+  const float o = 0x1.555558p+0f;
+  Ray r;
+  r.org = Vec3(o);
+  r.dir = Vec3(o);
+  r.tnear = -4.0f;
+  r.tfar = 1.5f;
+  const Scene s = one_triangle(Vec3(0.0f), Vec3(-3.5f, -4.0f, 3.5f), Vec3(-1.0f, -0x1.1b6d48p+0f, 1.5f), 2);
+  const Hit h = s.intersect(r);
+  ASSERT_TRUE(h.found());
+  EXPECT_FLOAT_EQ(h.t, -1.0f);
+  EXPECT_TRUE(s.occluded(r));
+}
+
+TEST(Scene, OccludedSeesSegmentsThatEndBeforeTheOrigin) {
+  // Any-hit walks stacked subtrees with an entry distance of 0, then skipped them as "beyond
+  // tfar" when tfar < 0. A row of triangles behind the ray's origin, each hit by its own ray.
+  std::vector<Vec3> v;
+  std::vector<Triangle> t;
+  for (uint32_t i = 0; i < 64; ++i) {
+    const Vec3 c(float(i % 8) * 3.0f, float(i / 8) * 3.0f, -5.0f);
+    v.insert(v.end(), {c, c + Vec3(1, 0, 0), c + Vec3(0, 1, 0)});
+    t.emplace_back(3 * i, 3 * i + 1, 3 * i + 2);
+  }
+  Scene s;
+  s.add_instance(s.add_mesh(v, t), Mat4(1.0f));
+  s.commit();
+  for (uint32_t i = 0; i < 64; ++i) {
+    Ray r;
+    r.org = v[3 * i] + Vec3(0.25f, 0.25f, 5.0f);
+    r.dir = Vec3(0, 0, 1);  // away from the triangles: the hit is at t = -5
+    r.tnear = -10.0f;
+    r.tfar = -1.0f;
+    EXPECT_FLOAT_EQ(s.intersect(r).t, -5.0f) << i;
+    EXPECT_TRUE(s.occluded(r)) << i;
+  }
+}
+
+TEST(Scene, RefinedHitDistanceStaysBeforeTfar) {
+  // The float test accepted a hit just before tfar = 0; the double-precision refinement then
+  // rounded its distance to 0 = tfar, outside the half-open segment [tnear, tfar).
+  const float a = 0x1.16c2p-133f, b = 0x1.281a0ep-119f;
+  Ray r;
+  r.org = Vec3(-0x1.676766p-24f);
+  r.dir = Vec3(-0x1p-25f, 0x1.7d9dap+0f, -0x1.6767a8p-24f);
+  r.tnear = -0x1.a9a9a8p+42f;
+  r.tfar = 0.0f;
+  for (int instances = 1; instances <= 3; ++instances) {
+    const Scene s = one_triangle(Vec3(a, a, b), Vec3(-4.0f), Vec3(2.0f, -2.0f, 0x1p-126f), instances);
+    const Hit h = s.intersect(r);
+    ASSERT_TRUE(h.found()) << instances;
+    EXPECT_LT(h.t, r.tfar) << instances;
+    EXPECT_GE(h.t, r.tnear) << instances;
+    EXPECT_TRUE(s.occluded(r)) << instances;
+  }
+}
