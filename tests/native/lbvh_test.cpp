@@ -45,7 +45,9 @@ void expect_same_as_reference(const MeshData& m, MortonBits bits) {
   EXPECT_EQ(gpu.leaf_parent, cpu.leaf_parent);
   ASSERT_EQ(gpu.nodes.size(), cpu.nodes.size());
   // memcmp of empty vectors would pass null pointers (undefined, UBSan says): one triangle has no node.
-  if (!gpu.nodes.empty()) EXPECT_EQ(0, std::memcmp(gpu.nodes.data(), cpu.nodes.data(), gpu.nodes.size() * sizeof(LbvhNode)));
+  if (!gpu.nodes.empty()) {
+    EXPECT_EQ(0, std::memcmp(gpu.nodes.data(), cpu.nodes.data(), gpu.nodes.size() * sizeof(LbvhNode)));
+  }
   // And the flat Bvh written on the device equals the host conversion of the reference.
   const Bvh flat = build_lbvh(p.boxes.data(), p.centers.data(), p.boxes.size(), config);
   const Bvh ref = to_bvh(cpu, p.boxes.data());
