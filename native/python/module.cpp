@@ -103,7 +103,14 @@ struct PerRay {
 PerRay per_ray(py::handle obj, size_t count, const char* name) {
   PerRay out;
   if (py::isinstance<py::float_>(obj) || py::isinstance<py::int_>(obj)) {
-    out.scalar = obj.cast<float>();
+    // A Python int beyond a double's range cannot become a number: name the argument (pybind11's
+    // cast only says "Unable to cast Python instance").
+    const double value = PyFloat_AsDouble(obj.ptr());
+    if (value == -1.0 && PyErr_Occurred()) {
+      PyErr_Clear();
+      throw py::value_error(std::string(name) + " is too large to be a number");
+    }
+    out.scalar = float(value);
   } else {
     const py::array a = try_array(obj);
     if (!a || !is_numeric(a))

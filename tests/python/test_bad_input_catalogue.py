@@ -170,6 +170,20 @@ def test_nan_scalar_tnear_is_refused():
     refused(lambda: committed().intersect(DOWN_ORG, DOWN_DIR, tnear=float("nan")), ValueError, "tnear is NaN")
 
 
+def test_python_int_beyond_float_range_for_tfar_is_refused_naming_it():
+    refused(lambda: committed().intersect(DOWN_ORG, DOWN_DIR, tfar=10**400), ValueError, "tfar is too large")
+
+
+def test_float_beyond_float32_range_for_tfar_is_infinite():
+    assert committed().intersect(DOWN_ORG, DOWN_DIR, tfar=1e300)["t"][0] == 1.0
+
+
+def test_integer_arguments_beyond_64_bits_are_refused_with_the_signature():
+    # pybind11's TypeError lists the signature, argument names and types included.
+    refused(lambda: committed().intersect(DOWN_ORG, DOWN_DIR, threads=2**70), TypeError, "threads: int")
+    refused(lambda: committed().add_instance(2**70, np.eye(4)), TypeError, "mesh: int")
+
+
 def test_zero_rays_give_empty_results():
     s = committed()
     hits = s.intersect(np.zeros((0, 3)), np.zeros((0, 3)))
