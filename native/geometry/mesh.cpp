@@ -106,6 +106,11 @@ void Mesh::finish(Bvh bvh, const std::vector<uint32_t>& valid) {
 template <bool AnyHit>
 bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v,
                  int32_t& prim) const {
+  // A valid world ray can overflow in an instance's object space (a huge inverse scale): with a
+  // NaN in every inverse direction component, each slab test keeps its NaN-free bounds, so even
+  // the empty slots of a wide node "hit" and send the walk back to the root until its stack
+  // overflows (found by tests/fuzz). Such a ray cannot hit anything here.
+  if (!is_finite(org) || !is_finite(dir) || dir == Vec3(0.0f)) return false;
   const float segment_end = tfar;
   const RayBoxData box_ray = make_ray_box_data(org, dir);
   const WatertightRay tri_ray = make_watertight_ray(org, dir);

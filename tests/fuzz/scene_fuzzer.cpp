@@ -203,11 +203,12 @@ void fuzz_scene(FuzzedDataProvider& in) {
     r.dir = fuzz_vec3(in);
     r.tnear = in.ConsumeBool() ? 0.0f : fuzz_float(in);
     r.tfar = in.ConsumeBool() ? kInfinity : fuzz_float(in);
+    // TOYRT_FUZZ_DUMP=1 prints every scene and ray before tracing it: how a saved input becomes
+    // a readable test.
+    static const bool dump_all = std::getenv("TOYRT_FUZZ_DUMP") != nullptr;
+    if (dump_all) dump(scene, r, Hit{});
     const Hit h = scene.intersect(r);
     const bool blocked = scene.occluded(r);
-    // TOYRT_FUZZ_DUMP=1 prints every scene and ray: how a saved input becomes a readable test.
-    static const bool dump_all = std::getenv("TOYRT_FUZZ_DUMP") != nullptr;
-    if (dump_all) dump(scene, r, h);
     if (h.found() != blocked) dump(scene, r, h);
     FUZZ_CHECK(h.found() == blocked);
     if (h.found()) {

@@ -127,3 +127,33 @@ TEST(Scene, RefinedHitDistanceStaysBeforeTfar) {
     EXPECT_TRUE(s.occluded(r)) << instances;
   }
 }
+
+TEST(Scene, RayOverflowingInAnInstancesObjectSpaceMisses) {
+  // A finite world ray through an instance scaled by 1e-12: in object space its direction is
+  // inf - inf = NaN in every component. The wide walk then took empty child slots for hits and
+  // re-entered the root until its stack overflowed (a segfault from Python).
+  std::vector<Vec3> v;
+  std::vector<Triangle> t;
+  for (uint32_t i = 0; i < 20; ++i) {
+    const Vec3 c(float(i % 5), float(i / 5), 0.0f);
+    v.insert(v.end(), {c, c + Vec3(1, 0, 0), c + Vec3(0, 1, 0)});
+    t.emplace_back(3 * i, 3 * i + 1, 3 * i + 2);
+  }
+  // to_object = 1e12 * B with B's first two columns of one sign, so x - y cancels to NaN in each row.
+  const glm::mat3 b(1, 1, 1, 1, 1, 2, 0, 1, 1);  // columns
+  Mat4 to_world(glm::inverse(b) * 1e-12f);
+  Scene s;
+  const uint32_t mesh = s.add_mesh(v, t);
+  s.add_instance(mesh, to_world);
+  s.add_instance(mesh, Mat4(1.0f));
+  s.commit();
+  Ray r;
+  r.org = Vec3(0.0f, 0.0f, 5.0f);
+  r.dir = Vec3(FLT_MAX, -FLT_MAX, 0.0f);
+  EXPECT_FALSE(s.intersect(r).found());
+  EXPECT_FALSE(s.occluded(r));
+  // Through the same overflowing instance, an ordinary ray still finds the identity instance.
+  r.dir = Vec3(0.0f, 0.0f, -1.0f);
+  r.org = Vec3(0.25f, 0.25f, 5.0f);
+  EXPECT_EQ(s.intersect(r).instance, 1);
+}

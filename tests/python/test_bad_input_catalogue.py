@@ -3,6 +3,9 @@ case, each pinning its outcome. Invalid input is refused with a ValueError or Ty
 argument, and the scene is left as it was; input a batch API can answer (a zero direction, a NaN
 origin, an empty batch) gets an answer: those rays miss. Nothing crashes or hangs.
 tests/python/test_bad_input.py holds the older cases (shapes, dtypes, matrices, query arguments)."""
+import os
+import subprocess
+import sys
 import threading
 
 import numpy as np
@@ -227,6 +230,30 @@ def test_unknown_mesh_id_is_refused_with_the_mesh_count():
     s = committed()
     refused(lambda: s.add_instance(1, np.eye(4)), ValueError, "unknown mesh id 1 (the scene has 1 meshes)")
     assert s.instance_count == 1 and s.committed
+
+
+def test_ray_overflowing_in_an_instances_object_space_misses_without_crashing():
+    # Regression (fuzzer): a world direction of +-FLT_MAX through an instance scaled by 1e-12 is
+    # NaN in object space; the traversal overflowed its stack (a segfault). Run in a child process
+    # so that a regression fails this test instead of killing the test run.
+    script = '''
+import numpy as np, toyrt
+rng = np.random.default_rng(1)
+v = rng.uniform(-1, 1, (60, 3)).astype(np.float32)
+to_world = np.eye(4)
+to_world[:3, :3] = np.linalg.inv([[1, 1, 0], [1, 1, 1], [1, 2, 1]]) * 1e-12
+s = toyrt.Scene()
+s.add_mesh(v, np.arange(60).reshape(20, 3))
+s.add_instance(0, to_world)
+s.commit()
+big = np.finfo(np.float32).max
+hits = s.intersect([[0, 0, 0]], [[big, -big, 0]])
+print(int(hits["prim"][0]), bool(s.occluded([[0, 0, 0]], [[big, -big, 0]])[0]))
+'''
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split() == ["-1", "False"]
 
 
 # ---- camera, lights, textures -----------------------------------------------------------------------
