@@ -124,6 +124,8 @@ bench-lbvh: native
 # Both use their own build directories: a clang build for libFuzzer, a sanitizer build of everything.
 FUZZ_BUILD   ?= build-fuzz
 FUZZ_SECONDS ?= 60
+# A fixed seed makes `make test` repeatable; FUZZ_SEED=0 picks a new one each run.
+FUZZ_SEED    ?= 1
 SAN_BUILD    ?= build-asan
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 # UBSan stops at the first finding; Python's interpreter keeps memory until exit, so leak checks are
@@ -137,7 +139,7 @@ fuzz: apt
 	@env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL cmake --build $(FUZZ_BUILD) -j$(JOBS) --target scene_fuzzer
 	@mkdir -p $(FUZZ_BUILD)/corpus
 	@# New inputs go to the build's corpus; the seeds in tests/fuzz/corpus are only read.
-	TOYRT_OPENCL=off $(FUZZ_BUILD)/scene_fuzzer -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 \
+	TOYRT_OPENCL=off $(FUZZ_BUILD)/scene_fuzzer -max_total_time=$(FUZZ_SECONDS) -seed=$(FUZZ_SEED) -print_final_stats=1 \
 		-artifact_prefix=$(FUZZ_BUILD)/ $(FUZZ_BUILD)/corpus tests/fuzz/corpus
 
 sanitize: apt venv
