@@ -480,6 +480,14 @@ def export_scene(depsgraph, toyrt_module, *, report=None, camera_object=None):
         if not inst.is_instance and not inst.show_self:
             continue  # e.g. a particle emitter with "show emitter" off
         matrix = np.array(inst.matrix_world, np.float64)
+        if _singular(matrix):  # scaled to zero: the core cannot invert it (helpers at the end)
+            entry = _add_baked_mesh(scene, obj, matrix, materials, depsgraph)
+            if entry[0] >= 0:
+                meshes[("baked", n_instances)] = entry
+                tri_stored += entry[1]
+                n_instances += 1
+                tri_instanced += entry[1]
+            continue
         key = _mesh_key(obj)
         entry = meshes.get(key)
         if entry is None:
@@ -639,3 +647,46 @@ def _light_power(light, matrix):
             area = w * h * (np.pi / 4.0 if light.shape in ("DISK", "ELLIPSE") else 1.0)
             power *= area * sx * sy
     return power
+
+
+# ---------------------------------------------------------------------------------------------
+# instances the core cannot place (for export_scene)
+
+def _singular(matrix):
+    """True when the core would refuse an instance's matrix: not finite, or (nearly) no volume,
+    as an object scaled to zero along an axis has (a common way to hide an object in an
+    animation, or to flatten one). The margin is generous: such an object is baked (below),
+    which is always correct, only not shared."""
+    if not np.isfinite(matrix).all():
+        return True
+    return abs(float(np.linalg.det(matrix[:3, :3]))) < 1e-18
+
+
+def _add_baked_mesh(scene, obj, matrix, materials, depsgraph):
+    """An object whose matrix the core cannot invert, as its own mesh with the matrix applied
+    to its vertices here (scaled to zero: every triangle degenerates to a point or a line and is
+    never hit, as in Cycles; flattened: a flat copy). A matrix that is not finite (a driver
+    dividing by zero) shows nothing. Returns (mesh id or -1, triangle count)."""
+    if not np.isfinite(matrix).all():
+        return (-1, 0)
+    try:
+        mesh = obj.to_mesh(preserve_all_data_layers=False, depsgraph=depsgraph)
+    except TypeError:
+        mesh = obj.to_mesh()
+    except RuntimeError:
+        mesh = None
+    if mesh is None:
+        return (-1, 0)
+    try:
+        verts, tris, _normals, uvs, mat_idx = _mesh_arrays(mesh)
+        if len(tris) == 0:
+            return (-1, 0)
+        world = (verts.astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]).astype(np.float32)
+        slot_map = _object_materials(obj, mesh, materials)
+        mat_ids = slot_map[np.clip(mat_idx, 0, len(slot_map) - 1)]
+        # No shading normals: a singular matrix has no normal transform (the core uses each
+        # triangle's own normal).
+        mid = scene.add_mesh(world, tris, transform=None, normals=None, uvs=uvs, material_ids=mat_ids)
+        return (mid, len(tris))
+    finally:
+        obj.to_mesh_clear()
