@@ -9,7 +9,7 @@
 #   make bench-blender TOYRT against Cycles in Blender: time to Cycles' 64-spp error, peak memory -> docs/blender.md
 #   make fuzz         libFuzzer over scene building and ray queries (FUZZ_SECONDS=60) -> docs/robustness.md
 #   make sanitize     C++ and Python tests on an AddressSanitizer + UBSan build (build-asan/)
-#   make clean        remove build/ (and its stamps);  make distclean: also .venv
+#   make clean        remove build/ (and its stamps), build-fuzz/, build-asan/;  make distclean: also .venv
 
 SHELL := /bin/bash
 .SHELLFLAGS := -eu -o pipefail -c
@@ -121,12 +121,13 @@ bench-lbvh: native
 	$(SYS_PY) bench/plot_lbvh.py docs/lbvh.csv docs/lbvh.png
 
 # ---- robustness: fuzzing and sanitizers (docs/robustness.md) ----------------------------------------
-# Both use their own build directories: a clang build for libFuzzer, a sanitizer build of everything.
-FUZZ_BUILD   ?= build-fuzz
+# Both use their own build directories beside $(BUILD): a clang build for libFuzzer
+# (build-fuzz/ by default) and a sanitizer build of everything (build-asan/).
+FUZZ_BUILD   ?= $(BUILD)-fuzz
 FUZZ_SECONDS ?= 60
 # A fixed seed makes `make test` repeatable; FUZZ_SEED=0 picks a new one each run.
 FUZZ_SEED    ?= 1
-SAN_BUILD    ?= build-asan
+SAN_BUILD    ?= $(BUILD)-asan
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 # UBSan stops at the first finding; Python's interpreter keeps memory until exit, so leak checks are
 # for the C++ tests only.
@@ -148,13 +149,15 @@ sanitize: apt venv
 		-DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" $(CMAKE_ARGS) || { rm -f $(SAN_BUILD)/CMakeCache.txt; exit 1; }
 	@env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL cmake --build $(SAN_BUILD) -j$(JOBS)
 	$(SAN_ENV) ctest --test-dir $(SAN_BUILD) --output-on-failure --no-tests=error
-	@# The interpreter is not built with ASan: its runtime must be loaded first. --noconftest: the
-	@# conftest would put build/python (not the sanitized module) first on the path.
-	$(SAN_ENV) ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 LD_PRELOAD=$$(g++ -print-file-name=libasan.so) \
+	@# The interpreter is not built with ASan: its runtime must be loaded first, and libstdc++ with
+	@# it (else ASan cannot find __cxa_throw and aborts on the first C++ exception). --noconftest:
+	@# the conftest would put build/python (not the sanitized module) first on the path.
+	$(SAN_ENV) ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
+		LD_PRELOAD="$$(g++ -print-file-name=libasan.so) $$(g++ -print-file-name=libstdc++.so)" \
 		PYTHONPATH=$(SAN_BUILD)/python $(VENV)/bin/python -m pytest tests/python -q --noconftest -p no:cacheprovider
 
 clean:
-	rm -rf $(BUILD)
+	rm -rf $(BUILD) $(FUZZ_BUILD) $(SAN_BUILD)
 
 distclean: clean
 	rm -rf $(VENV)
