@@ -1,0 +1,165 @@
+# Mitsuba 3 as the renderer a user might pick instead: the scene that bench/blender_bench.py wrote
+# (PLY meshes, lights in Blender's units, camera) given to Mitsuba through its Python API, rendered
+# by its `direct` integrator on the CPU at a sweep of sample counts and compared with the same
+# Cycles reference as TOYRT. Runs in .venv (requirements-bench.txt):
+#     .venv/bin/python bench/mitsuba_bench.py SCENE_DIR REF.npy OUT.json --spp 1 4 16
+#
+# Units. Cycles' (measured in shared/BLENDER_UNITS.md, as TOYRT uses them): a point light of power
+# P and colour c has radiant intensity P c / (4 pi), which is Mitsuba's `point` `intensity`; an area
+# light has radiance P c / (4 area), Mitsuba's `area` `radiance`. Diffuse BSDFs are albedo / pi in
+# both. Blender's area lights emit along their local -Z; Mitsuba's rectangle along +Z, so the
+# rectangle is turned over.
+#
+# Time: wall-clock seconds from the scene description to an image, as for the others: mi.load_dict
+# (which builds Mitsuba's BVH) plus mi.render.
+import argparse
+import json
+import math
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def probe_variant():
+    """llvm_ad_rgb (vectorised, JIT-compiled) when its kernels compile here, else scalar_rgb. The
+    probe runs in a child process because a failing LLVM back end can abort the interpreter."""
+    code = ("import mitsuba as mi; mi.set_variant('llvm_ad_rgb'); "
+            "s = mi.load_dict(mi.cornell_box()); mi.render(s, spp=1); print('ok')")
+    try:
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+        if out.returncode == 0 and "ok" in out.stdout:
+            return "llvm_ad_rgb", ""
+        last = (out.stderr.strip().splitlines() or ["no output"])[-1]
+        return "scalar_rgb", f"llvm_ad_rgb failed here ({last[:160]})"
+    except subprocess.TimeoutExpired:
+        return "scalar_rgb", "llvm_ad_rgb timed out compiling its kernels"
+
+
+def blender_matrix(m):
+    return np.array(m, np.float64)
+
+
+def to_transform(mi, m):
+    return mi.ScalarTransform4f(np.asarray(m, np.float64).tolist())
+
+
+def build_dict(mi, scene_dir, desc):
+    d = {"type": "scene"}
+    bsdfs = {}
+
+    def bsdf_for(mat):
+        key = json.dumps(mat, sort_keys=True)
+        if key in bsdfs:
+            return {"type": "ref", "id": bsdfs[key]}
+        name = f"bsdf{len(bsdfs)}"
+        bsdfs[key] = name
+        if mat["type"] == "glass":
+            d[name] = {"type": "dielectric", "int_ior": float(mat["ior"]), "ext_ior": 1.0}
+        elif "texture" in mat:
+            rgb = np.load(scene_dir / mat["texture"])
+            bitmap = mi.Bitmap(rgb)
+            if mat.get("srgb", True):
+                bitmap.set_srgb_gamma(True)  # 8-bit sRGB-encoded: Mitsuba decodes to linear on load
+            d[name] = {"type": "diffuse", "reflectance": {"type": "bitmap", "bitmap": bitmap,
+                                                          "filter_type": "bilinear", "wrap_mode": "repeat"}}
+        else:
+            d[name] = {"type": "diffuse", "reflectance": {"type": "rgb", "value": [float(c) for c in mat["color"]]}}
+        return {"type": "ref", "id": name}
+
+    for s, shape in enumerate(desc["shapes"]):
+        instanced = len(shape["instances"]) > 1
+        for p, part in enumerate(shape["parts"]):
+            ply = {"type": "ply", "filename": str(scene_dir / part["ply"]), "bsdf": bsdf_for(part["material"])}
+            if not instanced:
+                ply["to_world"] = to_transform(mi, shape["instances"][0])
+                d[f"shape{s}_{p}"] = ply
+            else:
+                d[f"group{s}_{p}"] = {"type": "shapegroup", "mesh": ply}
+                for i, m in enumerate(shape["instances"]):
+                    d[f"inst{s}_{p}_{i}"] = {"type": "instance", "to_world": to_transform(mi, m),
+                                             "shapegroup": {"type": "ref", "id": f"group{s}_{p}"}}
+    for k, light in enumerate(desc["lights"]):
+        color = np.array(light["color"], np.float64) * light["power"]
+        m = blender_matrix(light["matrix"])
+        if light["type"] == "POINT":
+            d[f"light{k}"] = {"type": "point", "position": m[:3, 3].tolist(),
+                              "intensity": {"type": "rgb", "value": (color / (4 * math.pi)).tolist()}}
+        elif light["type"] == "AREA" and light["shape"] in ("RECTANGLE", "SQUARE"):
+            sx = light["size"]
+            sy = light["size_y"] if light["shape"] == "RECTANGLE" else sx
+            scale = np.linalg.norm(m[:3, :3], axis=0)
+            area = sx * scale[0] * sy * scale[1]
+            # Mitsuba's rectangle spans [-1, 1]^2 with normal +Z: scale to half sizes, turn over.
+            local = np.diag([sx / 2, -sy / 2, -1.0, 1.0])
+            d[f"light{k}"] = {"type": "rectangle", "to_world": to_transform(mi, m @ local),
+                              "emitter": {"type": "area", "radiance": {"type": "rgb",
+                                                                       "value": (color / (4 * area)).tolist()}}}
+        else:
+            raise ValueError(f"light {light['type']}/{light.get('shape')} is not converted for Mitsuba")
+    if desc["world"] is not None:
+        d["world"] = {"type": "constant", "radiance": {"type": "rgb", "value": desc["world"]}}
+    cam = desc["camera"]
+    m = blender_matrix(cam["matrix"])
+    origin, forward, up = m[:3, 3], -m[:3, 2], m[:3, 1]
+    w, h = desc["width"], desc["height"]
+    # Blender's AUTO sensor fit puts the sensor width across the larger image side.
+    fov = math.degrees(2 * math.atan(cam["sensor_width"] / (2 * cam["lens"])))
+    d["sensor"] = {"type": "perspective", "fov": fov, "fov_axis": "larger" if cam["sensor_fit"] == "AUTO" else "x",
+                   "near_clip": cam["clip_start"], "far_clip": cam["clip_end"],
+                   "to_world": mi.ScalarTransform4f().look_at(origin=origin.tolist(), target=(origin + forward).tolist(),
+                                                              up=up.tolist()),
+                   "film": {"type": "hdrfilm", "width": w, "height": h, "pixel_format": "rgb",
+                            "rfilter": {"type": "box"}},  # Cycles' and TOYRT's Box filter of one pixel
+                   "sampler": {"type": "independent", "sample_count": 1}}
+    # Blender can hide a light from camera rays; Mitsuba only hides all emitters seen directly,
+    # which is the same picture when nothing else (no world) is seen directly.
+    hidden = [not l.get("visible_camera", True) for l in desc["lights"] if l["type"] == "AREA"]
+    if any(hidden) and not all(hidden):
+        raise ValueError("some area lights are hidden from the camera and some not: Mitsuba cannot show that")
+    if any(hidden) and desc["world"] is not None:
+        raise ValueError("a hidden area light and a world colour: Mitsuba cannot hide one and show the other")
+    d["integrator"] = {"type": "direct", "hide_emitters": any(hidden)}
+    return d
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("scene_dir", type=Path)
+    ap.add_argument("reference", type=Path)
+    ap.add_argument("out", type=Path)
+    ap.add_argument("--spp", type=int, nargs="+", required=True)
+    ap.add_argument("--repeats", type=int, default=1)
+    ap.add_argument("--variant", default="")
+    args = ap.parse_args()
+
+    import mitsuba as mi
+    variant, note = (args.variant, "") if args.variant else probe_variant()
+    mi.set_variant(variant)
+    desc = json.loads((args.scene_dir / "scene.json").read_text())
+    ref = np.load(args.reference).astype(np.float64)
+    # The pixels blender_bench.py counted (lights seen directly and their edges left out).
+    mask = np.load(str(args.reference).replace(".ref.npy", ".mask.npy"))
+    runs = []
+    for spp in args.spp:
+        best = None
+        for _ in range(args.repeats):
+            t0 = time.perf_counter()
+            scene = mi.load_dict(build_dict(mi, args.scene_dir, desc))
+            img = np.array(mi.render(scene, spp=spp), np.float64)[..., :3]
+            seconds = time.perf_counter() - t0
+            best = (img, seconds) if best is None or seconds < best[1] else best
+        d, r = (best[0] - ref)[mask], ref[mask]
+        rmse, relmse = float(np.sqrt(np.mean(d * d))), float(np.mean(d * d / (r * r + 1e-2)))
+        runs.append(dict(renderer="mitsuba", method="Mitsuba 3 direct", spp=spp, seconds=best[1], rmse=rmse,
+                         relmse=relmse))
+        print(f"bench: mitsuba {args.scene_dir.name} {spp} spp {best[1]:.3f} s rmse {rmse:.4g}", flush=True)
+    np.save(args.out.with_suffix(".mitsuba.npy"), best[0].astype(np.float32))
+    args.out.write_text(json.dumps(dict(variant=variant, variant_note=note, version=mi.__version__, runs=runs),
+                                   indent=1))
+
+
+if __name__ == "__main__":
+    main()
