@@ -7,6 +7,7 @@
 #   make bench-trace  ray-tracing benchmark against Embree -> docs/bench-trace.md
 #   make bench-lbvh   builders (LBVH, SAH, Embree) from 10K to 4M triangles -> docs/lbvh-bench.md, lbvh.png
 #   make bench-blender TOYRT against Cycles in Blender: time to Cycles' 64-spp error, peak memory -> docs/blender.md
+#   make bench        speed against accuracy vs Cycles, Mitsuba 3, Embree, Open3D -> docs/results.md (BENCH_QUICK=1: smoke run)
 #   make fuzz         libFuzzer over scene building and ray queries (FUZZ_SECONDS=60) -> docs/robustness.md
 #   make sanitize     C++ and Python tests on an AddressSanitizer + UBSan build (build-asan/)
 #   make clean        remove build/ (and its stamps), build-fuzz/, build-asan/;  make distclean: also .venv
@@ -33,11 +34,11 @@ VENV_STAMP  := $(VENV)/.stamp-requirements
 
 BLENDER_TESTS := $(sort $(wildcard tests/blender/test_*.py))
 
-.PHONY: help setup apt venv configure native addon test test-native test-python test-blender test-bpy bench-blender \
+.PHONY: bench help setup apt venv configure native addon test test-native test-python test-blender test-bpy bench-blender \
 	demo bench-trace bench-lbvh clean distclean fuzz sanitize
 
 help:
-	@sed -n '2,12p' Makefile | sed 's/^# \{0,1\}//'
+	@sed -n '2,13p' Makefile | sed 's/^# \{0,1\}//'
 
 # ---- setup ------------------------------------------------------------------------------------------
 setup: apt venv native addon
@@ -119,6 +120,21 @@ bench-trace: native
 bench-lbvh: native
 	$(if $(filter /%,$(BUILD)),,./)$(BUILD)/bench/bench_lbvh --out docs/lbvh-bench.md --csv docs/lbvh.csv
 	$(SYS_PY) bench/plot_lbvh.py docs/lbvh.csv docs/lbvh.png
+
+# The speed/accuracy report (bench/run.py): scenes from scenes/bench/, Cycles references cached in
+# out/bench-cache/, work files in out/bench/ -> docs/results.md and docs/results/*.png. Mitsuba 3
+# and Open3D come from requirements-bench.txt, installed here only (not by setup: CI stays fast).
+BENCH_QUICK ?=
+BENCH_STAMP := $(VENV)/.stamp-bench-requirements
+$(BENCH_STAMP): requirements-bench.txt $(VENV_STAMP)
+	$(VENV)/bin/python -m pip install -q --no-deps -r requirements-bench.txt
+	@# Open3D may have no wheel for this machine: the report then says so; Mitsuba must import.
+	$(VENV)/bin/python -c "import sys; sys.path.insert(0, 'bench'); import mitsuba, accel_python; \
+		m, why = accel_python.import_open3d(); print('bench: mitsuba', mitsuba.__version__, '/ open3d', m.__version__ if m else why)"
+	@touch $@
+
+bench: addon $(BENCH_STAMP)
+	$(VENV)/bin/python bench/run.py --build $(BUILD) --blender $(BLENDER) $(if $(BENCH_QUICK),--quick)
 
 # ---- robustness: fuzzing and sanitizers (docs/robustness.md) ----------------------------------------
 # Both use their own build directories beside $(BUILD): a clang build for libFuzzer

@@ -235,7 +235,14 @@ def dump_for_mitsuba(export, out_dir):
             continue
         key = obj.original.data.name
         if key not in shapes:
-            verts, tris, normals, uvs, mat_idx = export._mesh_arrays(obj.data)
+            verts, tris, normals, uvs, mat_idx = export._mesh_arrays(obj.data)[:5]
+            if normals is None:  # flat shading (the exporter sends no corner normals then)
+                p = verts[tris]
+                n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+                n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
+                normals = np.repeat(n[:, None, :], 3, axis=1)
+            elif normals.ndim == 2:  # per vertex (all faces smooth): to corners
+                normals = normals[tris]
             parts = []
             for m in np.unique(mat_idx):
                 sel = mat_idx == m
