@@ -1,9 +1,11 @@
-"""The render engine: exports the depsgraph (export.py), forwards it to the native renderer, and
-streams finished tiles into Blender's render result. No rendering logic here."""
+"""The render engine: exports the depsgraph (export.py, kept between frames by scene_cache.py),
+forwards it to the native renderer, and streams finished tiles into Blender's render result; in
+the 3D viewport's Rendered mode, viewport.py renders progressively. No rendering logic here."""
 import time
 
 import bpy
 import numpy as np
+from bpy.app.handlers import persistent
 
 
 class TOYRTRenderEngine(bpy.types.RenderEngine):
@@ -15,6 +17,32 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
     def __init__(self, *args, **kwargs):
         # Blender 4.4 passes arguments to __init__ and requires super().__init__ to receive them.
         super().__init__(*args, **kwargs)
+        self._viewport = None  # viewport.ViewportSession while this engine draws a 3D view
+
+    def __del__(self):
+        # Blender frees the engine when the view leaves Rendered mode, the engine changes or the
+        # file closes: stop and join the render thread with it.
+        session = getattr(self, "_viewport", None)
+        if session is not None:
+            session.close()
+
+    # ---- 3D viewport (viewport.py) ----------------------------------------------------------------
+    def view_update(self, context, depsgraph):
+        from . import native, viewport
+
+        try:
+            if self._viewport is None:
+                self._viewport = viewport.ViewportSession(native(), self)
+            self._viewport.update(context, depsgraph)
+        except Exception as err:  # shown in the viewport's header, never raised into Blender's UI
+            self.report({"ERROR"}, f"TOYRT: {err}")
+            print(f"TOYRT: viewport update failed: {err!r}", flush=True)
+
+    def view_draw(self, context, depsgraph):
+        if self._viewport is not None:
+            self._viewport.draw(context, depsgraph)
+
+    # ---- F12 and command-line renders ---------------------------------------------------------------
 
     def render(self, depsgraph):
         from . import export, native
@@ -26,11 +54,20 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             print(f"TOYRT: render failed: {err}", flush=True)
 
     def _render(self, depsgraph, toyrt, export):
+        from . import scene_cache
+
         scene = depsgraph.scene
         settings = scene.toyrt
         started = time.perf_counter()
         self.update_stats("TOYRT", "Exporting scene")
-        t_scene, camera, stats = export.export_scene(depsgraph, toyrt, report=self.report)
+        camera = export.export_camera(depsgraph)  # fails early without a camera
+        # One cache per Blender scene: the frames of an animation reuse the meshes that did not
+        # change, and the native scene is edited in place, so memory stays flat.
+        cache = scene_cache.for_render(depsgraph, toyrt)
+        cache.sync(depsgraph)
+        t_scene, stats = cache.scene, cache.stats
+        if cache.approximated:
+            self.report({"WARNING"}, "TOYRT approximated: " + "; ".join(cache.approximated))
         if self.test_break():
             return
         window = toyrt.camera_window(camera)
@@ -38,9 +75,9 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         samples = settings.samples
         rays_per_sample = 2 + stats.get("lights", 0)  # camera ray, shadow rays, a specular step
         self.update_stats("TOYRT", "Building BVH")
-        t_scene.commit(builder=settings.builder, threads=self._threads(scene),
-                       expected_rays=float(width * height * samples * rays_per_sample))
-        build_ms = t_scene.last_commit["build_ms"]
+        built = cache.commit(builder=settings.builder, threads=self._threads(scene),
+                             expected_rays=float(width * height * samples * rays_per_sample))
+        build_ms = t_scene.last_commit["build_ms"] if built else 0.0
         if self.test_break():
             return
 
@@ -103,9 +140,33 @@ def _set_rect(rect, pixels):
     rect.foreach_set(pixels.ravel() if _RECT_FLAT[0] else pixels.reshape(-1, 4))
 
 
+@persistent
+def _on_load_pre(*_args):
+    """A file is about to close: stop every viewport render and drop the final-render cache."""
+    from . import scene_cache, viewport
+
+    viewport.close_all()
+    scene_cache.free_render_caches()
+
+
 def register():
+    import atexit
+
+    from . import viewport
+
     bpy.utils.register_class(TOYRTRenderEngine)
+    bpy.app.handlers.load_pre.append(_on_load_pre)
+    atexit.register(viewport.close_all)  # Blender quitting: no render thread may outlive it
 
 
 def unregister():
+    import atexit
+
+    from . import scene_cache, viewport
+
+    viewport.close_all()
+    scene_cache.free_render_caches()
+    atexit.unregister(viewport.close_all)
+    if _on_load_pre in bpy.app.handlers.load_pre:
+        bpy.app.handlers.load_pre.remove(_on_load_pre)
     bpy.utils.unregister_class(TOYRTRenderEngine)

@@ -79,8 +79,10 @@ class _Materials:
     def __init__(self, scene, approximated):
         self.scene = scene
         self.approx = approximated           # list of strings, shared with the exporter
-        self.by_material = {}                # material pointer (0: none) -> material id
-        self.by_image = {}                   # (image pointer, srgb) -> texture id
+        # Keyed by name, not pointer: a final render's depsgraph may hand out new copies of the same
+        # material every frame, and the incremental cache (scene_cache.py) must find them again.
+        self.by_material = {}                # material name ('': none) -> material id
+        self.by_image = {}                   # (image name, srgb) -> texture id
         self.textures = 0
 
     def note(self, what):
@@ -91,7 +93,7 @@ class _Materials:
         return self.material_id(None)
 
     def material_id(self, mat):
-        key = mat.as_pointer() if mat is not None else 0
+        key = mat.name_full if mat is not None else ""
         mid = self.by_material.get(key)
         if mid is None:
             mid = self._convert(mat)
@@ -212,7 +214,7 @@ class _Materials:
         # Blender keeps float images in scene-linear memory (converted from their colour space
         # when loaded) and 8-bit images as their file's bytes: only 8-bit sRGB needs decoding.
         srgb = image.colorspace_settings.name == "sRGB" and not image.is_float
-        key = (image.as_pointer(), srgb)
+        key = (image.name_full, srgb)
         tid = self.by_image.get(key)
         if tid is not None:
             return tid
@@ -517,6 +519,17 @@ def export_scene(depsgraph, toyrt_module, *, report=None, camera_object=None):
 
 def _add_mesh(scene, obj, matrix, materials, depsgraph):
     """Convert an evaluated object's geometry; returns (mesh id or -1 if empty, triangle count)."""
+    data = mesh_data(obj, materials, depsgraph)
+    if data is None:
+        return (-1, 0)
+    verts, tris, normals, uvs, mat_ids = data
+    mid = scene.add_mesh(verts, tris, transform=matrix, normals=normals, uvs=uvs, material_ids=mat_ids)
+    return (mid, len(tris))
+
+
+def mesh_data(obj, materials, depsgraph):
+    """An evaluated object's geometry as the arrays add_mesh / replace_mesh take: (vertices,
+    triangles, normals, uvs, material ids), or None when it has no triangles."""
     try:
         mesh = obj.to_mesh(preserve_all_data_layers=False, depsgraph=depsgraph)
     except TypeError:
@@ -524,15 +537,14 @@ def _add_mesh(scene, obj, matrix, materials, depsgraph):
     except RuntimeError:
         mesh = None
     if mesh is None:
-        return (-1, 0)
+        return None
     try:
         verts, tris, normals, uvs, mat_idx = _mesh_arrays(mesh)
         if len(tris) == 0:
-            return (-1, 0)
+            return None
         slot_map = _object_materials(obj, mesh, materials)
         mat_ids = slot_map[np.clip(mat_idx, 0, len(slot_map) - 1)]
-        mid = scene.add_mesh(verts, tris, transform=matrix, normals=normals, uvs=uvs, material_ids=mat_ids)
-        return (mid, len(tris))
+        return verts, tris, normals, uvs, mat_ids
     finally:
         obj.to_mesh_clear()
 

@@ -6,6 +6,10 @@ class TOYRTRenderSettings(bpy.types.PropertyGroup):
     samples: bpy.props.IntProperty(
         name="Samples", description="Samples per pixel (Sobol-Owen pattern, box filter of one pixel)",
         default=16, min=1, soft_max=4096)
+    viewport_samples: bpy.props.IntProperty(
+        name="Viewport Samples",
+        description="Samples per pixel the 3D viewport's Rendered mode accumulates before it stops using the CPU",
+        default=32, min=1, soft_max=1024)
     area_light_sampling: bpy.props.EnumProperty(
         name="Area Lights", description="How soft shadows of rectangular area lights are sampled",
         items=[("solid_angle", "Solid Angle", "Uniform over the light's solid angle (spherical rectangles, Urena et al. 2013)"),

@@ -28,6 +28,7 @@ class RENDER_PT_toyrt(bpy.types.Panel):
         layout.use_property_split = True
         settings = context.scene.toyrt
         layout.prop(settings, "samples")
+        layout.prop(settings, "viewport_samples")
         layout.prop(settings, "area_light_sampling")
         layout.prop(settings, "light_sampling")
         layout.prop(settings, "builder")
