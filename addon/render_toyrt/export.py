@@ -84,6 +84,7 @@ class _Materials:
         self.by_material = {}                # material name ('': none) -> material id
         self.by_image = {}                   # (image name, srgb) -> texture id
         self.textures = 0
+        self.missing = set()                 # by_image keys that got the placeholder
 
     def note(self, what):
         if what not in self.approx:
@@ -216,11 +217,15 @@ class _Materials:
         srgb = image.colorspace_settings.name == "sRGB" and not image.is_float
         key = (image.name_full, srgb)
         tid = self.by_image.get(key)
+        missing = f"missing image '{image.name}' ({image.filepath or 'no file'}): magenta placeholder"
         if tid is not None:
+            if key in self.missing:
+                self.note(missing)  # again: scene_cache.py collects the notes afresh for each render
             return tid
         pixels = self._pixels(image)
         if pixels is None:
-            self.note(f"missing image '{image.name}' ({image.filepath or 'no file'}): magenta placeholder")
+            self.note(missing)
+            self.missing.add(key)
             tid = self._placeholder()
         else:
             if not image.is_float and image.colorspace_settings.name not in (

@@ -187,6 +187,9 @@ class SceneCache:
         tri_instanced = 0
         pool, by_fingerprint = {}, {}
         if fingerprints:
+            # Each final render reports what it approximates now (materials are converted again
+            # below, lights and the world re-read), not what earlier frames did.
+            del self.approximated[:]
             # A final render's depsgraph hands out new mesh datablocks every frame (their
             # addresses, hence the keys, change or even get reused by another object): last
             # frame's meshes are matched by content instead, then by the object that made them.
