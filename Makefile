@@ -118,6 +118,11 @@ bench-trace: native
 	$(if $(filter /%,$(BUILD)),,./)$(BUILD)/bench/bench_trace --out docs/bench-trace.md
 
 # Builders from 10K to 4M triangles (LBVH on PoCL, SAH, Embree): docs/lbvh.md and its chart.
+# TOYRT against Cycles in Blender: time to Cycles' 64-sample error on the seed's scene, peak memory of
+# 10,000 instances (bench/blender/bench_blender.py, about 4 minutes) -> docs/blender-bench.md
+bench-blender: addon
+	$(SYS_PY) bench/blender/bench_blender.py --blender $(BLENDER) --out docs/blender-bench.md
+
 bench-lbvh: native
 	$(if $(filter /%,$(BUILD)),,./)$(BUILD)/bench/bench_lbvh --out docs/lbvh-bench.md --csv docs/lbvh.csv
 	$(SYS_PY) bench/plot_lbvh.py docs/lbvh.csv docs/lbvh.png

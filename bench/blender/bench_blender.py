@@ -82,7 +82,8 @@ def rmse(a, b):
 
 def time_to_error(blender, workdir, args):
     blend = Path(workdir) / "cornell.blend"
-    run_blender(blender, ["-b", "--factory-startup", "--python", str(REPO / "scenes" / "cornell_demo.py"), "--", str(blend)])
+    # Not --factory-startup: the scene script sets TOYRT settings (the add-on must be enabled).
+    run_blender(blender, ["-b", "--python-exit-code", "1", "--python", str(REPO / "scenes" / "cornell_demo.py"), "--", str(blend)])
     pct = args.percent
     print(f"reference: Cycles {args.ref_samples} spp at {pct} %", flush=True)
     ref_s, ref, _ = render(blender, blend, "CYCLES", args.ref_samples, pct, workdir, "ref")
