@@ -2,7 +2,7 @@
 # `make setup` (which `make test` runs first) installs everything and is a fast no-op when done.
 #
 #   make setup        Debian packages, .venv with pytest, native build, add-on installed + enabled
-#   make test         C++ tests (ctest), Python tests (pytest), Blender tests (tests/blender)
+#   make test         C++ tests (ctest), Python tests (pytest), Blender tests (tests/blender), fuzz, sanitize
 #   make demo         renders the seed's Cornell box with TOYRT -> out/demo_0001.png
 #   make bench-trace  ray-tracing benchmark against Embree -> docs/bench-trace.md
 #   make bench-lbvh   builders (LBVH, SAH, Embree) from 10K to 4M triangles -> docs/lbvh-bench.md, lbvh.png
@@ -77,7 +77,7 @@ addon: native
 
 # ---- tests ------------------------------------------------------------------------------------------
 test: setup
-	@$(MAKE) --no-print-directory test-native test-python test-blender test-bpy
+	@$(MAKE) --no-print-directory test-native test-python test-blender test-bpy fuzz sanitize
 
 test-native:
 	ctest --test-dir $(BUILD) --output-on-failure --no-tests=error
