@@ -14,7 +14,8 @@ the progressive render, screenshot the area and measure; the outer part checks t
    re-exports that mesh only; editing a material converts that material only;
 4. Rendered mode and the render engine toggled 50 times: no viewport session or render thread is
    left, the OS thread count and the memory do not grow from toggle 10 to toggle 50;
-5. Blender quits while a viewport render is running (the process exits 0).
+5. a file is opened while a viewport render is running: the session and its thread are gone;
+6. Blender quits while a viewport render is running (the process exits 0).
 """
 import json
 import os
@@ -74,6 +75,7 @@ def check(r):
     mat = r["material_edit"]
     assert mat["materials_converted"] == 1 and mat["meshes_exported"] == 0 and mat["mesh_bvhs_built"] == 0, mat
 
+    assert r["file_load"] == dict(sessions_left=0, viewport_threads_left=0), r["file_load"]
     tog = r["toggles"]
     assert tog["sessions_left"] == 0 and tog["viewport_threads_left"] == 0, tog
     assert tog["os_threads_50"] <= tog["os_threads_10"], tog
@@ -253,8 +255,22 @@ def inner(result_path):
         window, area, region = view3d()
         state["session_bytes"] = s.cache.scene.memory_bytes + region.width * region.height * 16 * 3
 
+    def render_long():
+        bpy.context.scene.toyrt.viewport_samples = 100000
+        window, area, region = view3d()
+        area.spaces[0].shading.type = "RENDERED"
+
+    def reload_file():
+        # The file closes while its viewport renders: load_pre must stop and free the session.
+        bpy.ops.wm.open_mainfile(filepath=bpy.data.filepath)
+
+    def after_reload():
+        out["file_load"] = dict(sessions_left=len(viewport._sessions),
+                                viewport_threads_left=sum(t.name == "toyrt-viewport" for t in threading.enumerate()))
+
     def quit_while_rendering():
-        scene.toyrt.viewport_samples = 100000
+        bpy.context.scene.render.engine = "TOYRT"
+        bpy.context.scene.toyrt.viewport_samples = 100000
         window, area, region = view3d()
         area.spaces[0].shading.type = "RENDERED"
 
@@ -275,6 +291,10 @@ def inner(result_path):
               do(measure_session), toggle_once, do(after_toggles),
               wait_for(lambda: not viewport._sessions, "sessions freed after leaving Rendered mode"),
               do(toggles_done),
+              do(render_long), wait_for(lambda: session() is not None and session().passes > 0,
+                                        "a render running before the file closes"),
+              do(reload_file), wait_for(lambda: not viewport._sessions, "sessions freed by loading a file"),
+              do(after_reload),
               do(quit_while_rendering), wait_for(lambda: session() is not None and session().passes > 0,
                                                  "a render running before quitting"),
               do(write_and_quit)]
@@ -300,7 +320,7 @@ def inner(result_path):
             bpy.ops.wm.quit_blender()
         return None
 
-    bpy.app.timers.register(tick, first_interval=1.0)
+    bpy.app.timers.register(tick, first_interval=1.0, persistent=True)  # survives the file load
 
 
 if "--inner" in sys.argv:
