@@ -207,6 +207,10 @@ class SceneCache:
                 continue
             if not inst.is_instance and not inst.show_self:
                 continue
+            if export._singular(np.array(inst.matrix_world, np.float64)):
+                # Scaled to zero along an axis: the core refuses the matrix (export._singular).
+                # At zero scale nothing of it can be hit; a flattened object is left out too.
+                continue
             key = export._mesh_key(obj)
             owner = None if inst.is_instance else obj.original.as_pointer()
             if fingerprints:
