@@ -17,6 +17,7 @@
 # command-line parts (`blender -b file.blend -E TOYRT ...`) when TOYRT_NO_BLENDER_BINARY is set,
 # and say so.
 import argparse
+import atexit
 import glob
 import os
 import runpy
@@ -42,42 +43,40 @@ def main():
         sys.exit(f"run_with_bpy: expected one {build}/python/toyrt*.so, found {len(modules)} (make native first)")
 
     home = Path(tempfile.mkdtemp(prefix="toyrt-bpy-"))
+    # Removed at exit, after Blender's own exit handlers (registered later by `import bpy`, so run
+    # earlier): they disable the add-on, whose unregister() still imports from this folder.
+    atexit.register(shutil.rmtree, home, True)
+    scripts = home / "scripts"
+    addon_dir = scripts / "addons" / ADDON
+    shutil.copytree(args.addon, addon_dir, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    shutil.copy2(modules[0], addon_dir)
+    # Read by Blender when bpy is imported: the user scripts folder (with addons/ in it) and
+    # a throw-away config folder, so nothing of the user's Blender setup is involved.
+    os.environ["BLENDER_USER_SCRIPTS"] = str(scripts)
+    os.environ["BLENDER_USER_CONFIG"] = str(home / "config")
+    os.environ["BLENDER_USER_EXTENSIONS"] = str(home / "extensions")
+    os.environ["TOYRT_NO_BLENDER_BINARY"] = "1"
+    # The parity test keeps its Cycles references in the build folder it is given.
+    os.environ.setdefault("TOYRT_BUILD_DIR", str(build))
+
+    import bpy  # noqa: F401  (Blender starts here)
+    import addon_utils
+
+    if str(scripts / "addons") not in sys.path:
+        sys.path.append(str(scripts / "addons"))   # in case this Blender did not add it
+    mod = addon_utils.enable(ADDON, default_set=True, handle_error=None)
+    if mod is None:
+        sys.exit(f"run_with_bpy: addon_utils.enable('{ADDON}') failed")
+    print(f"run_with_bpy: Blender {bpy.app.version_string} (bpy module), add-on from {mod.__file__}", flush=True)
+
+    test = Path(args.test).resolve()
+    sys.argv = [str(test)] + rest
+    code = 0
     try:
-        scripts = home / "scripts"
-        addon_dir = scripts / "addons" / ADDON
-        shutil.copytree(args.addon, addon_dir,
-                        ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
-        shutil.copy2(modules[0], addon_dir)
-        # Read by Blender when bpy is imported: the user scripts folder (with addons/ in it) and
-        # a throw-away config folder, so nothing of the user's Blender setup is involved.
-        os.environ["BLENDER_USER_SCRIPTS"] = str(scripts)
-        os.environ["BLENDER_USER_CONFIG"] = str(home / "config")
-        os.environ["BLENDER_USER_EXTENSIONS"] = str(home / "extensions")
-        os.environ["TOYRT_NO_BLENDER_BINARY"] = "1"
-        # The parity test keeps its Cycles references in the build folder it is given.
-        os.environ.setdefault("TOYRT_BUILD_DIR", str(build))
-
-        import bpy  # noqa: F401  (Blender starts here)
-        import addon_utils
-
-        if str(scripts / "addons") not in sys.path:
-            sys.path.append(str(scripts / "addons"))   # in case this Blender did not add it
-        mod = addon_utils.enable(ADDON, default_set=True, handle_error=None)
-        if mod is None:
-            sys.exit(f"run_with_bpy: addon_utils.enable('{ADDON}') failed")
-        print(f"run_with_bpy: Blender {bpy.app.version_string} (bpy module), add-on from {mod.__file__}", flush=True)
-
-        test = Path(args.test).resolve()
-        sys.argv = [str(test)] + rest
-        code = 0
-        try:
-            runpy.run_path(str(test), run_name="__main__")
-        except SystemExit as stop:
-            code = stop.code if isinstance(stop.code, int) else (0 if stop.code is None else 1)
-    finally:
-        shutil.rmtree(home, ignore_errors=True)
+        runpy.run_path(str(test), run_name="__main__")
+    except SystemExit as stop:
+        code = stop.code if isinstance(stop.code, int) else (0 if stop.code is None else 1)
     sys.stdout.flush()
-    # Blender's own atexit handlers still run; the test's verdict is the exit status.
     sys.exit(code)
 
 
