@@ -15,7 +15,8 @@
 #     measured and printed, not checked.
 # Checked: a render cancelled while rendering returns within 0.2 s of Esc (every one of them); no
 # Python thread is left; the OS thread count does not grow after the first render has started the
-# native worker pool; resident memory stays flat from cycle 10 to 50.
+# native worker pool; resident memory stays flat from cycle 10 to 50 (within 32 MB: a leaked
+# scene is about 15 MB a cycle).
 import os
 import sys
 import threading
@@ -174,10 +175,14 @@ def main():
     check(max(threads[2:]) <= threads[2],
           f"OS threads flat: {threads[0]} after cycle 1, {threads[2]} after cycle 3 (the first F12), "
           f"at most {max(threads[2:])} after")
+    # One leaked native scene of this size is about 15 MB, so 40 cycles leaking one each would
+    # grow by 600 MB; the bound leaves room for the allocators' steps (+21 MB seen once on 5.0,
+    # flat on the rerun), so it catches leaked scenes and images, not every small allocation.
     growth = rss[-1] - rss[9]
-    check(growth < 20.0,
+    slope = float(np.polyfit(np.arange(10, CYCLES + 1), rss[9:], 1)[0])
+    check(growth < 32.0,
           f"resident memory flat: {rss[9]:.0f} MB after cycle 10, {rss[-1]:.0f} MB after cycle {CYCLES} "
-          f"({growth:+.1f} MB; max {max(rss[9:]):.0f} MB)")
+          f"({growth:+.1f} MB, trend {slope * 1024:+.0f} KB per cycle; max {max(rss[9:]):.0f} MB)")
 
 
 try:
