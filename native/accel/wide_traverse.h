@@ -53,6 +53,7 @@ inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear
   const vfloat start = splat(tnear);
   // Conservative distances, as in intersect_box: exits moved out, negative entries moved back.
   const vfloat widen = splat(1.0f + 2.0f * gamma(3)), shrink = splat(1.0f - 2.0f * gamma(3));
+  const bool negative_start = tnear < 0.0f;
 
   struct Entry { uint32_t child, count; float tentry; };
   Entry stack[(kWidth - 1) * kMaxBvhDepth + 1];
@@ -66,9 +67,13 @@ inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear
       const vfloat tny = (load(n.bounds[ray.near[1]]) - oy) * iy, tfy = (load(n.bounds[ray.far[1]]) - oy) * iy;
       const vfloat tnz = (load(n.bounds[ray.near[2]]) - oz) * iz, tfz = (load(n.bounds[ray.far[2]]) - oz) * iz;
       vfloat tmin = max_keep(max_keep(max_keep(start, tnx), tny), tnz);
-      tmin = tmin < 0.0f ? tmin * widen : tmin;
       vfloat tmax = min_keep(min_keep(min_keep(splat(kInfinity), tfx), tfy), tfz);
-      tmax = tmax * (tmax < 0.0f ? shrink : widen);
+      if (negative_start) {  // rare (rays reaching back before their origin): the general form
+        tmin = tmin < 0.0f ? tmin * widen : tmin;
+        tmax = tmax * (tmax < 0.0f ? shrink : widen);
+      } else {  // tmin >= 0, so a negative exit is a miss however it is scaled: Ize's form
+        tmax = tmax * widen;
+      }
       tmax = min_keep(tmax, splat(tfar));
       uint32_t mask = mask_of(tmin <= tmax);
       if (mask != 0 && AnyHit) {
