@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <condition_variable>
 #include <deque>
 #include <exception>
@@ -63,6 +64,8 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
     throw std::logic_error("render: the scene changed since the last commit(): call commit() first");
   if (settings.samples < 1) throw std::invalid_argument("samples must be at least 1");
   if (settings.first_sample < 0) throw std::invalid_argument("first_sample must be >= 0");
+  if (settings.samples > std::numeric_limits<int>::max() - settings.first_sample)
+    throw std::invalid_argument("first_sample + samples must stay below 2^31");
   if (settings.tile_size < 1) throw std::invalid_argument("tile_size must be at least 1");
   const auto start = std::chrono::steady_clock::now();
   const PixelWindow win = camera.window;

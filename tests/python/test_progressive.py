@@ -54,6 +54,8 @@ def test_first_sample_must_not_be_negative():
     s = lit_box_scene()
     with pytest.raises(ValueError, match="first_sample"):
         s.render(camera(), samples=1, first_sample=-1)
+    with pytest.raises(ValueError, match="first_sample"):
+        s.render(camera(), samples=2, first_sample=2**31 - 2)
 
 
 def test_cancel_stops_inside_a_pixel_even_at_100000_samples():
