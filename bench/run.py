@@ -102,9 +102,9 @@ def main():
         dump = work / "accel-rays"
         dump.mkdir(exist_ok=True)
         timings["accel"] = run([build / "bench" / "bench_accel", "--csv", work / "accel.csv", "--dump", dump,
-                                "--runs", cfg["repeats"], *(["--quick"] if args.quick else [])], log)
+                                "--runs", cfg["repeats"] + 1, *(["--quick"] if args.quick else [])], log)
         timings["accel python"] = run([sys.executable, REPO / "bench" / "accel_python.py", dump,
-                                       work / "accel-python.json", "--runs", cfg["repeats"]], log, env)
+                                       work / "accel-python.json", "--runs", cfg["repeats"] + 1], log, env)
         for f in dump.glob("*.bin"):
             f.unlink()  # up to 200 MB of meshes and rays: only needed for the step above
     if "stability" in stages:
