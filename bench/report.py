@@ -116,6 +116,16 @@ def ref_noise(runs, ref_spp):
     return fmt(math.exp(f.log_a + f.b * math.log(ref_spp)))
 
 
+def fixed_costs(data):
+    """The t0 of each renderer's time fit: what it pays before the first sample."""
+    lights = data.get("scene_stats", {}).get("lights", 0)
+    out = []
+    for m in ("Cycles", f"TOYRT solid_angle/{'one' if lights > 4 else 'all'}", "Mitsuba 3 direct"):
+        f = Fit(data["runs"], m, "relmse")
+        out.append(fmt(f.t0) if f.ok else "-")
+    return " / ".join(out)
+
+
 def worst_share(work, name):
     """How much of the squared error of TOYRT's last saved render (the first method at the most
     samples) sits in its worst 1 % of counted pixels: near 1, RMSE is a few pixels' fireflies."""
@@ -272,8 +282,9 @@ def main():
           "reference's, so the curves flatten there and the low-error end of the ratios below understates the "
           "faster method.\n")
         w("| scene | triangles (instanced) | instances | lights | pixels left out (lights) | reference s | "
-          "reference RMSE (est.) | TOYRT export + BVH build s (median) | worst 1 % of pixels' share of TOYRT's squared error |")
-        w("|---|---|---|---|---|---|---|---|---|")
+          "reference RMSE (est.) | TOYRT export + BVH build s (median) | fixed cost t0 s (fit, relMSE): Cycles / "
+          "TOYRT default / Mitsuba | worst 1 % of pixels' share of TOYRT's squared error |")
+        w("|---|---|---|---|---|---|---|---|---|---|")
         for name, data in scenes.items():
             st = data.get("scene_stats", {})
             ref = data["reference"]
@@ -281,7 +292,7 @@ def main():
               f"{100 * data.get('masked_fraction', 0):.1f} % | {fmt(ref.get('seconds'))}"
               f"{' (cached)' if ref.get('cached') else ''} | {ref_noise(data['runs'], ref.get('spp'))} | "
               f"{fmt(float(np.median([r['seconds'] - r['render_seconds'] for r in data['runs'] if r['renderer'] == 'toyrt'])))} | "
-              f"{worst_share(work, name)} |")
+              f"{fixed_costs(data)} | {worst_share(work, name)} |")
         for path in error_charts(scenes):
             w(f"\n![{path.stem}](results/{path.name})")
         w("\n### Time to equal error\n")
@@ -633,7 +644,9 @@ def main():
           + ". A slope steeper than -0.5 is the stratification paying off; TOYRT has no switch to another "
             "pattern, so this is the only comparison made.")
     w("\n## Reproducing\n")
-    w("`make bench` (about 20-30 minutes on 2 cores; `make bench BENCH_QUICK=1` for a few-minute smoke run) installs "
+    w(f"`make bench` ({meta.get('total_seconds', 0) / 60:.0f} minutes here, with the Cycles references "
+      f"{'cached' if all(d['reference'].get('cached') for d in scenes.values()) else 'rendered'}; "
+      "`make bench BENCH_QUICK=1` for a smoke run of a minute or two) installs "
       "requirements-bench.txt (Mitsuba 3, Dr.Jit, Open3D) into .venv, builds and installs the add-on, then runs "
       "bench/run.py. Scenes: scenes/bench/; programs: bench/. Stage times of this run: "
       + ", ".join(f"{k} {v:.0f} s" for k, v in meta.get("timings", {}).items()) + ".")
