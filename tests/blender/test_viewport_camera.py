@@ -1,0 +1,83 @@
+# Runs inside Blender:  blender -b --python-exit-code 1 --python tests/blender/test_viewport_camera.py
+# (`make test` runs it). viewport.view_camera reads a 3D view's camera back from its projection
+# matrix; here it is given the projection Blender computes for a camera object
+# (Object.calc_matrix_camera, the matrix the viewport's camera view uses) and its view matrix, and
+# the image it renders must be the image of the camera itself (export.export_camera): perspective
+# with lens shift, horizontal and vertical sensor fit, and orthographic. Known answer: the same
+# picture, to float rounding of the recovered parameters.
+import sys
+import types
+
+import bpy
+import numpy as np
+
+failures = []
+
+
+def check(cond, what):
+    print(("  ok: " if cond else "  FAIL: ") + what, flush=True)
+    if not cond:
+        failures.append(what)
+
+
+def main():
+    import render_toyrt
+    from render_toyrt import export, scene_cache, viewport
+
+    toyrt = render_toyrt.native()
+    bpy.data.batch_remove(list(bpy.data.objects) + list(bpy.data.meshes))
+    scene = bpy.context.scene
+    scene.render.engine = "TOYRT"
+    for x in (-2, 0, 2):
+        bpy.ops.mesh.primitive_cube_add(size=0.8, location=(x, x * 0.5, 0.4))
+    bpy.ops.mesh.primitive_plane_add(size=10)
+    light = bpy.data.lights.new("lamp", "POINT")
+    light.energy = 400
+    lo = bpy.data.objects.new("lamp", light)
+    lo.location = (1, -2, 4)
+    scene.collection.objects.link(lo)
+    cam = bpy.data.cameras.new("cam")
+    co = bpy.data.objects.new("cam", cam)
+    co.location = (1, -7, 4)
+    co.rotation_euler = (1.05, 0, 0.15)
+    scene.collection.objects.link(co)
+    scene.camera = co
+    scene.render.resolution_percentage = 100
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    cache = scene_cache.SceneCache(toyrt)
+    cache.sync(depsgraph)
+    cache.commit()
+
+    cases = [
+        ("perspective", dict(type="PERSP", lens=35, shift_x=0.0, shift_y=0.0), (64, 48)),
+        ("perspective with lens shift", dict(type="PERSP", lens=50, shift_x=0.1, shift_y=-0.05), (64, 48)),
+        ("perspective, portrait", dict(type="PERSP", lens=28, shift_x=0.0, shift_y=0.1), (40, 60)),
+        ("orthographic", dict(type="ORTHO", ortho_scale=9.0, shift_x=0.05, shift_y=0.0), (64, 48)),
+    ]
+    for label, settings, (w, h) in cases:
+        for k, v in settings.items():
+            setattr(cam, k, v)
+        scene.render.resolution_x, scene.render.resolution_y = w, h
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        co_eval = co.evaluated_get(depsgraph)
+        region = types.SimpleNamespace(width=w, height=h)
+        rv3d = types.SimpleNamespace(
+            window_matrix=co_eval.calc_matrix_camera(depsgraph, x=w, y=h),
+            view_matrix=co_eval.matrix_world.inverted(), is_perspective=cam.type == "PERSP")
+        from_view = viewport.view_camera(region, rv3d)
+        from_camera = export.export_camera(depsgraph)
+        a = cache.scene.render(from_view, samples=4)
+        b = cache.scene.render(from_camera, samples=4)
+        diff = np.abs(a - b)
+        # A recovered parameter off by float rounding moves a sample by far less than a pixel:
+        # only pixels on an edge may differ, and few of them.
+        changed = (diff.max(axis=2) > 1e-3).mean()
+        check(a.shape == b.shape and changed < 0.02,
+              f"{label}: the view's camera renders the camera's picture ({100 * changed:.2f} % of pixels differ)")
+
+
+main()
+if failures:
+    print(f"test_viewport_camera: {len(failures)} failed", flush=True)
+    sys.exit(1)
+print("test_viewport_camera: all checks passed", flush=True)
