@@ -346,7 +346,8 @@ class SceneCache:
 
 # ---------------------------------------------------------------------------------------------
 # Final renders: one cache per Blender scene, so the frames of an animation rendered in one
-# Blender process reuse what did not change (Blender makes a new engine object per render).
+# Blender process reuse what did not change (Blender makes a new engine object for every F12;
+# an animation's frames share one engine and depsgraph on 3.4, but not their mesh datablocks).
 
 _render_caches = {}
 
