@@ -4,6 +4,7 @@
 # tests/blender/test_cycles_parity.py does for its glass scenes: no diffuse bounces, glass
 # (transmission and its reflection) up to 8, box filter one pixel wide, no denoising, no adaptive
 # sampling, no light threshold, no clamping. Float EXR output, Standard view transform.
+import os
 import sys
 
 import bpy
@@ -43,3 +44,7 @@ else:
     scene.toyrt.samples = samples
     scene.toyrt.max_specular_depth = 8
     scene.toyrt.seed = 0
+    # Other TOYRT settings to compare, e.g. TOYRT_BENCH_SET="light_sampling=one".
+    for item in filter(None, os.environ.get("TOYRT_BENCH_SET", "").split(",")):
+        name, value = item.split("=", 1)
+        setattr(scene.toyrt, name, type(getattr(scene.toyrt, name))(value))
