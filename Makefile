@@ -6,7 +6,7 @@
 #   make demo         renders the seed's Cornell box with TOYRT -> out/demo_0001.png
 #   make bench-trace  ray-tracing benchmark against Embree -> docs/bench-trace.md
 #   make bench-lbvh   builders (LBVH, SAH, Embree) from 10K to 4M triangles -> docs/lbvh-bench.md, lbvh.png
-#   make bench-blender TOYRT against Cycles in Blender: time to Cycles' 64-spp error, peak memory -> docs/blender.md
+#   make bench-blender TOYRT against Cycles in Blender: time to Cycles' 64-spp error, peak memory -> docs/blender-bench.md
 #   make bench        speed against accuracy vs Cycles, Mitsuba 3, Embree, Open3D -> docs/results.md (BENCH_QUICK=1: smoke run)
 #   make fuzz         libFuzzer over scene building and ray queries (FUZZ_SECONDS=60) -> docs/robustness.md
 #   make sanitize     C++ and Python tests on an AddressSanitizer + UBSan build (build-asan/)
