@@ -4,8 +4,8 @@
 #   - each edit does only its part, by the cache's counters: a camera move exports and commits
 #     nothing; moving an object sets one transform and rebuilds the top level only (no mesh BVH);
 #     editing a mesh re-exports and rebuilds that mesh only; editing a material converts that
-#     material only; editing a light sends the lights again and nothing else; deleting an object
-#     frees its mesh;
+#     material only; editing a light sends the lights again and nothing else; moving a parent moves
+#     its child's instance too, without a walk over the scene; deleting an object frees its mesh;
 #   - after every edit, the incrementally updated scene renders exactly the image a fresh export of
 #     the same depsgraph renders (same meshes, transforms, materials, lights): the known answer.
 import sys
@@ -92,7 +92,8 @@ def main():
         nothing = dict(meshes_exported=0, commits=0, mesh_bvhs_built=0, light_sends=0, materials_converted=0)
         edit("camera move", lambda: setattr(scene.camera, "location", (0.5, -6, 4)), nothing)
         edit("object move", lambda: setattr(cube, "location", (-1.2, 0.3, 0.5)),
-             dict(transforms_set=1, meshes_exported=0, mesh_bvhs_built=0, top_level_builds=1, instance_resets=0))
+             dict(transforms_set=1, fast_moves=1, walks=0, meshes_exported=0, mesh_bvhs_built=0, top_level_builds=1,
+                  instance_resets=0))
 
         def mesh_edit():
             sphere.data.vertices[0].co.z += 0.3
@@ -106,6 +107,9 @@ def main():
         def light_edit():
             bpy.data.lights["lamp"].energy = 150
         edit("light edit", light_edit, dict(light_sends=1, meshes_exported=0, mesh_bvhs_built=0, transforms_set=0))
+        edit("parent the sphere to the cube", lambda: setattr(sphere, "parent", cube), dict(meshes_exported=0))
+        edit("move the parent: the child follows", lambda: setattr(cube, "location", (-0.8, 0.2, 0.5)),
+             dict(transforms_set=2, walks=0, meshes_exported=0, mesh_bvhs_built=0))
         edit("delete an object", lambda: bpy.data.objects.remove(sphere),
              dict(meshes_freed=1, meshes_exported=0, instance_resets=1))
         check(cache.scene.instance_count == 2, f"two instances left ({cache.scene.instance_count})")
