@@ -204,8 +204,6 @@ double fresnel_exact(double cos_i, double eta) {
   return 0.5 * (rs * rs + rp * rp);
 }
 
-std::string json_escape(const std::string& s) { return s; }  // names here are plain ASCII
-
 }  // namespace
 
 int main(int argc, char** argv) {
