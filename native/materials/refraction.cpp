@@ -76,4 +76,19 @@ SpecularSample sample(const FresnelDielectric& m, const Vec3& wo, const Vec3& ng
   return s;
 }
 
+int split(const FresnelDielectric& m, const Vec3& wo, const Vec3& ng, const Vec3& ns, SpecularSample out[2]) {
+  // u = 0 takes reflection whenever F > 0; u = 1 takes refraction whenever it is possible.
+  const SpecularSample r = sample(m, wo, ng, ns, 0.0f);
+  const SpecularSample t = sample(m, wo, ng, ns, 1.0f);
+  if (!r.reflected || t.reflected) {  // a single branch: F = 0, or no refraction
+    out[0] = t.reflected ? t : r;
+    out[0].probability = 1.0f;
+    return 1;
+  }
+  out[0] = r;
+  out[1] = t;
+  out[1].probability = 1.0f - r.probability;  // exactly complementary, whatever rounding did
+  return 2;
+}
+
 }  // namespace toyrt

@@ -60,4 +60,9 @@ SpecularSample sample(const PerfectRefraction& m, const Vec3& wo, const Vec3& ng
 // u: one uniform number choosing between reflection and refraction.
 SpecularSample sample(const FresnelDielectric& m, const Vec3& wo, const Vec3& ng, const Vec3& ns, float u);
 
+// Both branches at once, for splitting: the reflected and the refracted direction, each with
+// its Fresnel weight in `probability` (F and 1 - F, summing to 1), or one branch of weight 1
+// when only one exists (total internal reflection, or F = 0). Returns the branch count (1 or 2).
+int split(const FresnelDielectric& m, const Vec3& wo, const Vec3& ng, const Vec3& ns, SpecularSample out[2]);
+
 }  // namespace toyrt

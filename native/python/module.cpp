@@ -286,12 +286,14 @@ class PyScene {
 
   py::array_t<float> render(const py::dict& camera_settings, int samples, uint32_t seed, int max_specular_depth,
                             const std::string& area_light_sampling, const std::string& light_sampling, int threads,
-                            int tile_size, py::object on_tile, py::object should_cancel, int first_sample) {
+                            int tile_size, py::object on_tile, py::object should_cancel, int first_sample,
+                            int split_depth) {
     const Camera camera = Camera::make(to_camera(camera_settings));
     if (samples < 1) throw py::value_error("samples must be at least 1");
     if (first_sample < 0) throw py::value_error("first_sample must be >= 0");
     if (tile_size < 1) throw py::value_error("tile_size must be at least 1");
     if (max_specular_depth < 0) throw py::value_error("max_specular_depth must be >= 0");
+    if (split_depth < 0) throw py::value_error("split_depth must be >= 0");
     const AreaSampling area = to_area_sampling(area_light_sampling);
     RenderSettings settings;
     settings.samples = samples;
@@ -300,6 +302,7 @@ class PyScene {
     settings.threads = check_threads(threads);
     settings.integrator.seed = seed;
     settings.integrator.max_specular_depth = max_specular_depth;
+    settings.integrator.split_depth = split_depth;
     std::shared_lock lock(mutex_);
     require_committed();
     RenderScene rs = render_;  // a private copy: lights take this render's estimator
@@ -608,6 +611,7 @@ PYBIND11_MODULE(toyrt, m) {
            py::arg("max_specular_depth") = 8, py::arg("area_light_sampling") = "solid_angle",
            py::arg("light_sampling") = "auto", py::arg("threads") = 0, py::arg("tile_size") = 32,
            py::arg("on_tile") = py::none(), py::arg("should_cancel") = py::none(), py::arg("first_sample") = 0,
+           py::arg("split_depth") = IntegratorSettings{}.split_depth,
            "Renders the committed scene; returns (height, width, 4) float32 linear RGBA, rows from the top, of\n"
            "the camera's pixel window (the border region, if set).\n"
            "camera: a dict of Blender's camera and render settings: type ('PERSP', 'ORTHO'), lens, sensor_width,\n"
@@ -622,7 +626,9 @@ PYBIND11_MODULE(toyrt, m) {
            "first_sample: render samples [first_sample, first_sample + samples) of the same sequence, the\n"
            "mean of that pass: passes weighted by their sample counts average to one render of them all\n"
            "(progressive rendering). A window too large for the memory available raises MemoryError\n"
-           "before anything is allocated.")
+           "before anything is allocated.\n"
+           "split_depth: glass (Fresnel) surfaces among the first split_depth path vertices trace both reflection\n"
+           "and refraction, weighted by F and 1 - F; deeper ones choose one. 0: never split.")
       .def_property_readonly("last_render", &PyScene::last_render,
                              "What the last render did: cancelled, cancel_latency_ms, tiles_done, tiles_total, render_ms,\n"
                              "samples, light_sampling.")

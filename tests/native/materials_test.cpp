@@ -116,6 +116,27 @@ TEST(Fresnel, GlassChoosesReflectionWithProbabilityF) {
   EXPECT_FLOAT_EQ(tir.probability, 1.0f);
 }
 
+TEST(Fresnel, SplitGivesBothBranchesWeightedFAndOneMinusF) {
+  const FresnelDielectric glass = FresnelDielectric::make(1.5f);
+  for (double theta : {0.0, 0.8, 1.4}) {
+    const Vec3 wo = direction(theta, 0.3);
+    const float f = fresnel_dielectric(float(std::cos(theta)), 1.5f);
+    SpecularSample b[2];
+    ASSERT_EQ(split(glass, wo, kUp, kUp, b), 2);
+    EXPECT_TRUE(b[0].reflected && !b[1].reflected);
+    EXPECT_FLOAT_EQ(b[0].probability, f);
+    EXPECT_EQ(b[0].probability + b[1].probability, 1.0f);
+    // The same directions sample() picks for each branch.
+    EXPECT_NEAR(glm::length(b[0].wi - sample(glass, wo, kUp, kUp, 0.0f).wi), 0.0f, 1e-7f);
+    EXPECT_NEAR(glm::length(b[1].wi - sample(glass, wo, kUp, kUp, 1.0f).wi), 0.0f, 1e-7f);
+  }
+  // Total internal reflection: one branch, all of the weight.
+  SpecularSample b[2];
+  ASSERT_EQ(split(glass, direction(1.2, 0.0, true), kUp, kUp, b), 1);
+  EXPECT_TRUE(b[0].reflected && b[0].total_internal_reflection);
+  EXPECT_EQ(b[0].probability, 1.0f);
+}
+
 TEST(Refraction, SnellsLawHoldsBothWays) {
   const float ior = 1.5f;
   const PerfectRefraction glass = PerfectRefraction::make(ior);

@@ -225,3 +225,65 @@ def test_a_uniform_background_lights_an_open_plane_with_albedo_times_its_radianc
     np.testing.assert_allclose(img[..., :3].mean(axis=(0, 1)), [0.3, 0.6, 1.2], rtol=2e-3)
     s.background_lighting = False
     assert (s.render(camera_above(size=0.5, resolution=4), samples=4)[..., :3] == 0).all()
+
+
+def glass_plane_under_a_light(split_depth_scene_power=40.0, size=20.0):
+    """A glass (Fresnel) plane at z = 0 seen straight down by an ortho camera at z = 5, and a large
+    area light at z = 3 facing down, which camera rays pass (visible_camera=False) but the
+    plane's reflection sees. Below the plane nothing: the refracted ray sees the black world."""
+    s = toyrt.Scene()
+    s.add_material("glass", ior=1.5)
+    h = 50.0
+    v = np.array([[-h, -h, 0], [h, -h, 0], [h, h, 0], [-h, h, 0]], np.float32)
+    s.add_mesh(v, [[0, 1, 2], [0, 2, 3]], material_ids=0)
+    m = np.eye(4)
+    m[2, 3] = 3.0
+    s.add_area_light(m, shape="SQUARE", size=size, power=split_depth_scene_power, visible_camera=False)
+    s.commit()
+    return s, split_depth_scene_power / (4 * size * size)  # the light's radiance (Cycles' units)
+
+
+def test_split_glass_gives_fresnel_times_the_reflected_light_without_noise():
+    """At normal incidence F = ((1 - 1.5) / (1 + 1.5))^2 = 0.04: the pixel is 0.04 L. Splitting
+    traces both branches with weights F and 1 - F, so even one sample per pixel is exact; choosing
+    one branch with probability F is right only on average (a Bernoulli of mean 0.04)."""
+    s, L = glass_plane_under_a_light()
+    cam = camera_above(size=1.0, resolution=16)
+    F = ((1 - 1.5) / (1 + 1.5)) ** 2
+    split = s.render(cam, samples=1, split_depth=2)[..., 0]
+    np.testing.assert_allclose(split, F * L, rtol=1e-4)
+    chosen = s.render(cam, samples=64, split_depth=0)[..., 0]
+    # Unbiased: the mean of 16 x 16 x 64 Bernoulli samples of L with p = F, within 5 sigma.
+    n = chosen.size * 64
+    sigma = L * np.sqrt(F * (1 - F) / n)
+    assert abs(chosen.mean() - F * L) < 5 * sigma
+    assert chosen.std() > 100 * split.std()  # the noise splitting removes
+
+
+def test_split_and_chosen_branches_agree_on_a_glass_sphere():
+    """Splitting changes the noise, not the answer: the same glass-sphere scene with and without
+    it converges to one image (mean over the image within a few standard errors)."""
+    s = toyrt.Scene()
+    s.add_material("diffuse", color=(0.8, 0.8, 0.8))
+    s.add_material("glass", ior=1.45)
+    v = np.array([[-3, -3, 0], [3, -3, 0], [3, 3, 0], [-3, 3, 0]], np.float32)
+    s.add_mesh(v, [[0, 1, 2], [0, 2, 3]], material_ids=0)
+    rings, segs = 16, 32
+    th, ph = np.meshgrid(np.linspace(0, np.pi, rings + 1), np.linspace(0, 2 * np.pi, segs, endpoint=False), indexing="ij")
+    p = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1).reshape(-1, 3) * 0.8 + [0, 0, 1]
+    idx = lambda i, j: i * segs + j % segs  # noqa: E731
+    tris = [(idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)) for i in range(rings) for j in range(segs)]
+    tris += [(idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)) for i in range(rings) for j in range(segs)]
+    s.add_mesh(p.astype(np.float32), tris, normals=((p - [0, 0, 1]) / 0.8).astype(np.float32), material_ids=1)
+    m = np.eye(4)
+    m[:3, 3] = [0.5, 0, 3]
+    s.add_area_light(m, shape="SQUARE", size=1.5, power=200.0)
+    s.commit()
+    cam = camera_above(size=2.0, resolution=16)
+    a = s.render(cam, samples=256, split_depth=0)[..., :3].astype(np.float64)
+    b = s.render(cam, samples=256, split_depth=3, seed=7)[..., :3].astype(np.float64)
+    # Per-pixel sample noise is unknown in closed form: estimate it from a second run of each.
+    a2 = s.render(cam, samples=256, split_depth=0, seed=11)[..., :3].astype(np.float64)
+    noise = np.std(a - a2) / np.sqrt(2) / np.sqrt(a.size)  # standard error of an image mean
+    assert abs(a.mean() - b.mean()) < 6 * noise + 1e-6
+    assert np.std(b - s.render(cam, samples=256, split_depth=3, seed=13)[..., :3]) < np.std(a - a2)
