@@ -222,7 +222,9 @@ class SceneCache:
             # addresses, hence the keys, change or even get reused by another object): last
             # frame's meshes are matched by content instead, then by the object that made them.
             pool, self.meshes = self.meshes, {}
-            by_fingerprint = {e[2]: k for k, e in pool.items() if e[2] is not None}
+            for k, e in pool.items():
+                if e[2] is not None:  # identical copies (objects with the same modifiers) share a list
+                    by_fingerprint.setdefault(e[2], []).append(k)
         for inst in depsgraph.object_instances:
             obj = inst.object
             if obj is None:
@@ -256,7 +258,7 @@ class SceneCache:
             if owner is not None:
                 self.owner_keys[owner] = key
             if key not in exported_now:
-                if entry is None or self._changed(inst, obj, entry, dirty_objects, fingerprints):
+                if entry is None or self._changed(inst, obj, dirty_objects):
                     entry = self._export_mesh(obj, depsgraph, entry)
                     self.meshes[key] = entry
                 exported_now.add(key)
@@ -307,7 +309,8 @@ class SceneCache:
         if entry is not None:
             return entry
         fp = _fingerprint(obj)
-        same = by_fingerprint.pop(fp, None) if fp is not None else None
+        candidates = by_fingerprint.get(fp, []) if fp is not None else []
+        same = candidates.pop() if candidates else None
         if same is not None and same in pool:
             entry = pool.pop(same)
         else:
@@ -318,15 +321,14 @@ class SceneCache:
             self.owner_keys[owner] = key
         return entry
 
-    def _changed(self, inst, obj, entry, dirty_objects, fingerprints):
-        if dirty_objects is not None:
-            source = inst.parent if inst.is_instance and inst.parent is not None else obj
-            original = getattr(source, "original", None) or source
-            return original.as_pointer() in dirty_objects or obj.original.as_pointer() in dirty_objects
-        if fingerprints:
-            fp = _fingerprint(obj)
-            return fp is None or fp != entry[2]
-        return False
+    def _changed(self, inst, obj, dirty_objects):
+        """With updates: whether Blender says the geometry of the object (or of the instancer
+        that made this instance) changed."""
+        if not dirty_objects:
+            return False
+        source = inst.parent if inst.is_instance and inst.parent is not None else obj
+        original = getattr(source, "original", None) or source
+        return original.as_pointer() in dirty_objects or obj.original.as_pointer() in dirty_objects
 
     def _export_mesh(self, obj, depsgraph, entry, fingerprint=None):
         data = export.mesh_data(obj, self.materials, depsgraph)
