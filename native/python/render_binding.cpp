@@ -59,6 +59,14 @@ CameraParams to_camera(const py::dict& camera) {
         throw py::type_error("camera: '" + key + "' must be a number");
       }
     };
+    // A whole count: converting a double outside int's range (or NaN) to int is undefined
+    // behaviour, so it is checked first and refused by name.
+    auto count = [&]() {
+      const double x = number();
+      if (!(x >= 0.0 && x <= 1.0e9) || x != std::floor(x))
+        throw py::value_error("camera: '" + key + "' must be a whole number from 0 to 1e9, got " + std::to_string(x));
+      return int(x);
+    };
     if (key == "type") {
       const std::string t = py::str(v);
       if (t == "PERSP") p.type = CameraType::Perspective;
@@ -75,11 +83,11 @@ CameraParams to_camera(const py::dict& camera) {
     } else if (key == "use_border") {
       p.use_border = PyObject_IsTrue(v.ptr()) == 1;
     } else if (key == "resolution_x") {
-      p.resolution_x = int(number());
+      p.resolution_x = count();
     } else if (key == "resolution_y") {
-      p.resolution_y = int(number());
+      p.resolution_y = count();
     } else if (key == "resolution_percentage") {
-      p.resolution_percentage = int(number());
+      p.resolution_percentage = count();
     } else {
       const float x = float(number());
       if (key == "lens") p.lens = x;

@@ -282,6 +282,14 @@ def test_render_larger_than_memory_is_refused_before_allocating():
     assert "1000000 x 1000000" in str(info.value)
 
 
+@pytest.mark.parametrize("key, value", [("resolution_x", 1e12), ("resolution_y", float("nan")),
+                                        ("resolution_percentage", 2.0**40), ("resolution_x", 2.5),
+                                        ("resolution_x", -3)])
+def test_camera_counts_outside_int_range_or_fractional_are_refused_by_name(key, value):
+    # Converted to int only after the check: a double beyond int's range is undefined behaviour.
+    refused(lambda: toyrt.camera_window(camera(**{key: value})), ValueError, f"'{key}' must be a whole number")
+
+
 @pytest.mark.parametrize("power", [-1.0, float("nan"), float("inf")])
 def test_negative_or_non_finite_point_light_power_is_refused(power):
     refused(lambda: toyrt.Scene().add_point_light((0, 0, 1), power), ValueError, "power must be finite and >= 0")
