@@ -27,54 +27,15 @@ import sys
 import tempfile
 import time
 import traceback
-from contextlib import contextmanager
 
 import bpy
 import numpy as np
 
-RESULTS = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # for harness (see there)
+from harness import RESULTS, captured_output, check, finish, run_part  # noqa: E402
+
 TMP = tempfile.mkdtemp(prefix="toyrt-test-bad-scenes-")
 HAS_BINARY = bool(bpy.app.binary_path) and not os.environ.get("TOYRT_NO_BLENDER_BINARY")
-
-
-def check(cond, what):
-    RESULTS.append(bool(cond))
-    print(("  ok: " if cond else "  FAIL: ") + what, flush=True)
-
-
-def run_part(fn):
-    print(f"{fn.__name__}:", flush=True)
-    start = time.perf_counter()
-    try:
-        fn()
-    except Exception:
-        traceback.print_exc()
-        check(False, f"{fn.__name__} raised")
-    print(f"  ({time.perf_counter() - start:.1f} s)", flush=True)
-
-
-@contextmanager
-def captured_output():
-    """What Blender's C code prints (reports go to file descriptors 1 and 2)."""
-    sys.stdout.flush()
-    sys.stderr.flush()
-    buf = tempfile.TemporaryFile()
-    saved = os.dup(1), os.dup(2)
-    os.dup2(buf.fileno(), 1)
-    os.dup2(buf.fileno(), 2)
-    text = []
-    try:
-        yield text
-    finally:
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os.dup2(saved[0], 1)
-        os.dup2(saved[1], 2)
-        os.close(saved[0])
-        os.close(saved[1])
-        buf.seek(0)
-        text.append(buf.read().decode(errors="replace"))
-        buf.close()
 
 
 # ---- scene building ---------------------------------------------------------------------------
@@ -455,6 +416,4 @@ except Exception:
     traceback.print_exc()
     RESULTS.append(False)
 shutil.rmtree(TMP, ignore_errors=True)
-failed = RESULTS.count(False)
-print(f"bad scenes: {len(RESULTS) - failed} passed, {failed} failed", flush=True)
-sys.exit(1 if failed else 0)
+finish("bad scenes")

@@ -18,16 +18,13 @@ import traceback
 import bpy
 import numpy as np
 
-RESULTS = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # for harness (see there)
+from harness import RESULTS, check, finish  # noqa: E402
+
 TMP = tempfile.mkdtemp(prefix="toyrt-test-border-")
 W, H = 64, 48
 BORDER = (0.25, 0.75, 0.25, 0.5)            # min x, max x, min y, max y
 X0, X1, Y0, Y1 = 16, 48, 12, 24             # the same in pixels (rows from the bottom)
-
-
-def check(cond, what):
-    RESULTS.append(bool(cond))
-    print(("  ok: " if cond else "  FAIL: ") + what, flush=True)
 
 
 def build_scene():
@@ -123,6 +120,4 @@ except Exception:
     traceback.print_exc()
     RESULTS.append(False)
 shutil.rmtree(TMP, ignore_errors=True)
-failed = RESULTS.count(False)
-print(f"border: {len(RESULTS) - failed} passed, {failed} failed", flush=True)
-sys.exit(1 if failed else 0)
+finish("border")

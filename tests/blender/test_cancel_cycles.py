@@ -25,15 +25,12 @@ import traceback
 import bpy
 import numpy as np
 
-RESULTS = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # for harness (see there)
+from harness import RESULTS, check, finish  # noqa: E402
+
 CYCLES = int(os.environ.get("TOYRT_CANCEL_CYCLES", "50"))
 LATENCY_LIMIT = 0.2      # seconds, the figure, for cancels while rendering
 PHASES = ("export", "bvh", "render")
-
-
-def check(cond, what):
-    RESULTS.append(bool(cond))
-    print(("  ok: " if cond else "  FAIL: ") + what, flush=True)
 
 
 def os_threads():
@@ -194,6 +191,4 @@ try:
 except Exception:
     traceback.print_exc()
     RESULTS.append(False)
-failed = RESULTS.count(False)
-print(f"cancel cycles: {len(RESULTS) - failed} passed, {failed} failed", flush=True)
-sys.exit(1 if failed else 0)
+finish("cancel cycles")

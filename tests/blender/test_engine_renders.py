@@ -12,12 +12,8 @@ import traceback
 import bpy
 import numpy as np
 
-RESULTS = []
-
-
-def check(cond, what):
-    RESULTS.append(bool(cond))
-    print(("  ok: " if cond else "  FAIL: ") + what, flush=True)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # for harness (see there)
+from harness import RESULTS, check, finish  # noqa: E402
 
 
 def build_scene(with_camera=True):
@@ -113,6 +109,4 @@ try:
 except Exception:
     traceback.print_exc()
     RESULTS.append(False)
-failed = RESULTS.count(False)
-print(f"engine: {len(RESULTS) - failed} passed, {failed} failed", flush=True)
-sys.exit(1 if failed else 0)
+finish("engine")

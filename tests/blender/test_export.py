@@ -27,60 +27,21 @@ import tempfile
 import threading
 import time
 import traceback
-from contextlib import contextmanager
 
 import bpy
 import numpy as np
 
-RESULTS = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # for harness (see there)
+from harness import RESULTS, captured_output, check, finish, run_part  # noqa: E402
+
 TMP = tempfile.mkdtemp(prefix="toyrt-test-export-")   # every file the test writes; removed at the end
 RENDERABLE = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
-
-
-def check(cond, what):
-    RESULTS.append(bool(cond))
-    print(("  ok: " if cond else "  FAIL: ") + what, flush=True)
-
-
-def run_part(fn):
-    print(f"{fn.__name__}:", flush=True)
-    start = time.perf_counter()
-    try:
-        fn()
-    except Exception:
-        traceback.print_exc()
-        check(False, f"{fn.__name__} raised")
-    print(f"  ({time.perf_counter() - start:.1f} s)", flush=True)
 
 
 def addon():
     import render_toyrt
     from render_toyrt import export
     return export, render_toyrt.native()
-
-
-@contextmanager
-def captured_output():
-    """Everything written to file descriptors 1 and 2 (Blender's C code prints its reports there)."""
-    sys.stdout.flush()
-    sys.stderr.flush()
-    buf = tempfile.TemporaryFile()
-    saved = os.dup(1), os.dup(2)
-    os.dup2(buf.fileno(), 1)
-    os.dup2(buf.fileno(), 2)
-    text = []
-    try:
-        yield text
-    finally:
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os.dup2(saved[0], 1)
-        os.dup2(saved[1], 2)
-        os.close(saved[0])
-        os.close(saved[1])
-        buf.seek(0)
-        text.append(buf.read().decode(errors="replace"))
-        buf.close()
 
 
 # ---- scene building ---------------------------------------------------------------------------
@@ -719,6 +680,4 @@ except Exception:
     traceback.print_exc()
     RESULTS.append(False)
 shutil.rmtree(TMP, ignore_errors=True)
-failed = RESULTS.count(False)
-print(f"export: {len(RESULTS) - failed} passed, {failed} failed", flush=True)
-sys.exit(1 if failed else 0)
+finish("export")
