@@ -498,8 +498,12 @@ def write_doc(results):
         "scene sync; a cached reference keeps the time of the run that made it).",
         "",
         "Notes:",
-        "- The point lights have radius 0: Cycles 3.4 renders a point light of radius R as a disk facing the "
-        "shading point, TOYRT as a sphere (they differ by about R^2/d^2; see docs/render.md).",
+        ("- The point lights have radius 0: Cycles 3.4 renders a point light of radius R as a disk facing the "
+         "shading point, TOYRT as a sphere (they differ by about R^2/d^2; see docs/render.md)."
+         if bpy.app.version < (4, 0, 0) else
+         "- Area lights: Cycles 4.x and later give an area light of power P the radiance P / (pi A), 3.4 "
+         "P / (4 A); the exporter scales the power by 4 / pi on 4.x (docs/blender.md). Point lights of radius R "
+         "are spheres here, as in TOYRT."),
         "- Lights are seen by camera rays and through glass (Blender's per-object ray visibility, which the "
         "exporter passes on): glass_sphere_visible_light keeps Cycles' defaults and passes at 4x the samples "
         "(the light's image through the sphere is the noisiest part of both renders); glass_sphere and "
