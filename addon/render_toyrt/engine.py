@@ -75,8 +75,10 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         samples = settings.samples
         rays_per_sample = 2 + stats.get("lights", 0)  # camera ray, shadow rays, a specular step
         self.update_stats("TOYRT", "Building BVH")
+        # Esc is polled during the build too: a million-triangle SAH build takes about a second.
         built = cache.commit(builder=settings.builder, threads=self._threads(scene),
-                             expected_rays=float(width * height * samples * rays_per_sample))
+                             expected_rays=float(width * height * samples * rays_per_sample),
+                             should_cancel=self.test_break)
         build_ms = t_scene.last_commit["build_ms"] if built else 0.0
         if self.test_break():
             return

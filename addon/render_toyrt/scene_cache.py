@@ -190,11 +190,14 @@ class SceneCache:
         self.counters["fast_moves"] += 1
         return True
 
-    def commit(self, builder="auto", threads=0, expected_rays=None):
-        """Commit if anything changed; returns whether it did."""
+    def commit(self, builder="auto", threads=0, expected_rays=None, should_cancel=None):
+        """Commit if anything changed; returns whether it did. A build stopped by should_cancel
+        leaves the scene uncommitted (returns False): the next commit builds what is missing."""
         if self.scene.committed:
             return False
-        self.scene.commit(builder=builder, threads=threads, expected_rays=expected_rays)
+        if not self.scene.commit(builder=builder, threads=threads, expected_rays=expected_rays,
+                                 should_cancel=should_cancel):
+            return False
         info = self.scene.last_commit
         self.counters["commits"] += 1
         self.counters["mesh_bvhs_built"] += info["meshes_built"]

@@ -136,6 +136,9 @@ class Builder {
   }
 
   void build(uint32_t node, size_t begin, size_t end, const RangeBounds& rb, int depth) {
+    // One relaxed load per node; the exception crosses parallel_invoke, which cancels the
+    // sibling tasks and rethrows it on the calling thread.
+    if (cfg_.cancel && cfg_.cancel->load(std::memory_order_relaxed)) throw BuildCancelled();
     nodes_[node].set_bbox(rb.box);
     const size_t n = end - begin;
     if (n == 1) return make_leaf(node, begin, end);

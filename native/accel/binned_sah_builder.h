@@ -5,6 +5,9 @@
 
 #include "accel/bvh.h"
 
+#include <atomic>
+#include <stdexcept>
+
 namespace toyrt {
 
 struct BinnedSahConfig {
@@ -16,6 +19,14 @@ struct BinnedSahConfig {
   float traversal_cost = 3.0f;
   float intersection_cost = 1.0f;
   size_t parallel_threshold = 8192;  // ranges at least this large are binned and split in parallel
+  // Polled at every node: when it reads true the build stops by throwing BuildCancelled, so a
+  // user's cancel does not wait for a million-triangle build to finish. Not owned; may be null.
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+// Thrown by a build (and Scene::commit) that was cancelled through its cancel flag.
+struct BuildCancelled : std::runtime_error {
+  BuildCancelled() : std::runtime_error("BVH build cancelled") {}
 };
 
 // Builds over `count` primitives. Runs on the calling thread's TBB arena, so the caller chooses

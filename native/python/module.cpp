@@ -8,7 +8,11 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstring>
+#include <future>
+#include <thread>
 #include <variant>
 #include <mutex>
 #include <shared_mutex>
@@ -363,7 +367,7 @@ class PyScene {
     return scene_.add_instance(uint32_t(mesh), m);
   }
 
-  void commit(const std::string& builder, int threads, py::handle expected_rays) {
+  bool commit(const std::string& builder, int threads, py::handle expected_rays, py::object should_cancel) {
     CommitOptions opt;
     opt.builder = parse_builder(builder);
     opt.threads = check_threads(threads);
@@ -375,14 +379,48 @@ class PyScene {
         throw py::value_error("expected_rays must be a finite number >= 0 (or None when unknown)");
     }
     std::string warning;
+    bool cancelled = false;
     {
       std::unique_lock lock(mutex_);
       py::gil_scoped_release release;
-      scene_.commit(opt);
+      if (should_cancel.is_none()) {
+        scene_.commit(opt);
+      } else {
+        // The build runs on its own thread while this one polls should_cancel every 10 ms (with
+        // the GIL, as Blender's test_break needs); a true answer, or an exception from it, sets
+        // the flag the builders poll. Joined before anything else happens, exceptions included.
+        std::atomic<bool> cancel{false};
+        opt.cancel = &cancel;
+        std::packaged_task<void()> task([&] { scene_.commit(opt); });
+        std::future<void> done = task.get_future();
+        std::thread worker(std::move(task));
+        std::exception_ptr poll_error;
+        while (done.wait_for(std::chrono::milliseconds(10)) != std::future_status::ready) {
+          if (cancel.load() || poll_error) continue;
+          py::gil_scoped_acquire gil;
+          try {
+            if (should_cancel().cast<bool>()) cancel.store(true);
+          } catch (...) {
+            poll_error = std::current_exception();
+            cancel.store(true);
+          }
+        }
+        worker.join();
+        try {
+          done.get();
+        } catch (const BuildCancelled&) {
+          cancelled = true;
+        }
+        if (poll_error) {
+          py::gil_scoped_acquire gil;
+          std::rethrow_exception(poll_error);
+        }
+      }
       warning = scene_.commit_stats().warning;
     }
     // One clear warning when the LBVH could not run and the SAH builder stood in.
     if (!warning.empty() && PyErr_WarnEx(PyExc_RuntimeWarning, warning.c_str(), 1) != 0) throw py::error_already_set();
+    return !cancelled;
   }
 
   py::dict last_commit() {
@@ -650,8 +688,11 @@ PYBIND11_MODULE(toyrt, m) {
       .def("add_instance", &PyScene::add_instance, py::arg("mesh"), py::arg("transform"),
            "Places mesh `mesh` again with a (4, 4) row-major affine world matrix; returns the instance id.")
       .def("commit", &PyScene::commit, py::arg("builder") = "auto", py::arg("threads") = 0,
-           py::arg("expected_rays") = py::none(),
-           "Builds the BVHs of new meshes and the top level.\n"
+           py::arg("expected_rays") = py::none(), py::arg("should_cancel") = py::none(),
+           "Builds the BVHs of new meshes and the top level; returns True, or False when cancelled.\n"
+           "should_cancel(): polled every 10 ms while building; when it returns true the build stops\n"
+           "within a few milliseconds and the scene stays uncommitted (meshes already built keep their BVH,\n"
+           "so the next commit builds only the rest).\n"
            "builder: 'sah' (binned SAH on the CPU: the faster trees), 'lbvh' (Karras' linear BVH as OpenCL\n"
            "kernels: the faster builds; falls back to 'sah' with a RuntimeWarning when no OpenCL device or\n"
            "kernel build is available), or 'auto' (per mesh, whichever makes build + tracing cheaper for\n"

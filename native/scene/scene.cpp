@@ -88,10 +88,17 @@ void Scene::commit(const CommitOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   stats_ = {};
   instances_.shrink_to_fit();  // many instances are added one by one: drop the growth slack
+  committed_ = false;  // until this commit completes (it may be cancelled)
+  BinnedSahConfig sah = options.sah;
+  sah.cancel = options.cancel;
+  auto check_cancel = [&] {
+    if (options.cancel && options.cancel->load(std::memory_order_relaxed)) throw BuildCancelled();
+  };
   run_with_threads(options.threads, [&] {
     // Meshes first (each build is parallel inside), then the top level over their boxes.
     for (auto& mesh : meshes_) {
       if (mesh->built()) continue;
+      check_cancel();
       BuilderKind kind = options.builder;
       if (kind == BuilderKind::Auto) kind = options.cost_model.choose(mesh->triangles().size(), options.expected_rays);
       if (kind == BuilderKind::Lbvh) {
@@ -107,7 +114,7 @@ void Scene::commit(const CommitOptions& options) {
         }
       }
       if (kind == BuilderKind::Sah) {
-        mesh->build(options.sah);
+        mesh->build(sah);
         ++stats_.sah_meshes;
       }
       ++stats_.meshes_built;
@@ -134,7 +141,8 @@ void Scene::commit(const CommitOptions& options) {
       boxes.push_back(inst.world_bounds);
       centers.push_back(inst.world_bounds.center());
     }
-    BinnedSahConfig top_config = options.sah;
+    check_cancel();
+    BinnedSahConfig top_config = sah;
     top_config.max_leaf = 1;  // an instance test is a whole traversal: never group them
     top_ = build_binned_sah(boxes.data(), centers.data(), boxes.size(), top_config);
     for (uint32_t& id : top_.prim_ids) id = placed[id];

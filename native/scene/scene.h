@@ -31,6 +31,10 @@ struct CommitOptions {
   BinnedSahConfig sah;
   LbvhConfig lbvh;
   BuilderCostModel cost_model;
+  // Cancel flag (not owned; may be null): polled between meshes and inside every SAH build.
+  // A cancelled commit throws BuildCancelled and leaves the scene uncommitted; meshes built
+  // before the cancel keep their BVHs, so the next commit builds only the rest.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct CommitStats {
