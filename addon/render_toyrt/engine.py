@@ -64,7 +64,11 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         # One cache per Blender scene: the frames of an animation reuse the meshes that did not
         # change, and the native scene is edited in place, so memory stays flat.
         cache = scene_cache.for_render(depsgraph, toyrt)
-        cache.sync(depsgraph)
+        try:
+            cache.sync(depsgraph, should_cancel=self.test_break)
+        except scene_cache.ExportCancelled:
+            scene_cache.discard_render_cache(depsgraph)  # half updated: the next F12 starts afresh
+            return
         t_scene, stats = cache.scene, cache.stats
         if cache.approximated:
             self.report({"WARNING"}, "TOYRT approximated: " + "; ".join(cache.approximated))

@@ -108,6 +108,15 @@ def _fingerprint(obj):
     return h.digest()
 
 
+class ExportCancelled(Exception):
+    """Raised by sync() when its should_cancel answers true. The cache is then half updated:
+    the caller must drop it (discard_render_cache) so the next render starts from scratch."""
+
+
+# should_cancel is polled every this many object instances, and before each mesh export.
+_POLL_EVERY = 256
+
+
 class SceneCache:
     def __init__(self, toyrt):
         self.toyrt = toyrt
@@ -120,6 +129,7 @@ class SceneCache:
         self.owner_keys = {}                   # object pointer -> the mesh key it showed last
         self.owner_instances = {}              # object pointer -> its instance ids (plain objects)
         self.lights = None                     # the recorded light calls last sent
+        self._should_cancel = None             # set by sync() for the length of a full walk
         self.synced = False
         self.stats = {}
         self.counters = dict(syncs=0, walks=0, meshes_exported=0, meshes_freed=0, instance_resets=0,
@@ -127,13 +137,18 @@ class SceneCache:
                              commits=0, mesh_bvhs_built=0, top_level_builds=0)
 
     # ---------------------------------------------------------------------------------------
-    def sync(self, depsgraph, updates=None):
+    def sync(self, depsgraph, updates=None, should_cancel=None):
         """Bring the native scene up to date with `depsgraph`. Without `updates` (the first sync,
         and final renders) everything is walked and meshes are compared by fingerprint; with
-        `depsgraph.updates` only what they name is done."""
+        `depsgraph.updates` only what they name is done. should_cancel() (e.g. the engine's
+        test_break) is polled during a full walk; when true, ExportCancelled is raised."""
         self.counters["syncs"] += 1
         if not self.synced or updates is None:
-            self._walk(depsgraph, dirty_objects=None, fingerprints=True)
+            self._should_cancel = should_cancel
+            try:
+                self._walk(depsgraph, dirty_objects=None, fingerprints=True)
+            finally:
+                self._should_cancel = None
             self.synced = True
             return
         geometry, walk, scene_update, moved = set(), False, False, []
@@ -228,7 +243,10 @@ class SceneCache:
             for k, e in pool.items():
                 if e[2] is not None:  # identical copies (objects with the same modifiers) share a list
                     by_fingerprint.setdefault(e[2], []).append(k)
-        for inst in depsgraph.object_instances:
+        poll = self._should_cancel
+        for n, inst in enumerate(depsgraph.object_instances):
+            if poll is not None and n % _POLL_EVERY == 0 and poll():
+                raise ExportCancelled()
             obj = inst.object
             if obj is None:
                 continue
@@ -334,6 +352,9 @@ class SceneCache:
         return original.as_pointer() in dirty_objects or obj.original.as_pointer() in dirty_objects
 
     def _export_mesh(self, obj, depsgraph, entry, fingerprint=None):
+        poll = self._should_cancel
+        if poll is not None and poll():  # a mesh export can take a few hundred ms: ask first
+            raise ExportCancelled()
         data = export.mesh_data(obj, self.materials, depsgraph)
         self.counters["meshes_exported"] += 1
         old_id = entry[0] if entry is not None else -1
@@ -396,6 +417,12 @@ def for_render(depsgraph, toyrt):
         _render_caches.clear()  # one scene at a time: another scene's meshes are not kept alive
         cache = _render_caches[key] = SceneCache(toyrt)
     return cache
+
+
+def discard_render_cache(depsgraph):
+    """Drops the scene's cache after a cancelled export (it may be half updated)."""
+    scene = depsgraph.scene
+    _render_caches.pop((getattr(scene, "original", scene) or scene).as_pointer(), None)
 
 
 def free_render_caches():
