@@ -276,7 +276,18 @@ class _Materials:
 # ---------------------------------------------------------------------------------------------
 # meshes
 
-def _mesh_arrays(mesh):
+class ExportCancelled(Exception):
+    """A should_cancel poll answered true during an export."""
+
+
+def _stop_if(poll):
+    """Between the stages of a mesh's export (each a few tens of ms per million triangles), so
+    Esc on a million-triangle mesh is not held for its whole export."""
+    if poll is not None and poll():
+        raise ExportCancelled()
+
+
+def _mesh_arrays(mesh, poll=None):
     """Vertices (N,3) f32, triangles (M,3) u32, normals, corner UVs (M,3,2) f32 or None, material
     indices (M,) i32, from an evaluated mesh, through foreach_get.
 
@@ -296,6 +307,7 @@ def _mesh_arrays(mesh):
     verts, tris = verts.reshape(nv, 3), tris.reshape(nt, 3)
     if nt == 0:
         return verts, tris, None, None, np.zeros(0, np.int32)
+    _stop_if(poll)
 
     loops = None  # triangle corners -> mesh loops, read only when something per corner needs it
 
@@ -307,6 +319,7 @@ def _mesh_arrays(mesh):
         return loops
 
     normals = _mesh_normals(mesh, nt, corner_loops)
+    _stop_if(poll)
 
     uvs = None
     layers = mesh.uv_layers
@@ -319,6 +332,7 @@ def _mesh_arrays(mesh):
             # np.take, not uv[...] fancy indexing: 3x faster on a million triangles.
             uvs = np.take(uv.reshape(-1, 2), corner_loops(), axis=0).reshape(nt, 3, 2)
 
+    _stop_if(poll)
     if len(getattr(mesh, "materials", ())) <= 1:
         # One slot or none: every index maps to slot 0 (the caller clips), no need to read them.
         mat_idx = np.zeros(nt, np.int32)
@@ -532,9 +546,10 @@ def _add_mesh(scene, obj, matrix, materials, depsgraph):
     return (mid, len(tris))
 
 
-def mesh_data(obj, materials, depsgraph):
+def mesh_data(obj, materials, depsgraph, poll=None):
     """An evaluated object's geometry as the arrays add_mesh / replace_mesh take: (vertices,
-    triangles, normals, uvs, material ids), or None when it has no triangles."""
+    triangles, normals, uvs, material ids), or None when it has no triangles. poll(): asked
+    between stages; when it answers true, ExportCancelled is raised."""
     try:
         mesh = obj.to_mesh(preserve_all_data_layers=False, depsgraph=depsgraph)
     except TypeError:
@@ -544,7 +559,8 @@ def mesh_data(obj, materials, depsgraph):
     if mesh is None:
         return None
     try:
-        verts, tris, normals, uvs, mat_idx = _mesh_arrays(mesh)
+        _stop_if(poll)
+        verts, tris, normals, uvs, mat_idx = _mesh_arrays(mesh, poll)
         if len(tris) == 0:
             return None
         slot_map = _object_materials(obj, mesh, materials)

@@ -108,9 +108,10 @@ def _fingerprint(obj):
     return h.digest()
 
 
-class ExportCancelled(Exception):
-    """Raised by sync() when its should_cancel answers true. The cache is then half updated:
-    the caller must drop it (discard_render_cache) so the next render starts from scratch."""
+# Raised by sync() when its should_cancel answers true (export.py raises it between the stages
+# of one mesh too). The cache is then half updated: the caller must drop it
+# (discard_render_cache) so the next render starts from scratch.
+ExportCancelled = export.ExportCancelled
 
 
 # should_cancel is polled every this many object instances, and before each mesh export.
@@ -352,10 +353,11 @@ class SceneCache:
         return original.as_pointer() in dirty_objects or obj.original.as_pointer() in dirty_objects
 
     def _export_mesh(self, obj, depsgraph, entry, fingerprint=None):
+        # A mesh export can take a few hundred ms: Esc is asked between its stages (export.py)
+        # and once more before the copy into the native scene.
         poll = self._should_cancel
-        if poll is not None and poll():  # a mesh export can take a few hundred ms: ask first
-            raise ExportCancelled()
-        data = export.mesh_data(obj, self.materials, depsgraph)
+        data = export.mesh_data(obj, self.materials, depsgraph, poll=poll)
+        export._stop_if(poll)
         self.counters["meshes_exported"] += 1
         old_id = entry[0] if entry is not None else -1
         if data is None:

@@ -9,10 +9,10 @@
 #   - while rendering: F12 (bpy.ops.render.render) runs the engine as users do, with the native
 #     module seen through a proxy whose Scene.render() adds "Esc after 50 ms" to the engine's own
 #     should_cancel (its test_break); tiles, begin_result/end_result and all are the engine's;
-#   - during the export, which the engine interrupts between objects and before each mesh (not
-#     inside one mesh's export), the cycle runs the exporter (export.export_scene) and stops after
-#     it: with this scene's one big mesh the cancel latency is the rest of that mesh's export,
-#     measured and printed; that Esc stops the export before any mesh is read is checked once;
+#   - during the export, which the engine interrupts between objects and between the stages of a
+#     mesh's export, the cycle runs the exporter (export.export_scene, which does not poll) and
+#     stops after it: the time printed is what a cancel would wait without polling; that Esc stops
+#     the engine's export before any mesh is read is checked once;
 #   - during the BVH build, the cycle runs Scene.commit with the engine's kind of should_cancel,
 #     answering "Esc" 5 ms into the build: the build stops and the latency is checked.
 # Checked: a render cancelled while rendering returns within 0.2 s of Esc (the median of 17); no
