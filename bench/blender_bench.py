@@ -13,13 +13,15 @@ import hashlib
 import importlib.util
 import inspect
 import json
-import math
 import sys
 import time
 from pathlib import Path
 
 import bpy
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scenes"))
+from cycles_like_toyrt import configure_cycles  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 CYCLES_SETUP_REVISION = 1  # bump when the Cycles settings below change meaning
@@ -54,30 +56,8 @@ def setup_output(scene, width, height):
 
 
 def setup_cycles(scene, samples, specular_depth):
-    """Cycles restricted to TOYRT's light transport (as tests/blender/test_cycles_parity.py):
-    direct light only (max bounces 0), or only specular chains through glass; Box filter of
-    width 1; no denoising, adaptive sampling, clamping or light threshold."""
-    scene.render.engine = "CYCLES"
-    c = scene.cycles
-    c.device = "CPU"
-    c.samples = samples
-    c.use_denoising = False
-    c.use_adaptive_sampling = False
-    c.seed = 0
-    c.pixel_filter_type = "BOX"
-    c.filter_width = 1.0
-    c.light_sampling_threshold = 0.0
-    c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
-    c.blur_glossy = 0.0
-    c.caustics_reflective = c.caustics_refractive = True
-    if specular_depth:
-        c.max_bounces = specular_depth
-        c.diffuse_bounces = 0
-        c.glossy_bounces = specular_depth  # Cycles' glass reflection is a glossy bounce
-        c.transmission_bounces = specular_depth
-        c.transparent_max_bounces = specular_depth
-    else:
-        c.max_bounces = 0
+    """Cycles restricted to TOYRT's light transport (scenes/cycles_like_toyrt.py), float output."""
+    configure_cycles(scene, samples, specular_depth)
     scene.render.image_settings.file_format = "OPEN_EXR"
     scene.render.image_settings.color_depth = "32"
     scene.render.image_settings.color_mode = "RGBA"
@@ -128,6 +108,7 @@ def cache_key(job, path):
     for f in scene_sources(path):
         h.update(f.read_bytes())
     h.update(inspect.getsource(setup_cycles).encode())
+    h.update(inspect.getsource(configure_cycles).encode())
     h.update(json.dumps(dict(options=job.get("options", {}), size=(job["width"], job["height"]),
                              spp=job["ref_spp"], depth=job["specular_depth"], blender=bpy.app.version_string,
                              revision=CYCLES_SETUP_REVISION), sort_keys=True).encode())

@@ -9,6 +9,9 @@ import sys
 
 import bpy
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scenes"))
+from cycles_like_toyrt import configure_cycles  # noqa: E402
+
 argv = sys.argv[sys.argv.index("--") + 1:]
 engine, samples, percent = argv[0], int(argv[1]), int(argv[2])
 scene = bpy.context.scene
@@ -22,23 +25,7 @@ r.threads_mode = "AUTO"
 scene.view_settings.view_transform = "Standard"
 scene.view_settings.look = "None"
 if engine == "CYCLES":
-    r.engine = "CYCLES"
-    c = scene.cycles
-    c.device = "CPU"
-    c.samples = samples
-    c.use_denoising = False
-    c.use_adaptive_sampling = False
-    c.seed = 0
-    c.pixel_filter_type = "BOX"
-    c.filter_width = 1.0
-    c.light_sampling_threshold = 0.0
-    c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
-    c.blur_glossy = 0.0
-    c.caustics_reflective = c.caustics_refractive = True
-    c.max_bounces = 8
-    c.diffuse_bounces = 0
-    c.glossy_bounces = c.transmission_bounces = c.transparent_max_bounces = 8
-    c.volume_bounces = 0
+    configure_cycles(scene, samples, 8)
 else:
     r.engine = "TOYRT"
     scene.toyrt.samples = samples

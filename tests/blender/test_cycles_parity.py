@@ -29,6 +29,8 @@ import numpy as np
 from mathutils import Vector
 
 REPO = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(REPO / "scenes"))
+from cycles_like_toyrt import configure_cycles  # noqa: E402
 # The build folder of this run (`make test-blender BUILD=...` and run_with_bpy.py set it).
 CACHE = Path(os.environ.get("TOYRT_BUILD_DIR", REPO / "build")) / "parity-cache"
 # Debian's Blender 3.4 writes docs/parity.md; a current Blender through the bpy module
@@ -311,28 +313,9 @@ def setup_output(scene):
 
 
 def setup_cycles(scene, samples, transmission):
-    scene.render.engine = "CYCLES"
-    c = scene.cycles
-    c.device = "CPU"
-    c.samples = samples
-    c.use_denoising = False
-    c.use_adaptive_sampling = False
-    c.seed = 0
-    c.pixel_filter_type = "BOX"
-    c.filter_width = 1.0
-    c.light_sampling_threshold = 0.0     # no probabilistic light termination (unbiased, but noisier)
-    c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
-    c.blur_glossy = 0.0
-    c.caustics_reflective = c.caustics_refractive = True
-    if transmission:
-        c.max_bounces = transmission
-        c.diffuse_bounces = 0
-        # Glass reflection is a glossy bounce in Cycles; TOYRT's Fresnel dielectric reflects too.
-        c.glossy_bounces = transmission
-        c.transmission_bounces = transmission
-        c.transparent_max_bounces = transmission
-    else:
-        c.max_bounces = 0
+    """Cycles restricted to TOYRT's light transport (scenes/cycles_like_toyrt.py), Standard view,
+    float output."""
+    configure_cycles(scene, samples, transmission)
     scene.view_settings.view_transform = "Standard"
     scene.view_settings.look = "None"
     scene.view_settings.exposure = 0.0
