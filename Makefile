@@ -2,7 +2,9 @@
 # `make setup` (which `make test` runs first) installs everything and is a fast no-op when done.
 #
 #   make setup        Debian packages, .venv with pytest, native build, add-on installed + enabled
-#   make test         C++ tests (ctest), Python tests (pytest), Blender tests (tests/blender), fuzz, sanitize
+#   make test         lint, C++ tests (ctest), Python tests (pytest), Blender tests (tests/blender), fuzz, sanitize
+#   make test-quick   lint, C++ and Python tests only (about a minute once built: the loop while coding)
+#   make lint         clang-format check of the C++ and ruff over the Python;  make format: apply clang-format
 #   make demo         renders the seed's Cornell box with TOYRT -> out/demo_0001.png
 #   make bench-trace  ray-tracing benchmark against Embree -> docs/bench-trace.md
 #   make bench-lbvh   builders (LBVH, SAH, Embree) from 10K to 4M triangles -> docs/lbvh-bench.md, lbvh.png
@@ -27,7 +29,7 @@ CMAKE_ARGS ?=
 
 APT_PACKAGES := cmake g++ make libglm-dev pybind11-dev python3-dev python3-numpy python3-venv \
 	libembree-dev libtbb-dev libgtest-dev googletest ocl-icd-opencl-dev opencl-headers \
-	pocl-opencl-icd clinfo blender python3-matplotlib clang libclang-rt-14-dev \
+	pocl-opencl-icd clinfo blender python3-matplotlib clang clang-format-14 libclang-rt-14-dev \
 	xvfb xauth libgl1-mesa-dri
 # The stamp's name carries a hash of the list, so adding a package re-runs the check.
 APT_STAMP   := $(BUILD)/.stamp-apt-$(firstword $(shell printf '%s' '$(APT_PACKAGES)' | md5sum))
@@ -36,10 +38,10 @@ VENV_STAMP  := $(VENV)/.stamp-requirements
 BLENDER_TESTS := $(sort $(wildcard tests/blender/test_*.py))
 
 .PHONY: bench help setup apt venv configure native addon test test-native test-python test-blender test-bpy bench-blender \
-	demo bench-trace bench-lbvh clean distclean fuzz sanitize
+	demo bench-trace bench-lbvh clean distclean fuzz sanitize lint format test-quick
 
 help:
-	@sed -n '2,13p' Makefile | sed 's/^# \{0,1\}//'
+	@sed -n '2,15p' Makefile | sed 's/^# \{0,1\}//'
 
 # ---- setup ------------------------------------------------------------------------------------------
 setup: apt venv native addon
@@ -77,7 +79,22 @@ addon: native
 
 # ---- tests ------------------------------------------------------------------------------------------
 test: setup
-	@$(MAKE) --no-print-directory test-native test-python test-blender test-bpy fuzz sanitize
+	@$(MAKE) --no-print-directory lint test-native test-python test-blender test-bpy fuzz sanitize
+
+test-quick: native venv
+	@$(MAKE) --no-print-directory lint test-native test-python
+
+# Every C++ file we wrote (not the generated ones in build*/) and every Python file: one style each
+# (.clang-format, ruff.toml), checked, never rewritten, by `make test`.
+CXX_SOURCES = $(shell git ls-files '*.cpp' '*.h' 2>/dev/null || find native tests bench -name '*.cpp' -o -name '*.h')
+PY_SOURCES  := addon scenes tests bench scripts
+
+lint: venv
+	clang-format-14 --dry-run --Werror $(CXX_SOURCES)
+	$(VENV)/bin/ruff check $(PY_SOURCES)
+
+format:
+	clang-format-14 -i $(CXX_SOURCES)
 
 test-native:
 	ctest --test-dir $(BUILD) --output-on-failure --no-tests=error
