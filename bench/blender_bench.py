@@ -8,7 +8,7 @@
 #
 # Times are wall-clock seconds from the Blender scene to an image, for every renderer:
 #   Cycles: bpy.ops.render.render() (its scene sync, BVH build and render; the EXR is written after);
-#   TOYRT:  the add-on's export_scene() + commit() (BVH build) + render().
+#   TOYRT:  the add-on's sync.export_scene() + commit() (BVH build) + render().
 import hashlib
 import importlib.util
 import inspect
@@ -136,10 +136,10 @@ def reference(job, path, cache):
     return img, info
 
 
-def toyrt_render(export, toyrt, spp, area, lights, depth, seed=0):
+def toyrt_render(sync, toyrt, spp, area, lights, depth, seed=0):
     """(image, seconds from scene to image, seconds of render() alone, last_render, export stats)."""
     t0 = time.perf_counter()
-    scene_t, cam, stats = export.export_scene(bpy.context.evaluated_depsgraph_get(), toyrt)
+    scene_t, cam, stats = sync.export_scene(bpy.context.evaluated_depsgraph_get(), toyrt)
     scene_t.commit()
     t1 = time.perf_counter()
     img = scene_t.render(cam, samples=spp, seed=seed, max_specular_depth=depth, area_light_sampling=area,
@@ -196,7 +196,7 @@ def material_description(mat, out_dir):
     return dict(type="diffuse", color=list(color.default_value)[:3])
 
 
-def dump_for_mitsuba(export, out_dir):
+def dump_for_mitsuba(mesh, out_dir):
     """Meshes (one PLY per mesh and material, in object space), their instances' world matrices,
     lights in Blender's units, the camera and the world colour: bench/mitsuba_bench.py converts."""
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -216,7 +216,7 @@ def dump_for_mitsuba(export, out_dir):
             continue
         key = obj.original.data.name
         if key not in shapes:
-            verts, tris, normals, uvs, mat_idx = export._mesh_arrays(obj.data)[:5]
+            verts, tris, normals, uvs, mat_idx = mesh.mesh_arrays(obj.data)[:5]
             if normals is None:  # flat shading (the exporter sends no corner normals then)
                 p = verts[tris]
                 n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
@@ -255,7 +255,7 @@ def main():
     out = Path(job["out"])
     out.parent.mkdir(parents=True, exist_ok=True)
     import render_toyrt
-    from render_toyrt import export
+    from render_toyrt import mesh, sync
 
     toyrt = render_toyrt.native()
     module, path = load_scene_module(job["module"])
@@ -268,7 +268,7 @@ def main():
             module.build(**options)
             setup_output(bpy.context.scene, job["width"], job["height"])
             bpy.context.view_layer.update()
-            runs = [toyrt_render(export, toyrt, job["spp"], "solid_angle", "auto", job["specular_depth"])
+            runs = [toyrt_render(sync, toyrt, job["spp"], "solid_angle", "auto", job["specular_depth"])
                     for _ in range(job["repeats"])]
             best = min(runs, key=lambda r: r[1])
             stats = best[4]
@@ -314,7 +314,7 @@ def main():
         for spp in job["toyrt_spp"]:
             best = None
             for _ in range(job["repeats"]):
-                r = toyrt_render(export, toyrt, spp, area, lights, depth)
+                r = toyrt_render(sync, toyrt, spp, area, lights, depth)
                 best = r if best is None or r[1] < best[1] else best
             img, seconds, render_s, last, stats = best
             rmse, relmse = errors(img, ref, mask)
@@ -328,7 +328,7 @@ def main():
     result["approximated"] = stats.get("approximated", [])
     result["runs"] = runs
     if job.get("mitsuba_dir"):
-        dump_for_mitsuba(export, Path(job["mitsuba_dir"]))
+        dump_for_mitsuba(mesh, Path(job["mitsuba_dir"]))
     out.write_text(json.dumps(result, indent=1))
 
 

@@ -5,8 +5,10 @@
 # built from native/ (toyrt.cpython-311-x86_64-linux-gnu.so), so the module sits beside this file
 # and imports as `render_toyrt.toyrt`; it is built for Debian's Python 3.11, Blender 3.4's.
 #
-# The parts: properties.py (settings at scene.toyrt), ui.py (panels), export.py (depsgraph to
-# numpy arrays and the native scene), engine.py (the render loop). No rendering logic in Python.
+# The parts: properties.py (settings at scene.toyrt), ui.py (panels), sync.py (the one walker of
+# the depsgraph and the one writer of the native scene) over the converters that return plain
+# data (mesh.py, materials.py, lights.py, world.py, camera.py), engine.py (the render loop) and
+# viewport.py (the 3D viewport's Rendered mode). No rendering logic in Python.
 
 bl_info = {
     "name": "TOYRT",

@@ -1,5 +1,5 @@
-"""The render engine: exports the depsgraph (export.py, kept between frames by scene_cache.py),
-forwards it to the native renderer, and streams finished tiles into Blender's render result; in
+"""The render engine: syncs the depsgraph into the native scene (sync.py, kept between frames),
+has the native renderer render it, and streams finished tiles into Blender's render result; in
 the 3D viewport's Rendered mode, viewport.py renders progressively. No rendering logic here."""
 import time
 
@@ -45,29 +45,30 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
     # ---- F12 and command-line renders ---------------------------------------------------------------
 
     def render(self, depsgraph):
-        from . import export, native
+        from . import native
 
         try:
-            self._render(depsgraph, native(), export)
+            self._render(depsgraph, native())
         except Exception as err:  # reaches the user (and makes a farm's frame fail), never crashes Blender
             self.report({"ERROR"}, f"TOYRT: {err}")
             print(f"TOYRT: render failed: {err}", flush=True)
 
-    def _render(self, depsgraph, toyrt, export):
-        from . import scene_cache
+    def _render(self, depsgraph, toyrt):
+        from . import sync
+        from .camera import export_camera
 
         scene = depsgraph.scene
         settings = scene.toyrt
         started = time.perf_counter()
         self.update_stats("TOYRT", "Exporting scene")
-        camera = export.export_camera(depsgraph)  # fails early without a camera
+        camera = export_camera(depsgraph)  # fails early without a camera
         # One cache per Blender scene: the frames of an animation reuse the meshes that did not
         # change, and the native scene is edited in place, so memory stays flat.
-        cache = scene_cache.for_render(depsgraph, toyrt)
+        cache = sync.for_render(depsgraph, toyrt)
         try:
             cache.sync(depsgraph, should_cancel=self.test_break)
-        except scene_cache.ExportCancelled:
-            scene_cache.discard_render_cache(depsgraph)  # half updated: the next F12 starts afresh
+        except sync.ExportCancelled:
+            sync.discard_render_cache(depsgraph)  # half updated: the next F12 starts afresh
             return
         t_scene, stats = cache.scene, cache.stats
         if cache.approximated:
@@ -149,10 +150,10 @@ def _set_rect(rect, pixels):
 @persistent
 def _on_load_pre(*_args):
     """A file is about to close: stop every viewport render and drop the final-render cache."""
-    from . import scene_cache, viewport
+    from . import sync, viewport
 
     viewport.close_all()
-    scene_cache.free_render_caches()
+    sync.free_render_caches()
 
 
 def register():
@@ -168,10 +169,10 @@ def register():
 def unregister():
     import atexit
 
-    from . import scene_cache, viewport
+    from . import sync, viewport
 
     viewport.close_all()
-    scene_cache.free_render_caches()
+    sync.free_render_caches()
     atexit.unregister(viewport.close_all)
     if _on_load_pre in bpy.app.handlers.load_pre:
         bpy.app.handlers.load_pre.remove(_on_load_pre)

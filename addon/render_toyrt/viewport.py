@@ -1,7 +1,7 @@
 """The 3D viewport's Rendered mode: a progressive render on a background thread.
 
     engine.view_update -> ViewportSession.update: stop the render thread, apply depsgraph.updates
-                          to the SceneCache (scene_cache.py), commit, mark the image stale
+                          to the SceneSync (sync.py), commit, mark the image stale
     engine.view_draw   -> ViewportSession.draw: the view's camera; a new view (camera or
                           navigation) or a stale image restarts the render; upload the newest
                           accumulated image as a GPUTexture and draw it through Blender's
@@ -31,7 +31,7 @@ def close_all():
         session.close()
 
 
-def view_camera(region, rv3d):
+def view_camera(region, rv3d) -> dict:
     """The camera dict of what a 3D view shows, from its projection (window_matrix) and view
     matrix, at the region's size. The projection is read back into Blender's own camera
     parameters (horizontal sensor fit), so camera view, zoom and pan come for free."""
@@ -67,9 +67,9 @@ def _view_key(camera):
 
 class ViewportSession:
     def __init__(self, toyrt, engine):
-        from .scene_cache import SceneCache
+        from .sync import SceneSync
 
-        self.cache = SceneCache(toyrt)
+        self.cache = SceneSync(toyrt)
         self._engine = weakref.ref(engine)  # a strong reference would keep Blender's engine alive
         self._thread = None
         self._stop = threading.Event()

@@ -53,13 +53,14 @@ def add_big_mesh(triangles_wanted=1_000_000):
 
 def measure(label, rows):
     import render_toyrt
-    from render_toyrt import export, scene_cache
+    from render_toyrt import sync
+    from render_toyrt.camera import export_camera
 
     toyrt = render_toyrt.native()
     scene = bpy.context.scene
     scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 800, 600, 100
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    cache = scene_cache.SceneCache(toyrt)
+    cache = sync.SceneSync(toyrt)
     t0 = time.perf_counter()
     cache.sync(depsgraph)
     export_s = time.perf_counter() - t0
@@ -82,7 +83,7 @@ def measure(label, rows):
         for i in range(MOVES):
             scene.camera.location.x += 0.02 * (1 if i % 2 else -1)
             bpy.context.view_layer.update()  # runs depsgraph_update_post with the camera's update
-            camera = export.export_camera(bpy.context.evaluated_depsgraph_get())
+            camera = export_camera(bpy.context.evaluated_depsgraph_get())
             small = dict(camera, resolution_x=200, resolution_y=150)
             t = time.perf_counter()
             cache.scene.render(small, samples=1, threads=THREADS)

@@ -70,7 +70,7 @@ def build():
 
 
 def main():
-    from render_toyrt import scene_cache
+    from render_toyrt import sync
 
     scene, sphere = build()
     samples = {}
@@ -93,7 +93,7 @@ def main():
 
     files = sorted(f for f in os.listdir(TMP) if f.endswith(".png"))
     check(len(files) == FRAMES, f"{FRAMES} frames written ({len(files)})")
-    caches = list(scene_cache._render_caches.values())
+    caches = sync.render_caches()
     check(len(caches) == 1, "one render cache for the scene")
     cache = caches[0]
     c = cache.counters

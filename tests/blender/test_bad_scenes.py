@@ -177,8 +177,8 @@ def errors_in(log):
 
 def export_stats():
     import render_toyrt
-    from render_toyrt import export
-    _, _, stats = export.export_scene(bpy.context.evaluated_depsgraph_get(), render_toyrt.native())
+    from render_toyrt import sync
+    _, _, stats = sync.export_scene(bpy.context.evaluated_depsgraph_get(), render_toyrt.native())
     return stats
 
 
@@ -386,8 +386,8 @@ def test_100k_objects():
     depsgraph = bpy.context.evaluated_depsgraph_get()
     dg_s = time.perf_counter() - t0
     import render_toyrt
-    from render_toyrt import export
-    t_scene, _, stats = export.export_scene(depsgraph, render_toyrt.native())
+    from render_toyrt import sync
+    t_scene, _, stats = sync.export_scene(depsgraph, render_toyrt.native())
     t_scene.commit(threads=0)
     print(f"  {n:,} objects: made in {made:.1f} s, depsgraph {dg_s:.1f} s, export {stats['export_s']:.2f} s, "
           f"BVH {t_scene.last_commit['build_ms']:.0f} ms, native scene {t_scene.memory_bytes / 1e6:.1f} MB, "

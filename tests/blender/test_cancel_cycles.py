@@ -10,7 +10,7 @@
 #     module seen through a proxy whose Scene.render() adds "Esc after 50 ms" to the engine's own
 #     should_cancel (its test_break); tiles, begin_result/end_result and all are the engine's;
 #   - during the export, which the engine interrupts between objects and between the stages of a
-#     mesh's export, the cycle runs the exporter (export.export_scene, which does not poll) and
+#     mesh's export, the cycle runs the exporter (sync.export_scene, which does not poll) and
 #     stops after it: the time printed is what a cancel would wait without polling; that Esc stops
 #     the engine's export before any mesh is read is checked once;
 #   - during the BVH build, the cycle runs Scene.commit with the engine's kind of should_cancel,
@@ -129,7 +129,7 @@ def build_scene():
 
 def main():
     toyrt = install_proxy()
-    from render_toyrt import export
+    from render_toyrt import sync
 
     build_scene()
     py_threads = threading.active_count()
@@ -149,7 +149,7 @@ def main():
         else:
             depsgraph = bpy.context.evaluated_depsgraph_get()
             t0 = time.perf_counter()
-            t_scene, _, _ = export.export_scene(depsgraph, toyrt)
+            t_scene, _, _ = sync.export_scene(depsgraph, toyrt)
             t1 = time.perf_counter()
             if phase == "bvh":
                 esc = []
@@ -173,21 +173,20 @@ def main():
     # The engine's export polls test_break between objects and before each mesh: Esc already
     # down when the export starts stops it before any mesh is read, and the half-done cache is
     # dropped (the engine calls discard_render_cache), so the next render exports afresh.
-    from render_toyrt import scene_cache
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    cache = scene_cache.SceneCache(toyrt)
+    cache = sync.SceneSync(toyrt)
     try:
         cache.sync(depsgraph, should_cancel=lambda: True)
         raised = False
-    except scene_cache.ExportCancelled:
+    except sync.ExportCancelled:
         raised = True
     check(raised and cache.counters["meshes_exported"] == 0,
           f"Esc before the export: ExportCancelled, no mesh read ({cache.counters['meshes_exported']} exported)")
-    scene_cache.for_render(depsgraph, toyrt)
-    scene_cache.discard_render_cache(depsgraph)
-    check(scene_cache.for_render(depsgraph, toyrt).counters["syncs"] == 0,
+    sync.for_render(depsgraph, toyrt)
+    sync.discard_render_cache(depsgraph)
+    check(sync.for_render(depsgraph, toyrt).counters["syncs"] == 0,
           "after discard_render_cache the next render gets a fresh cache")
-    scene_cache.free_render_caches()
+    sync.free_render_caches()
 
     stopped = [s for done, s in bvh_cancels if not done and s is not None]
     check(len(stopped) == len(bvh_cancels),

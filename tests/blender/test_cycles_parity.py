@@ -1,6 +1,6 @@
 # Runs inside Blender:  blender -b --python-exit-code 1 --python tests/blender/test_cycles_parity.py
 # (`make test` runs it). No --factory-startup: the native module comes from the installed add-on
-# (render_toyrt.native()); the exporter is loaded from this repository (addon/render_toyrt/export.py).
+# (render_toyrt.native()); the scene sync is loaded from this repository (addon/render_toyrt/sync.py).
 #
 # TOYRT against Cycles on scenes built here with bpy: one point light with a hard shadow, three
 # coloured point lights, a rectangular area light with soft shadows, a glass sphere over a textured
@@ -47,11 +47,15 @@ PIXEL_LIMIT = 0.01       # ... and the image fails when more than 1 % of pixels 
 SCENES = os.environ.get("TOYRT_PARITY_SCENES", "")  # comma-separated subset, for development
 
 
-def load_export():
-    spec = importlib.util.spec_from_file_location("toyrt_export_under_test", REPO / "addon" / "render_toyrt" / "export.py")
+def load_sync():
+    """This repository's scene sync (addon/render_toyrt/sync.py and the converters beside it),
+    loaded as a package of its own name: what is tested is this tree, whatever is installed."""
+    package, root = "toyrt_addon_under_test", REPO / "addon" / "render_toyrt"
+    spec = importlib.util.spec_from_file_location(package, root / "__init__.py", submodule_search_locations=[str(root)])
     module = importlib.util.module_from_spec(spec)
+    sys.modules[package] = module
     spec.loader.exec_module(module)
-    return module
+    return importlib.import_module(f"{package}.sync")
 
 
 # ---- scene building ---------------------------------------------------------------------------
@@ -396,7 +400,7 @@ def main():
     import render_toyrt
 
     toyrt = render_toyrt.native()
-    export = load_export()
+    sync = load_sync()
     wanted = {s for s in SCENES.split(",") if s}
     results, failures = [], []
     out_dir = CACHE / "last-run"
@@ -419,7 +423,7 @@ def main():
         warnings = []
         depsgraph = bpy.context.evaluated_depsgraph_get()
         t0 = time.perf_counter()
-        scene_t, cam, stats = export.export_scene(depsgraph, toyrt, report=lambda kind, msg: warnings.append(msg))
+        scene_t, cam, stats = sync.export_scene(depsgraph, toyrt, report=lambda kind, msg: warnings.append(msg))
         scene_t.commit()
         t1 = time.perf_counter()
         img = scene_t.render(cam, samples=toyrt_spp, seed=0, max_specular_depth=max(transmission, 0))
@@ -462,7 +466,7 @@ def write_doc(results):
         "for the glass scene transmission and glossy bounces 8 with diffuse bounces 0, so only specular chains "
         "through the glass; Box filter of width 1, no denoising, no adaptive sampling, light threshold 0, Standard "
         f"view transform, float EXR) at {CYCLES_SAMPLES} samples per pixel (the table gives each scene's count), and by TOYRT through the add-on's "
-        f"exporter (`addon/render_toyrt/export.py`) at as many.",
+        f"scene sync (`addon/render_toyrt/sync.py`) at as many.",
         "",
         f"Pass: mean |TOYRT - Cycles| / mean(Cycles) <= {MEAN_LIMIT * 100:g} %, and at most {PIXEL_LIMIT * 100:g} % "
         f"of pixels with a channel differing by more than {PIXEL_FAIL} after clamping to [0, 1] (the rule of "

@@ -1,6 +1,6 @@
 # Runs inside Blender:  blender -b --python-exit-code 1 --python tests/blender/test_export.py
 # (`make test` runs it). No --factory-startup: the exporter, the engine and the native module are
-# the add-on as `make setup` installed it (render_toyrt.export, render_toyrt.native()).
+# the add-on as `make setup` installed it (render_toyrt.sync, render_toyrt.native()).
 #
 # The export (depsgraph -> toyrt.Scene) and the render loop, each check against a number Blender
 # itself gives:
@@ -40,8 +40,8 @@ RENDERABLE = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
 
 def addon():
     import render_toyrt
-    from render_toyrt import export
-    return export, render_toyrt.native()
+    from render_toyrt import sync
+    return sync, render_toyrt.native()
 
 
 # ---- scene building ---------------------------------------------------------------------------
@@ -284,10 +284,10 @@ def vertical_hits(x, y, z0, tris):
 
 
 def test_counts_and_transforms():
-    export, toyrt = addon()
+    sync, toyrt = addon()
     build_mixed_scene()
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    t_scene, camera, stats = export.export_scene(depsgraph, toyrt)
+    t_scene, camera, stats = sync.export_scene(depsgraph, toyrt)
     t_scene.commit(threads=2)
     print(f"  export stats: { {k: v for k, v in stats.items() if k != 'approximated'} }")
 
@@ -391,13 +391,13 @@ def uv_sphere_mesh(name, segments, rings):
 
 
 def test_instancing_memory():
-    export, toyrt = addon()
+    sync, toyrt = addon()
     n, budget = 10_000, 400
     clear_scene()
     sphere = sphere_20k()
     ortho_camera(300)
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    one, _, stats1 = export.export_scene(depsgraph, toyrt)
+    one, _, stats1 = sync.export_scene(depsgraph, toyrt)
     one.commit(threads=2)
     mesh_bytes, tris = one.memory_bytes, stats1["triangles_stored"]
     print(f"  one {tris:,}-triangle mesh: {mesh_bytes / 1e6:.2f} MB with its BVH")
@@ -410,7 +410,7 @@ def test_instancing_memory():
     t0 = time.perf_counter()
     depsgraph = bpy.context.evaluated_depsgraph_get()
     dg_s = time.perf_counter() - t0
-    scene, _, stats = export.export_scene(depsgraph, toyrt)
+    scene, _, stats = sync.export_scene(depsgraph, toyrt)
     scene.commit(threads=2)
     print(f"  {n:,} linked duplicates: depsgraph {dg_s:.2f} s, export {stats['export_s']:.3f} s, "
           f"BVH {scene.last_commit['build_ms']:.0f} ms, {scene.memory_bytes / 1e6:.2f} MB, "
@@ -446,7 +446,7 @@ def test_instancing_memory():
     instancer.modifiers.new("instancer", "NODES").node_group = ng
     ortho_camera(300)
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    scene, _, stats = export.export_scene(depsgraph, toyrt)
+    scene, _, stats = sync.export_scene(depsgraph, toyrt)
     scene.commit(threads=2)
     print(f"  {n:,} geometry-node instances: export {stats['export_s']:.3f} s, {scene.memory_bytes / 1e6:.2f} MB")
     check(stats["meshes"] == 1 and stats["instances"] == n and stats["triangles_stored"] == tris
@@ -459,7 +459,7 @@ def test_instancing_memory():
     link(bpy.data.objects.new("sphere_1m", uv_sphere_mesh("sphere_1m", 1000, 500)))
     ortho_camera(3)
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    scene, _, stats = export.export_scene(depsgraph, toyrt)
+    scene, _, stats = sync.export_scene(depsgraph, toyrt)
     check(stats["meshes"] == 1 and stats["triangles_stored"] == 1000 * 498 * 2 + 2 * 1000,
           f"a {stats['triangles_stored']:,}-triangle UV sphere with a UV map exports as one mesh in {stats['export_s']:.2f} s")
     del scene
@@ -469,7 +469,7 @@ def test_instancing_memory():
 # ---- 3. a missing image -------------------------------------------------------------------------
 
 def test_missing_texture():
-    export, toyrt = addon()
+    sync, toyrt = addon()
     scene = clear_scene()
     image = bpy.data.images.new("missing_checker", 4, 4)
     image.source = "FILE"
@@ -490,7 +490,7 @@ def test_missing_texture():
     scene.toyrt.samples = 4
 
     reports = []
-    export.export_scene(bpy.context.evaluated_depsgraph_get(), toyrt, report=lambda kind, msg: reports.append((kind, msg)))
+    sync.export_scene(bpy.context.evaluated_depsgraph_get(), toyrt, report=lambda kind, msg: reports.append((kind, msg)))
     warnings = [m for k, m in reports if "WARNING" in k]
     check(len(warnings) == 1 and "missing_checker" in warnings[0] and "magenta" in warnings[0],
           f"the export reports one warning naming the image: {warnings}")
@@ -509,7 +509,7 @@ def test_missing_texture():
 # ---- 4. an unsupported shader node --------------------------------------------------------------
 
 def test_unsupported_node():
-    export, toyrt = addon()
+    sync, toyrt = addon()
     scene = clear_scene()
     mat = bpy.data.materials.new("glowing")
     mat.use_nodes = True
@@ -526,7 +526,7 @@ def test_unsupported_node():
     scene.toyrt.samples = 4
 
     reports = []
-    _, _, stats = export.export_scene(bpy.context.evaluated_depsgraph_get(), toyrt,
+    _, _, stats = sync.export_scene(bpy.context.evaluated_depsgraph_get(), toyrt,
                                       report=lambda kind, msg: reports.append((kind, msg)))
     warnings = [m for k, m in reports if "WARNING" in k]
     check(len(reports) == 1 and len(warnings) == 1 and "ShaderNodeEmission" in warnings[0]
@@ -548,13 +548,13 @@ def os_threads():
 
 
 def test_cancel():
-    export, toyrt = addon()
+    sync, toyrt = addon()
     scene = clear_scene()
     plane("floor", 10.0, material=diffuse("grey", (0.8, 0.8, 0.8)))
     bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=1.0, location=(0, 0, 1))
     point_light((2, -2, 4), 500.0, radius=0.5)
     ortho_camera(8.0, resolution=(320, 240))
-    t_scene, camera, stats = export.export_scene(bpy.context.evaluated_depsgraph_get(), toyrt)
+    t_scene, camera, stats = sync.export_scene(bpy.context.evaluated_depsgraph_get(), toyrt)
     t_scene.commit(threads=2)
 
     py_before, os_before = threading.active_count(), os_threads()

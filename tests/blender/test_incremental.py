@@ -1,5 +1,5 @@
 # Runs inside Blender:  blender -b --python-exit-code 1 --python tests/blender/test_incremental.py
-# (`make test` runs it). The incremental export cache (addon/render_toyrt/scene_cache.py) fed with
+# (`make test` runs it). The incremental scene sync (addon/render_toyrt/sync.py) fed with
 # Blender's own depsgraph.updates (a depsgraph_update_post handler, as view_update gets them):
 #   - each edit does only its part, by the cache's counters: a camera move exports and commits
 #     nothing; moving an object sets one transform and rebuilds the top level only (no mesh BVH);
@@ -57,11 +57,12 @@ def build():
 
 def main():
     import render_toyrt
-    from render_toyrt import export, scene_cache
+    from render_toyrt import sync
+    from render_toyrt.camera import export_camera
 
     toyrt = render_toyrt.native()
     scene = build()
-    cache = scene_cache.SceneCache(toyrt)
+    cache = sync.SceneSync(toyrt)
     cache.sync(bpy.context.evaluated_depsgraph_get())
     cache.commit()
 
@@ -78,8 +79,8 @@ def main():
         check(not wrong, f"{label}: {', '.join(f'{k} {v}' for k, v in expect.items())}"
                          + (f" -- got (got, expected) {wrong}" if wrong else ""))
         depsgraph = bpy.context.evaluated_depsgraph_get()
-        camera = export.export_camera(depsgraph)
-        fresh, _, _ = export.export_scene(depsgraph, toyrt)
+        camera = export_camera(depsgraph)
+        fresh, _, _ = sync.export_scene(depsgraph, toyrt)
         fresh.commit()
         a = cache.scene.render(camera, samples=4)
         b = fresh.render(camera, samples=4)

@@ -2,7 +2,7 @@
 # (`make test` runs it). viewport.view_camera reads a 3D view's camera back from its projection
 # matrix; here it is given the projection Blender computes for a camera object
 # (Object.calc_matrix_camera, the matrix the viewport's camera view uses) and its view matrix, and
-# the image it renders must be the image of the camera itself (export.export_camera): perspective
+# the image it renders must be the image of the camera itself (camera.export_camera): perspective
 # with lens shift, horizontal and vertical sensor fit, and orthographic. Known answer: the same
 # picture, to float rounding of the recovered parameters.
 import sys
@@ -22,7 +22,8 @@ def check(cond, what):
 
 def main():
     import render_toyrt
-    from render_toyrt import export, scene_cache, viewport
+    from render_toyrt import sync, viewport
+    from render_toyrt.camera import export_camera
 
     toyrt = render_toyrt.native()
     bpy.data.batch_remove(list(bpy.data.objects) + list(bpy.data.meshes))
@@ -44,7 +45,7 @@ def main():
     scene.camera = co
     scene.render.resolution_percentage = 100
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    cache = scene_cache.SceneCache(toyrt)
+    cache = sync.SceneSync(toyrt)
     cache.sync(depsgraph)
     cache.commit()
 
@@ -65,7 +66,7 @@ def main():
             window_matrix=co_eval.calc_matrix_camera(depsgraph, x=w, y=h),
             view_matrix=co_eval.matrix_world.inverted(), is_perspective=cam.type == "PERSP")
         from_view = viewport.view_camera(region, rv3d)
-        from_camera = export.export_camera(depsgraph)
+        from_camera = export_camera(depsgraph)
         a = cache.scene.render(from_view, samples=4)
         b = cache.scene.render(from_camera, samples=4)
         diff = np.abs(a - b)

@@ -1,0 +1,283 @@
+"""Blender materials -> MaterialSpec, images -> pixel arrays, with notes on what was approximated.
+
+Plain data only: a MaterialSpec says what toyrt.Scene.add_material / set_material is to get,
+naming its texture by the image it comes from (ImageKey); sync.py gives images their texture ids,
+sends the specs and compares them with what it sent, so an edit that changes nothing sends
+nothing.
+
+Written against Debian's Blender 3.4 (tested) and kept valid on 4.x and 5.0: node sockets that
+were renamed are reached by both names (Principled "Transmission" -> "Transmission Weight" in
+4.0, "Specular" -> "Specular IOR Level", "Emission" -> "Emission Color")."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+DEFAULT_GREY = (0.8, 0.8, 0.8)   # Blender's default surface colour
+MAGENTA = (1.0, 0.0, 1.0)        # placeholder for missing images
+PLACEHOLDER_PIXELS = np.array([[MAGENTA]], np.float32)   # one magenta pixel, linear
+
+
+@dataclass(frozen=True)
+class ImageKey:
+    """Which texture a material reads: an image by name, decoded from sRGB or not. The magenta
+    placeholder (an Image Texture node without an image, or an image without pixels) has the
+    name ''."""
+    name: str
+    srgb: bool
+
+    @property
+    def placeholder(self) -> bool:
+        return self.name == ""
+
+
+PLACEHOLDER = ImageKey("", False)
+
+
+@dataclass(frozen=True)
+class MaterialSpec:
+    """What the core's material is made of: kind 'diffuse' (a colour or a texture), 'refraction'
+    or 'glass' (an index of refraction)."""
+    kind: str
+    color: tuple[float, float, float] = DEFAULT_GREY
+    texture: ImageKey | None = None
+    ior: float = 1.45
+
+    def arguments(self, texture_id: int = -1) -> dict:
+        """Keyword arguments of toyrt.Scene.add_material / set_material, with the texture's id."""
+        return dict(kind=self.kind, color=self.color, texture=texture_id, ior=self.ior)
+
+
+@dataclass(frozen=True)
+class ConvertedMaterial:
+    """A material's spec, what it approximated, and the Blender image its texture reads (None
+    for no texture or the placeholder; not part of the comparison)."""
+    spec: MaterialSpec
+    notes: tuple[str, ...] = ()
+    image: object = field(default=None, compare=False)
+
+
+def material_spec(mat) -> ConvertedMaterial:
+    """A Blender material (None: an empty slot) as the core's material."""
+    notes = []
+    spec, image = _convert(mat, notes)
+    return ConvertedMaterial(spec, tuple(dict.fromkeys(notes)), image)
+
+
+def image_key(image) -> ImageKey:
+    """Blender keeps float images in scene-linear memory (converted from their colour space when
+    loaded) and 8-bit images as their file's bytes: only 8-bit sRGB needs decoding."""
+    return ImageKey(image.name_full, image.colorspace_settings.name == "sRGB" and not image.is_float)
+
+
+def image_pixels(image) -> np.ndarray | None:
+    """(height, width, 3) pixels, rows from the bottom (uint8 for 8-bit images, float32 for
+    float images); None if the image has no data."""
+    try:
+        w, h = image.size[:]            # reading the size loads the image (packed or on disk)
+        channels = image.channels
+        n = len(image.pixels)
+    except (RuntimeError, ReferenceError):
+        return None
+    if w <= 0 or h <= 0 or channels <= 0 or n != w * h * channels:
+        return None
+    if hasattr(image, "has_data") and not image.has_data:
+        return None
+    buf = np.empty(n, np.float32)
+    image.pixels.foreach_get(buf)
+    buf = buf.reshape(h, w, channels)
+    if channels == 1 or channels == 2:
+        buf = np.repeat(buf[..., :1], 3, axis=2)
+    buf = buf[..., :3]
+    if not image.is_float:
+        # An 8-bit image: pass its bytes (exact: Blender's pixels are byte / 255), a quarter of
+        # the memory, and the core knows it is an 8-bit image (Cycles filters 8-bit sRGB
+        # images before decoding them; see docs/parity.md).
+        return np.ascontiguousarray(np.rint(np.clip(buf, 0.0, 1.0) * 255.0).astype(np.uint8))
+    return np.ascontiguousarray(buf)
+
+
+def image_notes(image, pixels: np.ndarray | None) -> tuple[str, ...]:
+    """What loading `image` approximated: a missing image (the placeholder), or a colour space
+    the core reads as linear."""
+    if pixels is None:
+        return (f"missing image '{image.name}' ({image.filepath or 'no file'}): magenta placeholder",)
+    if not image.is_float and image.colorspace_settings.name not in (
+            "sRGB", "Linear", "Linear Rec.709", "Non-Color", "Raw"):
+        return (f"image '{image.name}': colour space {image.colorspace_settings.name} (linear)",)
+    return ()
+
+
+# ---------------------------------------------------------------------------------------------
+# node helpers
+
+def input_socket(node, *names):
+    """The first of the named input sockets the node has (names moved between versions)."""
+    for n in names:
+        sock = node.inputs.get(n)
+        if sock is not None:
+            return sock
+    return None
+
+
+def linked_node(socket):
+    """The node feeding `socket`, following reroutes; None when unlinked."""
+    seen = 0
+    while socket is not None and socket.is_linked and seen < 64:
+        link = socket.links[0]
+        if hasattr(link, "is_muted") and link.is_muted:
+            return None
+        node = link.from_node
+        if node.type == "REROUTE":
+            socket = node.inputs[0]
+            seen += 1
+            continue
+        return node
+    return None
+
+
+def output_node(ntree, output_type: str):
+    """The active output node of a node tree for Cycles (or for all renderers)."""
+    get = getattr(ntree, "get_output_node", None)
+    if get is not None:
+        for target in ("CYCLES", "ALL"):
+            try:
+                node = get(target)
+            except (TypeError, ValueError):
+                node = None
+            if node is not None:
+                return node
+    candidates = [n for n in ntree.nodes if n.type == output_type]
+    for n in candidates:
+        if getattr(n, "is_active_output", False):
+            return n
+    return candidates[0] if candidates else None
+
+
+def rgb(value) -> tuple[float, float, float]:
+    return tuple(float(c) for c in tuple(value)[:3])
+
+
+# ---------------------------------------------------------------------------------------------
+# the conversion: (MaterialSpec, image or None), notes appended to `notes`
+
+def _diffuse(color):
+    return MaterialSpec("diffuse", color=color), None
+
+
+def _convert(mat, notes):
+    if mat is None:
+        return _diffuse(DEFAULT_GREY)
+    name = mat.name
+    if not getattr(mat, "use_nodes", False) or mat.node_tree is None:
+        # Cycles renders a node-less material as a diffuse of its viewport colour.
+        return _diffuse(rgb(mat.diffuse_color))
+    out = output_node(mat.node_tree, "OUTPUT_MATERIAL")
+    if out is None:
+        notes.append(f"material '{name}': no Material Output (grey diffuse)")
+        return _diffuse(DEFAULT_GREY)
+    node = linked_node(input_socket(out, "Surface"))
+    if node is None:
+        # Cycles renders an unconnected surface black; the nearest we have is a black diffuse.
+        notes.append(f"material '{name}': nothing linked to the Surface output (black)")
+        return _diffuse((0.0, 0.0, 0.0))
+    t = node.type
+    if t == "BSDF_DIFFUSE":
+        rough = input_socket(node, "Roughness")
+        if rough is not None and not rough.is_linked and rough.default_value > 0.0:
+            notes.append(f"material '{name}': Diffuse roughness (Lambert)")
+        return _color_material(name, input_socket(node, "Color"), notes)
+    if t == "BSDF_PRINCIPLED":
+        return _principled(name, node, notes)
+    if t == "BSDF_REFRACTION":
+        _check_sharp(name, node, "Refraction", notes)
+        return MaterialSpec("refraction", ior=_ior(name, node, notes)), None
+    if t == "BSDF_GLASS":
+        _check_sharp(name, node, "Glass", notes)
+        return MaterialSpec("glass", ior=_ior(name, node, notes)), None
+    # Anything else: the colour it has, as a diffuse, else grey.
+    color = input_socket(node, "Color", "Base Color")
+    if color is not None and not color.is_linked and hasattr(color.default_value, "__len__"):
+        notes.append(f"material '{name}': {node.bl_idname} (diffuse of its colour)")
+        return _diffuse(rgb(color.default_value))
+    notes.append(f"material '{name}': {node.bl_idname} (grey diffuse)")
+    return _diffuse(DEFAULT_GREY)
+
+
+def _ior(name, node, notes):
+    sock = input_socket(node, "IOR")
+    if sock is None:
+        return 1.45
+    if sock.is_linked:
+        notes.append(f"material '{name}': linked IOR (its constant value)")
+    return float(sock.default_value)
+
+
+def _check_sharp(name, node, label, notes):
+    rough = input_socket(node, "Roughness")
+    if rough is not None and (rough.is_linked or rough.default_value > 0.0):
+        notes.append(f"material '{name}': rough {label} (sharp)")
+    color = input_socket(node, "Color")
+    if color is not None and (color.is_linked or tuple(color.default_value)[:3] != (1.0, 1.0, 1.0)):
+        notes.append(f"material '{name}': {label} tint (white)")
+
+
+def _principled(name, node, notes):
+    trans = input_socket(node, "Transmission Weight", "Transmission")  # 4.0+ / 3.x
+    if trans is not None and not trans.is_linked and trans.default_value >= 0.999:
+        rough = input_socket(node, "Roughness")
+        if rough is not None and (rough.is_linked or rough.default_value > 0.0):
+            notes.append(f"material '{name}': rough Principled transmission (sharp glass)")
+        return MaterialSpec("glass", ior=_ior(name, node, notes)), None
+    extras = []
+    metal = input_socket(node, "Metallic")
+    if metal is not None and (metal.is_linked or metal.default_value > 0.0):
+        extras.append("metallic")
+    if trans is not None and (trans.is_linked or trans.default_value > 0.0):
+        extras.append("partial transmission")
+    spec = input_socket(node, "Specular IOR Level", "Specular")
+    if spec is not None and (spec.is_linked or spec.default_value > 0.0):
+        extras.append("specular")
+    emis = input_socket(node, "Emission Color", "Emission")
+    strength = input_socket(node, "Emission Strength")
+    if (emis is not None and (emis.is_linked or any(c > 0 for c in tuple(emis.default_value)[:3]))
+            and (strength is None or strength.is_linked or strength.default_value > 0.0)):
+        extras.append("emission")
+    if extras:
+        notes.append(f"material '{name}': Principled {', '.join(extras)} (Lambert base colour)")
+    return _color_material(name, input_socket(node, "Base Color"), notes)
+
+
+def _color_material(name, sock, notes):
+    if sock is None:
+        return _diffuse(DEFAULT_GREY)
+    src = linked_node(sock)
+    if src is None:
+        return _diffuse(rgb(sock.default_value))
+    if src.type == "TEX_IMAGE":
+        key, image = _texture(name, src, notes)
+        return MaterialSpec("diffuse", texture=key), image
+    notes.append(f"material '{name}': colour from {src.bl_idname} (its constant colour)")
+    return _diffuse(rgb(sock.default_value))
+
+
+def _texture(name, node, notes):
+    """The image an Image Texture node reads, as (ImageKey, image); the placeholder without one."""
+    vec = input_socket(node, "Vector")
+    if vec is not None and vec.is_linked:
+        src = linked_node(vec)
+        if src is None or src.type not in ("UVMAP", "TEX_COORD"):
+            notes.append(f"material '{name}': texture coordinates from "
+                         f"{src.bl_idname if src else 'a link'} (the mesh's UV map)")
+    if getattr(node, "extension", "REPEAT") != "REPEAT":
+        notes.append(f"material '{name}': image extension {node.extension} (repeat)")
+    if getattr(node, "interpolation", "Linear") not in ("Linear",):
+        notes.append(f"material '{name}': image interpolation {node.interpolation} (bilinear)")
+    if getattr(node, "projection", "FLAT") != "FLAT":
+        notes.append(f"material '{name}': image projection {node.projection} (flat)")
+    image = node.image
+    if image is None:
+        notes.append(f"material '{name}': Image Texture without an image (magenta)")
+        return PLACEHOLDER, None
+    return image_key(image), image
