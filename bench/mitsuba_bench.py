@@ -109,14 +109,14 @@ def build_dict(mi, scene_dir, desc):
     fov = math.degrees(2 * math.atan(cam["sensor_width"] / (2 * cam["lens"])))
     d["sensor"] = {"type": "perspective", "fov": fov, "fov_axis": "larger" if cam["sensor_fit"] == "AUTO" else "x",
                    "near_clip": cam["clip_start"], "far_clip": cam["clip_end"],
-                   "to_world": mi.ScalarTransform4f().look_at(origin=origin.tolist(), target=(origin + forward).tolist(),
-                                                              up=up.tolist()),
+                   "to_world": mi.ScalarTransform4f().look_at(origin=origin.tolist(),
+                                                              target=(origin + forward).tolist(), up=up.tolist()),
                    "film": {"type": "hdrfilm", "width": w, "height": h, "pixel_format": "rgb",
                             "rfilter": {"type": "box"}},  # Cycles' and TOYRT's Box filter of one pixel
                    "sampler": {"type": "independent", "sample_count": 1}}
     # Blender can hide a light from camera rays; Mitsuba only hides all emitters seen directly,
     # which is the same picture when nothing else (no world) is seen directly.
-    hidden = [not l.get("visible_camera", True) for l in desc["lights"] if l["type"] == "AREA"]
+    hidden = [not light.get("visible_camera", True) for light in desc["lights"] if light["type"] == "AREA"]
     if any(hidden) and not all(hidden):
         raise ValueError("some area lights are hidden from the camera and some not: Mitsuba cannot show that")
     if any(hidden) and desc["world"] is not None:

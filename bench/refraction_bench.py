@@ -117,10 +117,12 @@ def main():
     spp = 64 if args.quick else 512
     angles = [0, 30, 60, 75, 85]
     result = dict(ior=IOR, spp=spp,
-                  slab=slab("glass", angles, spp, 64) + slab("glass", angles, spp, 2) + slab("refraction", angles, spp, 64),
+                  slab=(slab("glass", angles, spp, 64) + slab("glass", angles, spp, 2)
+                        + slab("refraction", angles, spp, 64)),
                   sphere=furnace("glass", [1, 2, 4, 8, 16, 64], spp) + furnace("refraction", [2, 4, 8, 16, 64], spp))
     for r in result["slab"]:
-        print(f"bench: slab {r['material']} {r['deg']} deg depth {r['depth']}: {r['measured']:.4f} (closed form {r['expected']:.4f})")
+        print(f"bench: slab {r['material']} {r['deg']} deg depth {r['depth']}: {r['measured']:.4f} "
+              f"(closed form {r['expected']:.4f})")
     for r in result["sphere"]:
         print(f"bench: furnace sphere {r['material']} depth {r['depth']}: mean {r['mean']:.4f}")
     with open(args.out, "w") as f:

@@ -82,8 +82,8 @@ def main():
     def blender_job(job):
         path = work / f"job-{job['name']}.json"
         path.write_text(json.dumps(job))
-        return run([args.blender, "-b", "--python-exit-code", "1", "--python", REPO / "bench" / "blender_bench.py", "--",
-                    path], log)
+        return run([args.blender, "-b", "--python-exit-code", "1", "--python", REPO / "bench" / "blender_bench.py",
+                    "--", path], log)
 
     for name, module, options, depth, mitsuba in SCENES:
         if "render" in stages:
@@ -93,8 +93,9 @@ def main():
                 methods=METHODS, repeats=cfg["repeats"], out=str(work / f"render-{name}.json"), cache=str(cache),
                 mitsuba_dir=str(work / f"mitsuba-{name}") if mitsuba else ""))
         if "mitsuba" in stages and mitsuba:
-            timings[f"mitsuba {name}"] = run([sys.executable, REPO / "bench" / "mitsuba_bench.py", work / f"mitsuba-{name}",
-                                              work / f"render-{name}.ref.npy", work / f"mitsuba-{name}.json",
+            timings[f"mitsuba {name}"] = run([sys.executable, REPO / "bench" / "mitsuba_bench.py",
+                                              work / f"mitsuba-{name}", work / f"render-{name}.ref.npy",
+                                              work / f"mitsuba-{name}.json",
                                               "--spp", *cfg["spp"], "--repeats", cfg["repeats"]], log)
     if "economy" in stages:
         timings["economy"] = blender_job(dict(name="economy", module="cornell", economy=ECONOMY, width=cfg["width"],

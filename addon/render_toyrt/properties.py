@@ -12,7 +12,8 @@ class TOYRTRenderSettings(bpy.types.PropertyGroup):
         default=32, min=1, soft_max=1024)
     area_light_sampling: bpy.props.EnumProperty(
         name="Area Lights", description="How soft shadows of rectangular area lights are sampled",
-        items=[("solid_angle", "Solid Angle", "Uniform over the light's solid angle (spherical rectangles, Urena et al. 2013)"),
+        items=[("solid_angle", "Solid Angle",
+                "Uniform over the light's solid angle (spherical rectangles, Urena et al. 2013)"),
                ("area", "Area", "Uniform over the light's area")],
         default="solid_angle")
     light_sampling: bpy.props.EnumProperty(

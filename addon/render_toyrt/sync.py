@@ -37,8 +37,7 @@ from . import materials
 from .camera import export_camera
 from .lights import LightSpec, light_spec
 from .materials import PLACEHOLDER, PLACEHOLDER_PIXELS, ImageKey
-from .mesh import (RENDERABLE, ExportCancelled, evaluated_geometry, fingerprint, mesh_key, singular, stop_if,
-                   to_array)
+from .mesh import RENDERABLE, ExportCancelled, evaluated_geometry, fingerprint, mesh_key, singular, stop_if, to_array
 from .world import WorldSpec, world_spec
 
 __all__ = ["SceneSync", "ExportCancelled", "export_scene", "for_render", "discard_render_cache",

@@ -122,7 +122,8 @@ class ViewportSession:
             h, w = image.shape[:2]
             # GL rows go from the bottom; a numpy array is handed over as a buffer, not a list.
             pixels = np.ascontiguousarray(image[::-1]).ravel()
-            texture = gpu.types.GPUTexture((w, h), format="RGBA16F", data=gpu.types.Buffer("FLOAT", pixels.size, pixels))
+            data = gpu.types.Buffer("FLOAT", pixels.size, pixels)
+            texture = gpu.types.GPUTexture((w, h), format="RGBA16F", data=data)
             self._drawn = (version, texture)
         texture = self._drawn[1]
         gpu.state.blend_set("ALPHA_PREMULT")

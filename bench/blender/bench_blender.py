@@ -22,7 +22,6 @@ import json
 import os
 import re
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -83,7 +82,8 @@ def rmse(a, b):
 def time_to_error(blender, workdir, args):
     blend = Path(workdir) / "cornell.blend"
     # Not --factory-startup: the scene script sets TOYRT settings (the add-on must be enabled).
-    run_blender(blender, ["-b", "--python-exit-code", "1", "--python", str(REPO / "scenes" / "cornell_demo.py"), "--", str(blend)])
+    run_blender(blender, ["-b", "--python-exit-code", "1", "--python", str(REPO / "scenes" / "cornell_demo.py"),
+                          "--", str(blend)])
     pct = args.percent
     print(f"reference: Cycles {args.ref_samples} spp at {pct} %", flush=True)
     ref_s, ref, _ = render(blender, blend, "CYCLES", args.ref_samples, pct, workdir, "ref")
@@ -152,7 +152,8 @@ def peak_memory(blender, workdir, args):
     script.write_text(INSTANCES_SCENE)
     run_blender(blender, ["-b", "--factory-startup", "--python", str(script), "--", str(blend)])
     rows = {}
-    _, rows["load only"] = run_blender(blender, ["-b", str(blend), "--python-expr", "import bpy; bpy.context.evaluated_depsgraph_get()"])
+    _, rows["load only"] = run_blender(blender, ["-b", str(blend), "--python-expr",
+                                                 "import bpy; bpy.context.evaluated_depsgraph_get()"])
     for engine in ("TOYRT", "CYCLES"):
         best = None
         for k in range(args.repeats):

@@ -59,7 +59,7 @@ def main():
     # The parity test keeps its Cycles references in the build folder it is given.
     os.environ.setdefault("TOYRT_BUILD_DIR", str(build))
 
-    import bpy  # noqa: F401  (Blender starts here)
+    import bpy  # noqa: F401, I001  (Blender starts here: before addon_utils)
     import addon_utils
 
     if str(scripts / "addons") not in sys.path:

@@ -177,7 +177,8 @@ def test_same_scene_on_every_path():
     check(stats["lights"] == engine.stats["lights"] == 2 and len(engine.lights) == 2,
           f"lights: one-shot {stats['lights']}, SceneSync {engine.stats['lights']} (2 in the scene)")
     a, b = render(one, camera), render(engine.scene, camera)
-    check(np.array_equal(a, b), f"one-shot and SceneSync render the same image (max difference {np.abs(a - b).max():.3g})")
+    check(np.array_equal(a, b),
+          f"one-shot and SceneSync render the same image (max difference {np.abs(a - b).max():.3g})")
 
     f12 = f12_image("f12")
     check(f12.shape == a.shape and float(np.abs(f12 - a).max()) <= 1e-6,
@@ -240,13 +241,14 @@ def test_incremental_equals_one_shot():
             bpy.data.materials["red"].node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = \
                 (0.1, 0.8, 0.1, 1.0)
         edit("material edit", material_edit, dict(materials_converted=1, meshes_exported=0, light_sends=0))
-        edit("move the flattened cube (baked again)", lambda: setattr(bpy.data.objects["flat"], "location", (-2.5, 0.5, 0.8)),
+        flat = bpy.data.objects["flat"]
+        edit("move the flattened cube (baked again)", lambda: setattr(flat, "location", (-2.5, 0.5, 0.8)),
              dict(meshes_exported=1, light_sends=0))
         edit("flatten the ball along y", lambda: setattr(bpy.data.objects["ball"], "scale", (1.0, 0.0, 1.0)),
              dict(meshes_exported=1))
-        edit("give the cube its volume back", lambda: setattr(bpy.data.objects["flat"], "scale", (1.0, 1.0, 0.5)),
+        edit("give the cube its volume back", lambda: setattr(flat, "scale", (1.0, 1.0, 0.5)),
              dict(meshes_exported=1))
-        edit("then move it (instance matrices only)", lambda: setattr(bpy.data.objects["flat"], "location", (-2.0, 0.0, 0.5)),
+        edit("then move it (instance matrices only)", lambda: setattr(flat, "location", (-2.0, 0.0, 0.5)),
              dict(meshes_exported=0, walks=0, transforms_set=1))
         edit("move a collection instance", lambda: setattr(bpy.data.objects["instancer1"], "location", (1.5, 3.0, 0.0)))
     finally:

@@ -93,7 +93,6 @@ def inner(result_path):
     import bpy
     import numpy as np
     from bpy_extras.view3d_utils import location_3d_to_region_2d
-
     from render_toyrt import viewport
 
     out = {"viewport_samples": 16}
@@ -244,7 +243,6 @@ def inner(result_path):
         area.spaces[0].shading.type = "SOLID"
 
     def toggles_done():
-        s = session()
         out["toggles"].update(
             rss_50=rss(), os_threads_50=len(os.listdir("/proc/self/task")), sessions_left=len(viewport._sessions),
             viewport_threads_left=sum(t.name == "toyrt-viewport" for t in threading.enumerate()),
