@@ -11,7 +11,6 @@
 #   TOYRT:  the add-on's sync.export_scene() + commit() (BVH build) + render().
 import hashlib
 import importlib.util
-import inspect
 import json
 import sys
 import time
@@ -20,11 +19,11 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scenes"))
-from cycles_like_toyrt import configure_cycles  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scenes"))  # the scene kit
+import kit  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
-CYCLES_SETUP_REVISION = 1  # bump when the Cycles settings below change meaning
+CYCLES_SETUP_REVISION = 1  # bump when the Cycles settings change meaning in a way their text does not show
 
 
 def load_scene_module(name):
@@ -36,31 +35,12 @@ def load_scene_module(name):
 
 
 def scene_sources(path):
-    """The files a scene's pixels depend on: its script, the shared helpers and (Cornell) the seed's."""
-    files = [path, REPO / "scenes" / "bench" / "common.py"]
+    """The files a scene's pixels depend on: its script, the scene kit, the Cycles settings and
+    (Cornell) the seed's scene."""
+    files = [path, REPO / "scenes" / "kit.py", REPO / "scenes" / "cycles_like_toyrt.py"]
     if path.stem == "cornell":
         files.append(REPO / "scenes" / "cornell_demo.py")
     return files
-
-
-def setup_output(scene, width, height):
-    r = scene.render
-    r.resolution_x, r.resolution_y, r.resolution_percentage = width, height, 100
-    r.pixel_aspect_x = r.pixel_aspect_y = 1.0
-    r.use_border = False
-    r.film_transparent = False
-    scene.view_settings.view_transform = "Standard"
-    scene.view_settings.look = "None"
-    scene.view_settings.exposure = 0.0
-    scene.view_settings.gamma = 1.0
-
-
-def setup_cycles(scene, samples, specular_depth):
-    """Cycles restricted to TOYRT's light transport (scenes/cycles_like_toyrt.py), float output."""
-    configure_cycles(scene, samples, specular_depth)
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
-    scene.render.image_settings.color_mode = "RGBA"
 
 
 def render_cycles(scene, tmp):
@@ -69,15 +49,9 @@ def render_cycles(scene, tmp):
     bpy.ops.render.render(write_still=False)
     seconds = time.perf_counter() - t0
     bpy.data.images["Render Result"].save_render(str(tmp))
-    image = bpy.data.images.load(str(tmp), check_existing=False)
-    try:
-        w, h = image.size[:]
-        buf = np.empty(w * h * 4, np.float32)
-        image.pixels.foreach_get(buf)
-    finally:
-        bpy.data.images.remove(image)
+    image = kit.read_image(tmp)
     tmp.unlink(missing_ok=True)
-    return buf.reshape(h, w, 4)[::-1, :, :3].astype(np.float64), seconds
+    return image[::-1, :, :3].astype(np.float64), seconds
 
 
 LIGHT_SEEN = 20.0  # W/(m^2 sr): above any lit diffuse surface in the bench scenes, below their lights
@@ -107,8 +81,6 @@ def cache_key(job, path):
     h = hashlib.sha256()
     for f in scene_sources(path):
         h.update(f.read_bytes())
-    h.update(inspect.getsource(setup_cycles).encode())
-    h.update(inspect.getsource(configure_cycles).encode())
     h.update(json.dumps(dict(options=job.get("options", {}), size=(job["width"], job["height"]),
                              spp=job["ref_spp"], depth=job["specular_depth"], blender=bpy.app.version_string,
                              revision=CYCLES_SETUP_REVISION), sort_keys=True).encode())
@@ -125,7 +97,7 @@ def reference(job, path, cache):
         info["cached"] = True
         return np.load(npy), info
     scene = bpy.context.scene
-    setup_cycles(scene, job["ref_spp"], job["specular_depth"])
+    kit.cycles(scene, job["ref_spp"], job["specular_depth"])
     print(f"bench: {job['name']}: Cycles reference at {job['ref_spp']} spp (cached after this run)", flush=True)
     img, seconds = render_cycles(scene, cache / f"{job['name']}-{key}.exr")
     np.save(npy, img)
@@ -266,7 +238,7 @@ def main():
         steps = []
         for label, options in job["economy"]:
             module.build(**options)
-            setup_output(bpy.context.scene, job["width"], job["height"])
+            kit.output(bpy.context.scene, job["width"], job["height"])
             bpy.context.view_layer.update()
             runs = [toyrt_render(sync, toyrt, job["spp"], "solid_angle", "auto", job["specular_depth"])
                     for _ in range(job["repeats"])]
@@ -285,7 +257,7 @@ def main():
     module.build(**job.get("options", {}))
     result["build_seconds"] = time.perf_counter() - t0
     scene = bpy.context.scene
-    setup_output(scene, job["width"], job["height"])
+    kit.output(scene, job["width"], job["height"])
     bpy.context.view_layer.update()
     depth = job["specular_depth"]
 
@@ -298,10 +270,10 @@ def main():
 
     runs = []
     cycles_tmp = out.with_suffix(".cycles.exr")
-    setup_cycles(scene, 1, depth)
+    kit.cycles(scene, 1, depth)
     render_cycles(scene, cycles_tmp)  # warm-up: the first render in a process loads Cycles' kernels
     for spp in job["cycles_spp"]:
-        setup_cycles(scene, spp, depth)
+        kit.cycles(scene, spp, depth)
         best = None
         for _ in range(job["repeats"]):
             img, seconds = render_cycles(scene, cycles_tmp)

@@ -9,8 +9,8 @@ import sys
 
 import bpy
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scenes"))
-from cycles_like_toyrt import configure_cycles  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scenes"))  # the scene kit
+import kit  # noqa: E402
 
 argv = sys.argv[sys.argv.index("--") + 1:]
 engine, samples, percent = argv[0], int(argv[1]), int(argv[2])
@@ -18,19 +18,13 @@ scene = bpy.context.scene
 r = scene.render
 r.resolution_percentage = percent
 r.use_border = False
-r.image_settings.file_format = "OPEN_EXR"
-r.image_settings.color_depth = "32"
-r.image_settings.color_mode = "RGBA"
 r.threads_mode = "AUTO"
-scene.view_settings.view_transform = "Standard"
-scene.view_settings.look = "None"
+kit.float_exr(scene)
+kit.standard_view(scene)
 if engine == "CYCLES":
-    configure_cycles(scene, samples, 8)
+    kit.cycles(scene, samples, 8)
 else:
-    r.engine = "TOYRT"
-    scene.toyrt.samples = samples
-    scene.toyrt.max_specular_depth = 8
-    scene.toyrt.seed = 0
+    kit.toyrt(scene, samples=samples, max_specular_depth=8, seed=0)
     # Other TOYRT settings to compare, e.g. TOYRT_BENCH_SET="light_sampling=one".
     for item in filter(None, os.environ.get("TOYRT_BENCH_SET", "").split(",")):
         name, value = item.split("=", 1)

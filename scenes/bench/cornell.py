@@ -9,17 +9,17 @@ import sys
 from pathlib import Path
 
 import bpy
+import numpy as np
 
-sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[1])]
-import common  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the scene kit and the seed's scene
 import cornell_demo  # noqa: E402
+import kit  # noqa: E402
 
 
 def build(glass=True, texture=True, point_lights=2, extra_lights=0, instances=0):
     """glass: True (the seed's glass sphere), False (a diffuse sphere), None (no sphere)."""
-    common.clear()
     # The seed's scene, unchanged, then edited: its script is the one source of truth.
-    cornell_demo.build(str(Path(bpy.app.tempdir or "/tmp") / "toyrt_bench_cornell.blend"))
+    scene = cornell_demo.build()
     objects = bpy.data.objects
     # Camera-visible, as Cycles' default light (bpy.data.objects.new leaves it hidden in 3.4):
     # Mitsuba can hide emitters only all at once, so every renderer sees the light here.
@@ -36,20 +36,20 @@ def build(glass=True, texture=True, point_lights=2, extra_lights=0, instances=0)
         bpy.data.objects.remove(objects[name], do_unlink=True)
     # More lights: a ring of dim coloured point lights under the ceiling.
     for i in range(extra_lights):
-        a = 2 * common.np.pi * i / max(extra_lights, 1)
-        common.point_light(f"extra{i}", (0.8 * common.np.cos(a), 0.8 * common.np.sin(a) - 0.1, 1.75), 60.0 / extra_lights,
-                           color=(0.5 + 0.5 * common.np.cos(a), 0.5 + 0.5 * common.np.sin(a), 0.7))
+        a = 2 * np.pi * i / max(extra_lights, 1)
+        kit.point_light(f"extra{i}", (0.8 * np.cos(a), 0.8 * np.sin(a) - 0.1, 1.75), 60.0 / extra_lights,
+                        color=(0.5 + 0.5 * np.cos(a), 0.5 + 0.5 * np.sin(a), 0.7))
     # Instances: small cubes sharing one mesh, in a grid on the floor in front of the sphere.
     if instances:
         n = int(round(instances ** 0.5))
-        proto = common.box("pebble", 0.06, (0, 0, -10), white)
+        proto = kit.box("pebble", 0.06, (0, 0, -10), white)
         proto.hide_render = True  # only its instances are in the picture
         for k in range(instances):
-            obj = common.link(bpy.data.objects.new(f"pebble{k}", proto.data))
+            obj = kit.link(bpy.data.objects.new(f"pebble{k}", proto.data))
             obj.location = (-0.85 + 1.7 * (k % n) / max(n - 1, 1), -0.85 + 0.6 * (k // n) / max(n - 1, 1), 0.03)
             obj.rotation_euler = (0, 0, 0.7 * k)
-    return common.finish()
+    return scene
 
 
 if __name__ == "__main__":
-    common.main(build)
+    kit.main(build)

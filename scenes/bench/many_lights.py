@@ -4,33 +4,34 @@
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import common  # noqa: E402
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the scene kit
+import kit  # noqa: E402
 
 POINTS, AREAS = 64, 4
 
 
 def build():
-    common.clear()
-    grey = common.diffuse("grey", (0.75, 0.75, 0.75))
-    common.plane("floor", 10.0, (0, 0, 0), grey)
-    rng = common.np.random.default_rng(64)
+    scene = kit.clear_scene()
+    grey = kit.diffuse("grey", (0.75, 0.75, 0.75))
+    kit.plane("floor", 10.0, grey)
+    rng = np.random.default_rng(64)
     for k in range(36):
         x, y = (k % 6 - 2.5) * 1.2, (k // 6 - 2.5) * 1.2
         h = 0.2 + 0.8 * rng.random()
-        common.box(f"box{k}", (0.5, 0.5, h), (x, y, h / 2), grey, rotation_z=rng.random())
+        kit.box(f"box{k}", (0.5, 0.5, h), (x, y, h / 2), grey, rotation_z=rng.random())
     for k in range(POINTS):
         x, y = rng.uniform(-4, 4, 2)
         color = tuple(0.3 + 0.7 * rng.random(3))
         # At least 0.6 m above the tallest box: lights grazing a surface make fireflies that no
         # renderer's reference converges in minutes.
-        common.point_light(f"p{k}", (x, y, 1.6 + 1.0 * rng.random()), 10.0 + 30.0 * rng.random(), color=color)
+        kit.point_light(f"p{k}", (x, y, 1.6 + 1.0 * rng.random()), 10.0 + 30.0 * rng.random(), color=color)
     for k in range(AREAS):
-        common.area_light(f"a{k}", ((k % 2 - 0.5) * 5, (k // 2 - 0.5) * 5, 3.0), 0.5, 0.5, 80.0)
-    common.world(None)
-    common.camera((0.0, -8.0, 6.0), (0, 0, 0), lens=30)
-    return common.finish()
+        kit.area_light(f"a{k}", ((k % 2 - 0.5) * 5, (k // 2 - 0.5) * 5, 3.0), 80.0, 0.5, 0.5, visible_camera=True)
+    kit.camera((0.0, -8.0, 6.0), (0, 0, 0), lens=30)
+    return scene
 
 
 if __name__ == "__main__":
-    common.main(build)
+    kit.main(build)

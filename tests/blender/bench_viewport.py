@@ -8,16 +8,18 @@
 # Printed as a Markdown table for docs/viewport.md. Drawing (the texture upload) is not included:
 # there is no GPU in background mode; under Xvfb a 200x150 upload is well under a millisecond.
 import os
-import runpy
 import statistics
 import sys
-import tempfile
 import time
 
 import bpy
 import numpy as np
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "scenes"))  # the scene kit and the seed's scene
+import cornell_demo  # noqa: E402
+import kit  # noqa: E402
+
 THREADS = 2
 MOVES = 7
 
@@ -36,18 +38,7 @@ def add_big_mesh(triangles_wanted=1_000_000):
         b = r * seg + (np.arange(seg) + 1) % seg
         quads.append(np.stack([a, b, b + seg, a + seg], -1))
     quads = np.concatenate(quads)
-    mesh = bpy.data.meshes.new("big")
-    mesh.vertices.add(len(verts))
-    mesh.vertices.foreach_set("co", verts.ravel())
-    mesh.loops.add(quads.size)
-    mesh.loops.foreach_set("vertex_index", quads.ravel().astype(np.int32))
-    mesh.polygons.add(len(quads))
-    mesh.polygons.foreach_set("loop_start", (np.arange(len(quads)) * 4).astype(np.int32))
-    mesh.polygons.foreach_set("loop_total", np.full(len(quads), 4, np.int32))
-    mesh.update()
-    obj = bpy.data.objects.new("big", mesh)
-    obj.location = (-0.3, -0.4, 0.5)
-    bpy.context.scene.collection.objects.link(obj)
+    kit.mesh_object("big", verts, quads, location=(-0.3, -0.4, 0.5))
     return len(quads) * 2
 
 
@@ -102,11 +93,7 @@ def measure(label, rows):
 
 
 def main():
-    with tempfile.TemporaryDirectory() as tmp:
-        blend = os.path.join(tmp, "cornell.blend")
-        sys.argv = [sys.argv[0], "--", blend]
-        runpy.run_path(os.path.join(REPO, "scenes", "cornell_demo.py"), run_name="__main__")
-        bpy.ops.wm.open_mainfile(filepath=blend)
+    cornell_demo.build()
     rows = ["| scene | triangles | first sync (once) | sync after a camera move | coarse pass 200x150, 1 spp "
             "| full pass 800x600, 1 spp | camera move to first picture |",
             "| --- | --- | --- | --- | --- | --- | --- |"]
