@@ -27,6 +27,15 @@ def committed(*meshes):
     return s
 
 
+def random_soup(seed, vertices, triangles, rays):
+    """Random triangles on `vertices` points in [-1, 1]^3 ((V, 3) float32, (T, 3) int64 indices) and
+    rays from [-2, 2]^3 in random directions ((R, 3) float32 origins and directions)."""
+    rng = np.random.default_rng(seed)
+    v = rng.uniform(-1, 1, (vertices, 3)).astype(np.float32)
+    t = rng.integers(0, vertices, (triangles, 3))
+    return v, t, rng.uniform(-2, 2, (rays, 3)).astype(np.float32), rng.normal(size=(rays, 3)).astype(np.float32)
+
+
 def assert_misses(hits, blocked):
     assert np.all(np.isinf(hits["t"])) and np.all(hits["prim"] == -1) and np.all(hits["instance"] == -1)
     assert not np.any(blocked)
@@ -73,7 +82,8 @@ def test_negative_index_is_refused():
 
 
 def test_float_indices_are_refused_as_not_integers():
-    refused(lambda: toyrt.Scene().add_mesh(TRI_V, TRI_T.astype(np.float32)), TypeError, "triangles must be an integer array")
+    refused(lambda: toyrt.Scene().add_mesh(TRI_V, TRI_T.astype(np.float32)), TypeError,
+            "triangles must be an integer array")
 
 
 def test_complex_vertices_are_refused_as_not_numbers():
@@ -85,11 +95,13 @@ def test_none_inside_a_vertex_list_is_refused():
 
 
 def test_vertices_of_shape_n_by_4_are_refused_with_the_shape():
-    refused(lambda: toyrt.Scene().add_mesh(np.zeros((3, 4)), TRI_T), ValueError, "vertices must have shape (N, 3), got (3, 4)")
+    refused(lambda: toyrt.Scene().add_mesh(np.zeros((3, 4)), TRI_T), ValueError,
+            "vertices must have shape (N, 3), got (3, 4)")
 
 
 def test_triangles_of_shape_m_by_4_are_refused_with_the_shape():
-    refused(lambda: toyrt.Scene().add_mesh(TRI_V, [[0, 1, 2, 0]]), ValueError, "triangles must have shape (M, 3), got (1, 4)")
+    refused(lambda: toyrt.Scene().add_mesh(TRI_V, [[0, 1, 2, 0]]), ValueError,
+            "triangles must have shape (M, 3), got (1, 4)")
 
 
 def test_lists_work_like_arrays():
@@ -99,11 +111,7 @@ def test_lists_work_like_arrays():
 
 
 def test_non_contiguous_and_fortran_arrays_give_the_answers_of_contiguous_ones():
-    rng = np.random.default_rng(7)
-    v = rng.uniform(-1, 1, (60, 3)).astype(np.float32)
-    t = rng.integers(0, 60, (80, 3)).astype(np.int64)
-    org = rng.uniform(-2, 2, (500, 3)).astype(np.float32)
-    dirs = rng.normal(size=(500, 3)).astype(np.float32)
+    v, t, org, dirs = random_soup(7, 60, 80, 500)
     wide = np.zeros((60, 6), np.float32)
     wide[:, ::2] = v                            # every other column: a strided view
     t_fortran = np.asfortranarray(t)            # column-major
@@ -267,7 +275,8 @@ def camera(**settings):
 
 
 def test_resolution_zero_is_refused():
-    refused(lambda: toyrt.camera_window(camera(resolution_x=0)), ValueError, "resolution_x and resolution_y must be positive")
+    refused(lambda: toyrt.camera_window(camera(resolution_x=0)), ValueError,
+            "resolution_x and resolution_y must be positive")
     refused(lambda: committed().render(camera(resolution_y=0)), ValueError, "resolution")
 
 
@@ -317,7 +326,8 @@ def test_zero_power_light_is_accepted_and_lights_nothing():
 
 @pytest.mark.parametrize("shape", [(0, 4, 3), (4, 0, 4), (0, 0, 3)])
 def test_texture_of_size_zero_is_refused(shape):
-    refused(lambda: toyrt.Scene().add_texture(np.zeros(shape, np.float32)), ValueError, "width and height must be positive")
+    refused(lambda: toyrt.Scene().add_texture(np.zeros(shape, np.float32)), ValueError,
+            "width and height must be positive")
 
 
 @pytest.mark.parametrize("channels", [1, 2, 5])
@@ -338,12 +348,8 @@ def test_texture_with_nan_texels_is_refused():
 # ---- several Python threads at once -----------------------------------------------------------------
 
 def test_eight_threads_querying_while_another_commits_get_single_threaded_answers():
-    rng = np.random.default_rng(11)
-    v = rng.uniform(-1, 1, (400, 3)).astype(np.float32)
-    t = rng.integers(0, 400, (600, 3)).astype(np.uint32)
-    org = rng.uniform(-2, 2, (2000, 3)).astype(np.float32)
-    dirs = rng.normal(size=(2000, 3)).astype(np.float32)
-    s = committed((v, t))
+    v, t, org, dirs = random_soup(11, 400, 600, 2000)
+    s = committed((v, t.astype(np.uint32)))
     expected_hits, expected_blocked = s.intersect(org, dirs, threads=1), s.occluded(org, dirs, threads=1)
     assert np.any(expected_hits["prim"] >= 0)
 

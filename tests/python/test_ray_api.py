@@ -7,14 +7,18 @@ import pytest
 import toyrt
 
 
+def one_mesh(vertices, triangles, **commit_options):
+    """A scene of one mesh, committed."""
+    s = toyrt.Scene()
+    s.add_mesh(vertices, triangles)
+    s.commit(**commit_options)
+    return s
+
+
 def quad_scene(z=0.0):
     """Two triangles covering [0, 1]^2 at height z."""
     v = np.array([[0, 0, z], [1, 0, z], [1, 1, z], [0, 1, z]], np.float32)
-    t = np.array([[0, 1, 2], [0, 2, 3]], np.uint32)
-    s = toyrt.Scene()
-    s.add_mesh(v, t)
-    s.commit()
-    return s
+    return one_mesh(v, np.array([[0, 1, 2], [0, 2, 3]], np.uint32))
 
 
 def random_soup(rng, count, size):
@@ -64,9 +68,7 @@ def test_distance_to_a_plane_is_the_closed_form():
 
 def test_barycentrics_follow_embree_convention():
     v = np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0]], np.float32)
-    s = toyrt.Scene()
-    s.add_mesh(v, np.array([[0, 1, 2]]))
-    s.commit()
+    s = one_mesh(v, np.array([[0, 1, 2]]))
     h = s.intersect([[0.5, 0.5, 1.0]], [[0, 0, -1.0]])
     # p = (1-u-v) p0 + u p1 + v p2 = (0.5, 0.5, 0)  =>  u = v = 0.25
     assert h["u"][0] == pytest.approx(0.25) and h["v"][0] == pytest.approx(0.25)
@@ -75,9 +77,7 @@ def test_barycentrics_follow_embree_convention():
 def test_agrees_with_float64_brute_force_on_a_random_soup():
     rng = np.random.default_rng(7)
     vertices, triangles = random_soup(rng, 300, 0.08)
-    s = toyrt.Scene()
-    s.add_mesh(vertices, triangles)
-    s.commit()
+    s = one_mesh(vertices, triangles)
     org = rng.uniform(-0.5, 1.5, (2000, 3)).astype(np.float32)
     d = (rng.uniform(0, 1, (2000, 3)) - org).astype(np.float32)
     hits = s.intersect(org, d)
@@ -155,9 +155,7 @@ def test_results_do_not_depend_on_thread_count():
     rng = np.random.default_rng(5)
     vertices = rng.uniform(0, 1, (3000, 3)).astype(np.float32)
     triangles = rng.integers(0, 3000, (5000, 3)).astype(np.uint32)
-    s = toyrt.Scene()
-    s.add_mesh(vertices, triangles)
-    s.commit(threads=1)
+    s = one_mesh(vertices, triangles, threads=1)
     org = rng.uniform(-1, 2, (20000, 3)).astype(np.float32)
     d = rng.normal(size=(20000, 3)).astype(np.float32)
     one, two = s.intersect(org, d, threads=1), s.intersect(org, d, threads=2)
@@ -186,9 +184,7 @@ def test_rays_that_cannot_hit_miss_quietly():
 
 def test_degenerate_triangles_are_kept_in_numbering_but_never_hit():
     v = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0]], np.float32)
-    s = toyrt.Scene()
-    s.add_mesh(v, np.array([[0, 1, 2], [0, 1, 3]]))  # the first is a line
-    s.commit()
+    s = one_mesh(v, np.array([[0, 1, 2], [0, 1, 3]]))  # the first is a line
     h = s.intersect([[0.2, 0.2, 1], [0.5, 0.0, 1]], [[0, 0, -1], [0, 0, -1]])
     assert h["prim"][0] == 1                                  # index of the input, not of a compacted list
     assert h["prim"][1] in (-1, 1)                            # on the shared edge: only the real triangle
@@ -208,9 +204,7 @@ def test_queries_release_the_gil():
     """A long batch in one thread leaves the interpreter free for another."""
     rng = np.random.default_rng(9)
     vertices, triangles = random_soup(rng, 50000, 0.01)
-    s = toyrt.Scene()
-    s.add_mesh(vertices, triangles)
-    s.commit()
+    s = one_mesh(vertices, triangles)
     org = rng.uniform(0, 1, (400000, 3)).astype(np.float32)
     d = rng.normal(size=(400000, 3)).astype(np.float32)
     started = threading.Event()
@@ -274,9 +268,7 @@ def test_lbvh_builder_gives_the_same_hits_as_sah():
     d = (rng.uniform(0, 1, (20000, 3)) - org).astype(np.float32)
     hits = {}
     for builder in ("sah", "lbvh"):
-        s = toyrt.Scene()
-        s.add_mesh(vertices, triangles)
-        s.commit(builder=builder)
+        s = one_mesh(vertices, triangles, builder=builder)
         assert s.last_commit[f"{builder}_meshes"] == 1 and s.last_commit["warning"] == ""
         hits[builder] = s.intersect(org, d)
     assert np.array_equal(np.isfinite(hits["sah"]["t"]), np.isfinite(hits["lbvh"]["t"]))
@@ -287,9 +279,7 @@ def test_auto_builder_follows_the_expected_ray_count():
     rng = np.random.default_rng(12)
     vertices = rng.uniform(0, 1, (30000, 3)).astype(np.float32)
     triangles = np.arange(30000, dtype=np.uint32).reshape(-1, 3)
-    s = toyrt.Scene()
-    s.add_mesh(vertices, triangles)
-    s.commit(builder="auto")  # no estimate: the faster-tracing SAH tree
+    s = one_mesh(vertices, triangles, builder="auto")  # no estimate: the faster-tracing SAH tree
     assert s.last_commit["sah_meshes"] == 1
     s.add_mesh(vertices, triangles)
     s.commit(builder="auto", expected_rays=1000)  # a handful of rays: the cheaper build

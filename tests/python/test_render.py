@@ -23,6 +23,19 @@ def floor_scene(albedo=1.0, half=5.0):
     return s
 
 
+def add_uv_sphere(s, rings, segs, material_id, radius=0.8, centre=(0, 0, 1)):
+    """A coarse UV sphere with smooth normals: each cell of its rings x segs latitude/longitude grid
+    as two triangles (degenerate at the poles)."""
+    th, ph = np.meshgrid(np.linspace(0, np.pi, rings + 1), np.linspace(0, 2 * np.pi, segs, endpoint=False),
+                         indexing="ij")
+    p = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1).reshape(-1, 3) * radius + centre
+    idx = lambda i, j: i * segs + j % segs  # noqa: E731
+    tris = [(idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)) for i in range(rings) for j in range(segs)]
+    tris += [(idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)) for i in range(rings) for j in range(segs)]
+    return s.add_mesh(p.astype(np.float32), tris, normals=((p - centre) / radius).astype(np.float32),
+                      material_ids=material_id)
+
+
 def pixel_centres(cam):
     """World (x, y) of every pixel's area, sampled on a fine grid (for averaging closed forms)."""
     n, size = cam["resolution_x"], cam["ortho_scale"]
@@ -64,7 +77,8 @@ def test_square_area_light_above_a_point_matches_the_closed_form_with_both_estim
     # each giving E = pi L F with the form factor F = 1/(2 pi) (X/sqrt(1+X^2) atan(Y/sqrt(1+X^2))
     # + Y/sqrt(1+Y^2) atan(X/sqrt(1+Y^2))), X = Y = (a/2)/h.
     X = Y = a / 2 / h
-    corner = X / np.sqrt(1 + X * X) * np.arctan(Y / np.sqrt(1 + X * X)) + Y / np.sqrt(1 + Y * Y) * np.arctan(X / np.sqrt(1 + Y * Y))
+    corner = (X / np.sqrt(1 + X * X) * np.arctan(Y / np.sqrt(1 + X * X))
+              + Y / np.sqrt(1 + Y * Y) * np.arctan(X / np.sqrt(1 + Y * Y)))
     E = 4 * np.pi * L * corner / (2 * np.pi)
     cam = camera_above(size=0.01, resolution=4)
     for estimator in ("solid_angle", "area"):
@@ -101,7 +115,7 @@ def test_tiles_arrive_as_they_finish_and_cover_the_image():
         seen[y:y + h, x:x + w] += 1
         assert pixels.shape == (h, w, 4)
 
-    img = s.render(cam, samples=2, tile_size=16, on_tile=on_tile)
+    s.render(cam, samples=2, tile_size=16, on_tile=on_tile)
     assert (seen == 1).all() and len(tiles) == 16 and s.last_render["tiles_done"] == 16
 
 
@@ -167,15 +181,7 @@ def test_glass_sphere_with_textures_and_lights_has_only_finite_non_negative_pixe
     s.add_material("glass", ior=1.45)
     v = np.array([[-3, -3, 0], [3, -3, 0], [3, 3, 0], [-3, 3, 0]], np.float32)
     s.add_mesh(v, [[0, 1, 2], [0, 2, 3]], uvs=np.array([[0, 0], [2, 0], [2, 2], [0, 2]], np.float32), material_ids=0)
-    # An icosahedron-ish sphere: a coarse UV sphere with smooth normals.
-    rings, segs = 12, 24
-    th, ph = np.meshgrid(np.linspace(0, np.pi, rings + 1), np.linspace(0, 2 * np.pi, segs, endpoint=False), indexing="ij")
-    p = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1).reshape(-1, 3) * 0.8 + [0, 0, 1]
-    idx = lambda i, j: i * segs + j % segs  # noqa: E731
-    tris = [(idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)) for i in range(rings) for j in range(segs)]
-    tris += [(idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)) for i in range(rings) for j in range(segs)]
-    normals = (p - [0, 0, 1]) / 0.8
-    s.add_mesh(p.astype(np.float32), tris, normals=normals.astype(np.float32), material_ids=1)
+    add_uv_sphere(s, 12, 24, material_id=1)
     s.add_point_light((1, 1, 3), 200.0, color=(1, 0.5, 0.2), radius=0.1)
     m = np.eye(4)
     m[:3, 3] = [-1, 0, 3]
@@ -263,18 +269,9 @@ def test_split_glass_gives_fresnel_times_the_reflected_light_without_noise():
 def test_split_and_chosen_branches_agree_on_a_glass_sphere():
     """Splitting changes the noise, not the answer: the same glass-sphere scene with and without
     it converges to one image (mean over the image within a few standard errors)."""
-    s = toyrt.Scene()
-    s.add_material("diffuse", color=(0.8, 0.8, 0.8))
+    s = floor_scene(albedo=0.8, half=3.0)
     s.add_material("glass", ior=1.45)
-    v = np.array([[-3, -3, 0], [3, -3, 0], [3, 3, 0], [-3, 3, 0]], np.float32)
-    s.add_mesh(v, [[0, 1, 2], [0, 2, 3]], material_ids=0)
-    rings, segs = 16, 32
-    th, ph = np.meshgrid(np.linspace(0, np.pi, rings + 1), np.linspace(0, 2 * np.pi, segs, endpoint=False), indexing="ij")
-    p = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1).reshape(-1, 3) * 0.8 + [0, 0, 1]
-    idx = lambda i, j: i * segs + j % segs  # noqa: E731
-    tris = [(idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)) for i in range(rings) for j in range(segs)]
-    tris += [(idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)) for i in range(rings) for j in range(segs)]
-    s.add_mesh(p.astype(np.float32), tris, normals=((p - [0, 0, 1]) / 0.8).astype(np.float32), material_ids=1)
+    add_uv_sphere(s, 16, 32, material_id=1)
     m = np.eye(4)
     m[:3, 3] = [0.5, 0, 3]
     s.add_area_light(m, shape="SQUARE", size=1.5, power=200.0)
