@@ -148,6 +148,20 @@ def slope(runs, method, metric):
     return float(np.polyfit(x, y, 1)[0])
 
 
+def variance_ratio(e):
+    """One estimator sweep point's one-sample variance of the area estimator over the solid-angle one's."""
+    return (e["area_rel_std"] * e["area_mean"]) ** 2 / max((e["solid_rel_std"] * e["solid_mean"]) ** 2, 1e-300)
+
+
+def save_figure(fig, name):
+    """Writes a matplotlib figure to docs/results/<name> (90 dpi, tight layout) and closes it: its path."""
+    fig.tight_layout()
+    path = FIG / name
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path
+
+
 def error_charts(scenes):
     paths = []
     for name, data in scenes.items():
@@ -162,11 +176,7 @@ def error_charts(scenes):
             ax.grid(True, which="both", alpha=0.3)
         axes[0].legend(fontsize=7)
         fig.suptitle(f"{name}: error against the Cycles reference vs time")
-        fig.tight_layout()
-        path = FIG / f"error-{name}.png"
-        fig.savefig(path, dpi=90)
-        plt.close(fig)
-        paths.append(path)
+        paths.append(save_figure(fig, f"error-{name}.png"))
     return paths
 
 
@@ -179,11 +189,7 @@ def scene_montage(work, scenes):
         ax.imshow(np.clip(srgb, 0, 1))
         ax.set_title(name, fontsize=9)
         ax.axis("off")
-    fig.tight_layout()
-    path = FIG / "scenes.png"
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return path
+    return save_figure(fig, "scenes.png")
 
 
 # ---- section 2: acceleration structures -------------------------------------------------------
@@ -216,15 +222,16 @@ def main():
     w = md.append
 
     # -- header: machine, versions, date --
-    cpu = next((l.split(":", 1)[1].strip() for l in Path("/proc/cpuinfo").read_text().splitlines()
-                if l.startswith("model name")), platform.processor())
+    cpu = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
+                if line.startswith("model name")), platform.processor())
     commit = sh("git", "rev-parse", "--short=12", "HEAD")
     dirty = sh("git", "status", "--porcelain", "--untracked-files=no", "--", "native", "kernels", "addon")
     mitsuba_info = next((load(p) for p in sorted(work.glob("mitsuba-*.json"))), None) or {}
     py = load(work / "accel-python.json") or {}
     versions = {
         "Blender": sh(args.blender, "-b", "--version").splitlines()[0] if sh(args.blender, "-b", "--version") else "?",
-        "Embree": sh("dpkg-query", "-W", "-f", "${Version}", "libembree3-3") or sh("dpkg-query", "-W", "-f", "${Version}", "libembree-dev"),
+        "Embree": (sh("dpkg-query", "-W", "-f", "${Version}", "libembree3-3")
+                   or sh("dpkg-query", "-W", "-f", "${Version}", "libembree-dev")),
         "PoCL": sh("dpkg-query", "-W", "-f", "${Version}", "pocl-opencl-icd"),
         "Mitsuba": f"{mitsuba_info.get('version', 'not run')} ({mitsuba_info.get('variant', '?')})",
         "Open3D": py.get("open3d") or f"not available ({py.get('open3d_error', 'not run')})",
@@ -288,16 +295,19 @@ def main():
         for name, data in scenes.items():
             st = data.get("scene_stats", {})
             ref = data["reference"]
+            toyrt_fixed = np.median([r["seconds"] - r["render_seconds"] for r in data["runs"]
+                                     if r["renderer"] == "toyrt"])
             w(f"| {name} | {st.get('triangles', '?'):,} | {st.get('instances', '?')} | {st.get('lights', '?')} | "
               f"{100 * data.get('masked_fraction', 0):.1f} % | {fmt(ref.get('seconds'))}"
               f"{' (cached)' if ref.get('cached') else ''} | {ref_noise(data['runs'], ref.get('spp'))} | "
-              f"{fmt(float(np.median([r['seconds'] - r['render_seconds'] for r in data['runs'] if r['renderer'] == 'toyrt'])))} | "
+              f"{fmt(float(toyrt_fixed))} | "
               f"{fixed_costs(data)} | {worst_share(work, name)} |")
-        firefly = [n for n in scenes if worst_share(work, n).rstrip(" %").isdigit() and int(worst_share(work, n).rstrip(" %")) >= 90]
+        shares = {n: worst_share(work, n).rstrip(" %") for n in scenes}
+        firefly = [n for n in scenes if shares[n].isdigit() and int(shares[n]) >= 90]
         if firefly:
             w("\nIn " + ", ".join(firefly) + " the worst 1 % of pixels hold most of TOYRT's squared error: RMSE there "
-              "measures a few fireflies (here: paths that find the bright light through the glass sphere) and falls slowly; relative "
-              "MSE weighs them down and is the fairer metric for those scenes.")
+              "measures a few fireflies (here: paths that find the bright light through the glass sphere) and falls "
+              "slowly; relative MSE weighs them down and is the fairer metric for those scenes.")
         for path in error_charts(scenes):
             w(f"\n![{path.stem}](results/{path.name})")
         w("\n### Time to equal error\n")
@@ -308,7 +318,8 @@ def main():
           "the largest sample count measured. Above 1: faster than the peer. '>=': the method beat some of the "
           "peer's errors with its fewest samples and no error is covered by both fits: the time of its fewest "
           "samples then stands in for its (longer) true time.\n")
-        w("| scene | method | vs Cycles, RMSE (n) | vs Cycles, relMSE (n) | vs Mitsuba, RMSE (n) | vs Mitsuba, relMSE (n) |")
+        w("| scene | method | vs Cycles, RMSE (n) | vs Cycles, relMSE (n) | vs Mitsuba, RMSE (n) "
+          "| vs Mitsuba, relMSE (n) |")
         w("|---|---|---|---|---|---|")
         summary = {}
         for name, data in scenes.items():
@@ -339,9 +350,11 @@ def main():
         w("Not run.")
 
     # Headlines: TOYRT as shipped (solid angle; light_sampling auto = one light per hit above 4).
-    head = ["\n## Headlines\n", "TOYRT with its defaults (solid-angle estimator; `light_sampling=\"auto\"`, which picks "
+    head = ["\n## Headlines\n",
+            "TOYRT with its defaults (solid-angle estimator; `light_sampling=\"auto\"`, which picks "
             "one light per hit above 4 lights) against the others, time to equal error (section 1; above 1: TOYRT "
-            "faster):\n", "| scene | TOYRT method | vs Cycles, RMSE | vs Cycles, relMSE | vs Mitsuba, RMSE | vs Mitsuba, relMSE |",
+            "faster):\n",
+            "| scene | TOYRT method | vs Cycles, RMSE | vs Cycles, relMSE | vs Mitsuba, RMSE | vs Mitsuba, relMSE |",
             "|---|---|---|---|---|---|"]
     for name, data in scenes.items():
         lights = data.get("scene_stats", {}).get("lights", 0)
@@ -371,7 +384,8 @@ def main():
           "(C++: `Scene::intersect`/`occluded`; Python: TOYRT's `Scene.intersect`/`occluded` and Open3D's "
           "`cast_rays`/`test_occlusions` on the same rays, read from files bench_accel wrote).\n")
         fig, axes = plt.subplots(1, 4, figsize=(16, 3.8))
-        series = [("SAH", lambda n, k: by.get((n, "sah"), {}).get(k)), ("LBVH", lambda n, k: by.get((n, "lbvh"), {}).get(k)),
+        series = [("SAH", lambda n, k: by.get((n, "sah"), {}).get(k)),
+                  ("LBVH", lambda n, k: by.get((n, "lbvh"), {}).get(k)),
                   ("Embree 3", lambda n, k: by.get((n, "embree"), {}).get(k))]
         o3d_names = {"build_ms": "open3d_build_ms", "primary_mrays": "open3d_primary_mrays",
                      "diffuse_mrays": "open3d_diffuse_mrays", "shadow_mrays": "open3d_shadow_mrays"}
@@ -382,7 +396,8 @@ def main():
             for sname, get in series:
                 ax.plot(sizes, [float(get(n, key)) for n in sizes], "o-", label=sname)
             if pyrows and o3d_names[key] in next(iter(pyrows.values())):
-                ax.plot(sizes, [pyrows.get(n, {}).get(o3d_names[key], np.nan) for n in sizes], "s--", label="Open3D (Python)")
+                ax.plot(sizes, [pyrows.get(n, {}).get(o3d_names[key], np.nan) for n in sizes], "s--",
+                        label="Open3D (Python)")
                 ax.plot(sizes, [pyrows.get(n, {}).get(t_names[key], np.nan) for n in sizes], "^--",
                         label="TOYRT SAH (Python)")
             ax.set_xscale("log")
@@ -392,24 +407,25 @@ def main():
             ax.set_title(label)
             ax.grid(True, which="both", alpha=0.3)
         axes[0].legend(fontsize=7)
-        fig.tight_layout()
-        fig.savefig(FIG / "accel.png", dpi=90)
-        plt.close(fig)
+        save_figure(fig, "accel.png")
         w("![build time and trace speed against triangle count](results/accel.png)\n")
         w("| triangles | builder | build ms | SAH cost | primary Mrays/s | diffuse Mrays/s | shadow Mrays/s |")
         w("|---|---|---|---|---|---|---|")
         for n in sizes:
             for b, label in (("sah", "SAH"), ("lbvh", "LBVH"), ("embree", "Embree 3")):
                 r = by[(n, b)]
-                w(f"| {n:,} | {label} | {fmt(float(r['build_ms']))} | {fmt(float(r['sah_cost'])) if b != 'embree' else '-'} | "
-                  f"{fmt(float(r['primary_mrays']))} | {fmt(float(r['diffuse_mrays']))} | {fmt(float(r['shadow_mrays']))} |")
+                w(f"| {n:,} | {label} | {fmt(float(r['build_ms']))} | "
+                  f"{fmt(float(r['sah_cost'])) if b != 'embree' else '-'} | {fmt(float(r['primary_mrays']))} | "
+                  f"{fmt(float(r['diffuse_mrays']))} | {fmt(float(r['shadow_mrays']))} |")
             p = pyrows.get(n)
             if p:
-                w(f"| {n:,} | TOYRT SAH, Python API | {fmt(p['toyrt_build_ms'])} | - | {fmt(p['toyrt_primary_mrays'])} | "
+                w(f"| {n:,} | TOYRT SAH, Python API | {fmt(p['toyrt_build_ms'])} | - | "
+                  f"{fmt(p['toyrt_primary_mrays'])} | "
                   f"{fmt(p['toyrt_diffuse_mrays'])} | {fmt(p['toyrt_shadow_mrays'])} |")
                 if "open3d_build_ms" in p:
                     w(f"| {n:,} | Open3D RaycastingScene, Python API | {fmt(p['open3d_build_ms'])} | - | "
-                      f"{fmt(p['open3d_primary_mrays'])} | {fmt(p['open3d_diffuse_mrays'])} | {fmt(p['open3d_shadow_mrays'])} |")
+                      f"{fmt(p['open3d_primary_mrays'])} | {fmt(p['open3d_diffuse_mrays'])} | "
+                      f"{fmt(p['open3d_shadow_mrays'])} |")
         if pyrows and all("agree_primary" in p for p in pyrows.values()):
             worst = min(min(p[f"agree_{k}"] for k in ("primary", "diffuse", "shadow")) for p in pyrows.values())
             w(f"\nOpen3D and TOYRT agree on hit or miss for at least {100 * worst:.3f} % of the rays at every size.")
@@ -419,7 +435,8 @@ def main():
         w("\n**Total time** (build + trace) of a render with one primary, one diffuse and one shadow ray per "
           "sample, from the measured build times and per-type speeds; `auto` is TOYRT's choice for that ray count "
           "(`commit(builder=\"auto\", expected_rays=...)`, read back from `last_commit`).\n")
-        w("| triangles | workload | SAH s | LBVH s | Embree s | fastest | auto builds | auto's total vs the faster TOYRT builder |")
+        w("| triangles | workload | SAH s | LBVH s | Embree s | fastest | auto builds "
+          "| auto's total vs the faster TOYRT builder |")
         w("|---|---|---|---|---|---|---|---|")
         auto_verdicts = []
         for n in sizes:
@@ -436,7 +453,8 @@ def main():
                 loss = tot[picked] / better - 1
                 auto_verdicts.append((loss, f"{n:,} triangles, {label.split(':')[0]}"))
                 w(f"| {n:,} | {label} | {fmt(tot['sah'])} | {fmt(tot['lbvh'])} | {fmt(tot['embree'])} | "
-                  f"{dict(sah='SAH', lbvh='LBVH', embree='Embree')[fastest]} | {picked.upper()} | {100 * loss:+.1f} % |")
+                  f"{dict(sah='SAH', lbvh='LBVH', embree='Embree')[fastest]} | {picked.upper()} | "
+                  f"{100 * loss:+.1f} % |")
         embree_faster = all(float(by[(n, "embree")][k]) > float(by[(n, "sah")][k]) for n in sizes
                             for k in ("primary_mrays", "diffuse_mrays", "shadow_mrays"))
     else:
@@ -459,7 +477,8 @@ def main():
         for c in st["leaks"]:
             w(f"| {c['mesh']} | {c['placement']} | {c['rays']} | **{c['watertight']}** | {c['moller_trumbore']} | "
               f"{c['embree']} | {c['embree_robust']} |")
-        tot = {k: sum(c[k] for c in st["leaks"]) for k in ("rays", "watertight", "moller_trumbore", "embree", "embree_robust")}
+        tot = {k: sum(c[k] for c in st["leaks"])
+               for k in ("rays", "watertight", "moller_trumbore", "embree", "embree_robust")}
         w(f"\nIn all: {tot['watertight']} leaks for TOYRT, {tot['moller_trumbore']} for Moller-Trumbore, "
           f"{tot['embree']} for Embree and {tot['embree_robust']} for Embree robust, of {tot['rays']} rays.\n")
         w("### Self-intersection (shadow acne)\n")
@@ -487,7 +506,8 @@ def main():
             pts = [e for e in est if e["sweep"] == sweep]
             x = [max(e["parameter"], 1e-3) if sweep == "distance" else e["parameter"] for e in pts]
             ax.plot(x, [e["area_rel_std"] for e in pts], "o-", label="area", color=COLORS["TOYRT area/all"])
-            ax.plot(x, [e["solid_rel_std"] for e in pts], "o-", label="solid angle", color=COLORS["TOYRT solid_angle/all"])
+            ax.plot(x, [e["solid_rel_std"] for e in pts], "o-", label="solid angle",
+                    color=COLORS["TOYRT solid_angle/all"])
             if sweep == "distance":
                 ax.set_xscale("log")
             ax.set_yscale("log")
@@ -495,14 +515,13 @@ def main():
             ax.set_ylabel("relative std. dev. of one sample")
             ax.grid(True, which="both", alpha=0.3)
             ax.legend()
-        fig.tight_layout()
-        fig.savefig(FIG / "estimators.png", dpi=90)
-        plt.close(fig)
+        save_figure(fig, "estimators.png")
         w("![estimator noise](results/estimators.png)\n")
-        w("| sweep | m | area: mean | area: rel. std | solid angle: mean | solid angle: rel. std | variance ratio area / solid angle |")
+        w("| sweep | m | area: mean | area: rel. std | solid angle: mean | solid angle: rel. std "
+          "| variance ratio area / solid angle |")
         w("|---|---|---|---|---|---|---|")
         for e in est:
-            ratio = (e["area_rel_std"] * e["area_mean"]) ** 2 / max((e["solid_rel_std"] * e["solid_mean"]) ** 2, 1e-300)
+            ratio = variance_ratio(e)
             w(f"| {e['sweep']} | {fmt(e['parameter'])} | {fmt(e['area_mean'])} | {fmt(e['area_rel_std'])} | "
               f"{fmt(e['solid_mean'])} | {fmt(e['solid_rel_std'])} | {fmt(ratio)} |")
         room = st["lbvh_room"]
@@ -560,7 +579,8 @@ def main():
         w(f"The seed's Cornell box at {cfg.get('width')}x{cfg.get('height')}, {eco['spp']} spp, TOYRT's defaults, "
           "features switched on one at a time (scenes/bench/cornell.py). Seconds from scene to image (export, "
           "build, render) and of `render()` alone; best of several runs.\n")
-        w("| step | triangles | instances | lights | s, scene to image | s, render() | render() vs the bare box | light sampling used |")
+        w("| step | triangles | instances | lights | s, scene to image | s, render() | render() vs the bare box "
+          "| light sampling used |")
         w("|---|---|---|---|---|---|---|---|")
         base = steps[0]["render_seconds"]
         for s in steps:
@@ -573,9 +593,7 @@ def main():
                 left=[s["render_seconds"] for s in steps][::-1], color="#aec7e8", label="export + build")
         ax.set_xlabel("seconds")
         ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(FIG / "economy.png", dpi=90)
-        plt.close(fig)
+        save_figure(fig, "economy.png")
         w("\n![render time as features are switched on](results/economy.png)")
     else:
         w("Not run.")
@@ -612,41 +630,42 @@ def main():
              "area sampling's variance explodes, so the change it argues for is a per-shading-point choice "
              "(solid angle when the light subtends a large solid angle, area otherwise), a native change, rather "
              "than a switch to area.")
-          + (f" Near a light its one-sample variance is up to {fmt(max((e['area_rel_std'] * e['area_mean']) ** 2 / max((e['solid_rel_std'] * e['solid_mean']) ** 2, 1e-300) for e in st['estimators']))}x lower (section 3)." if st else ""))
+          + (f" Near a light its one-sample variance is up to {fmt(max(variance_ratio(e) for e in st['estimators']))}x "
+             "lower (section 3)." if st else ""))
         ls_ratios = []
         for name, data in scenes.items():
             s, _ = speedup(data["runs"], "TOYRT solid_angle/one", "TOYRT solid_angle/all", "relmse")
             lights = data.get("scene_stats", {}).get("lights", 0)
             if s:
                 ls_ratios.append((name, lights, s[0]))
-        single = [(n, s) for n, l, s in ls_ratios if l == 1]
+        single = [(n, s) for n, lights, s in ls_ratios if lights == 1]
         # A one-light scene renders the same image both ways: its ratio is the timing noise, and only
         # ratios beyond it count as disagreeing with auto's threshold.
         # Ratios within 10 % of 1 (or within that noise, if larger) count as ties.
         noise = max([max(s, 1 / s) for n, s in single] + [1.1])
-        disagree = [(n, l, s) for n, l, s in ls_ratios
-                    if l > 1 and ((l > 4 and s < 1 / noise) or (l <= 4 and s > noise))]
+        disagree = [(n, lights, s) for n, lights, s in ls_ratios
+                    if lights > 1 and ((lights > 4 and s < 1 / noise) or (lights <= 4 and s > noise))]
         w("- **Light sampling** (one light per hit against all, solid angle, relative MSE; above 1: one is faster): "
-          + ", ".join(f"{n} ({l} light{'s' if l != 1 else ''}) {fmt(s)}" for n, l, s in ls_ratios) + ". "
+          + ", ".join(f"{n} ({lights} light{'s' if lights != 1 else ''}) {fmt(s)}" for n, lights, s in ls_ratios) + ". "
           + "".join(f"{n} has one light, so both modes render the same image and {fmt(s)} is the timing noise of "
                     "this run. " for n, s in single)
           + ("`auto` (one light above 4) matches every scene here." if not disagree else
              "`auto` switches to one light above 4 lights; the measurements disagree with that for "
-             + ", ".join(f"{n} ({l} lights, {fmt(s)})" for n, l, s in disagree)
+             + ", ".join(f"{n} ({lights} lights, {fmt(s)})" for n, lights, s in disagree)
              + (": with many lights a shadow ray to every light still converged faster per second than one light "
                 "chosen by expected contribution, so the threshold should move up (or the selection improve) "
-                "before `one` pays off." if any(l > 4 for n, l, s in disagree) else ".")))
+                "before `one` pays off." if any(lights > 4 for n, lights, s in disagree) else ".")))
         if auto_verdicts:
             right = sum(v <= 1e-9 for v, _ in auto_verdicts)
             missed = [row for v, row in auto_verdicts if v > 1e-9]
-            w(f"- **Builder**: `auto` picked the faster of SAH and LBVH in {right} of {len(auto_verdicts)} workloads of "
-              "section 2" + (f"; where it did not ({', '.join(missed)}), its pick cost "
+            w(f"- **Builder**: `auto` picked the faster of SAH and LBVH in {right} of {len(auto_verdicts)} "
+              "workloads of section 2" + (f"; where it did not ({', '.join(missed)}), its pick cost "
                              f"{100 * max(v for v, _ in auto_verdicts):.1f} % at most." if missed else ".")
               + (" Embree's trees traced faster than TOYRT's SAH trees for every ray type at every size, so "
                  "final-render totals would gain most from faster traversal, not from another builder policy."
                  if embree_faster else ""))
-        sl = [(n, slopes.get((n, "TOYRT solid_angle/all")), slopes.get((n, "Mitsuba 3 direct")), slopes.get((n, "Cycles")))
-              for n in scenes]
+        sl = [(n, slopes.get((n, "TOYRT solid_angle/all")), slopes.get((n, "Mitsuba 3 direct")),
+               slopes.get((n, "Cycles"))) for n in scenes]
         w("- **Sample pattern**: TOYRT's RMSE slopes against spp (Sobol-Owen) are "
           + ", ".join(f"{n} {fmt(a)}" for n, a, b, c in sl)
           + "; Cycles' " + ", ".join(f"{fmt(c)}" for n, a, b, c in sl)
