@@ -1,11 +1,17 @@
 """What the Blender test scripts share: checks that are counted instead of raising (one failed
-check must not hide the next), parts timed and isolated, Blender's C-level output captured, and
-the summary line + exit status that `make test-blender` and run_with_bpy.py read.
+check must not hide the next), parts timed and isolated, Blender's C-level output captured, F12
+to a file, and the summary line + exit status that `make test-blender` and run_with_bpy.py read.
+Their scenes come from the scene kit, scenes/kit.py, which the benchmarks and the demo use too.
 
 The scripts run as `blender -b --python tests/blender/test_x.py`, which does not put the script's
-folder on sys.path; each adds it before `from harness import ...`. Not a test itself (no test_
-prefix), so `make test-blender` does not run it."""
+folder on sys.path; each adds it and scenes/ before `from harness import ...` and `import kit`:
+
+    HERE = os.path.dirname(os.path.abspath(__file__))
+    sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit
+
+Not a test itself (no test_ prefix), so `make test-blender` does not run it."""
 import os
+import shutil
 import sys
 import tempfile
 import time
@@ -55,6 +61,30 @@ def captured_output():
         buf.seek(0)
         text.append(buf.read().decode(errors="replace"))
         buf.close()
+
+
+def render_still(path):
+    """F12's operator, writing the still to `path` in the scene's file format: (the operator's
+    result, or the text of the error it raised; everything Blender printed meanwhile)."""
+    import bpy
+
+    bpy.context.scene.render.filepath = str(path)
+    with captured_output() as out:
+        try:
+            result = bpy.ops.render.render(write_still=True)
+        except RuntimeError as err:
+            result = str(err)
+    return result, out[0]
+
+
+def run_script(parts, label, tmp=None):
+    """A script's last line: runs its parts in turn (run_part: an exception fails one check and the
+    next part still runs), removes the folder `tmp` they wrote to, then finish(label)."""
+    for part in parts:
+        run_part(part)
+    if tmp is not None:
+        shutil.rmtree(tmp, ignore_errors=True)
+    finish(label)
 
 
 def finish(label):

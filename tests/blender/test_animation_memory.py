@@ -10,12 +10,15 @@
 #   - each frame's picture is right: the moving cube is where the camera puts it (checked on the
 #     first and last frames).
 import os
-import shutil
 import sys
 import tempfile
 
 import bpy
-import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit (see harness)
+import kit  # noqa: E402
+from harness import check, run_script  # noqa: E402
 
 FRAMES = 100
 TMP = tempfile.mkdtemp(prefix="toyrt-test-animation-")
@@ -30,22 +33,17 @@ def rss():
 
 
 def build():
-    bpy.data.batch_remove(list(bpy.data.objects) + list(bpy.data.meshes))
-    scene = bpy.context.scene
-    scene.render.engine = "TOYRT"
-    scene.render.resolution_x = scene.render.resolution_y = 16
-    scene.render.resolution_percentage = 100
-    scene.toyrt.samples = 1
+    scene = kit.clear_scene()
     # Standard, not the default view transform: 4.x's AgX maps the cube's top and the floor beside
     # it (radiance 0.45 and 0.40) to the same 8-bit value.
-    scene.view_settings.view_transform = "Standard"
+    kit.output(scene, 16, 16)
+    kit.toyrt(scene, samples=1)
     scene.frame_start, scene.frame_end = 1, FRAMES
     scene.render.image_settings.file_format = "PNG"
     scene.render.filepath = os.path.join(TMP, "frame_")
 
-    bpy.ops.mesh.primitive_plane_add(size=20, location=(0, 0, 0))              # static
-    bpy.ops.mesh.primitive_cube_add(size=1, location=(-2, 0, 0.5))             # moves
-    cube = bpy.context.object
+    kit.plane("floor", 20.0)                                                   # static
+    cube = kit.box("cube", 1.0, (-2, 0, 0.5))                                  # moves
     cube.keyframe_insert("location", frame=1)
     cube.location.x = 2
     cube.keyframe_insert("location", frame=FRAMES)
@@ -54,18 +52,8 @@ def build():
     wave = sphere.modifiers.new("wave", "WAVE")
     wave.height = 0.1
     wave.time_offset = 0.0
-    light = bpy.data.lights.new("light", "POINT")
-    light.energy = 500
-    lo = bpy.data.objects.new("light", light)
-    lo.location = (0, 0, 5)
-    scene.collection.objects.link(lo)
-    cam = bpy.data.cameras.new("cam")
-    cam.type = "ORTHO"
-    cam.ortho_scale = 10
-    co = bpy.data.objects.new("cam", cam)
-    co.location = (0, 0, 10)
-    scene.collection.objects.link(co)
-    scene.camera = co
+    kit.point_light("light", (0, 0, 5), 500.0, radius=0.25)     # Blender 3.4's default radius
+    kit.camera((0, 0, 10), ortho_scale=10.0)
     return scene, sphere
 
 
@@ -84,13 +72,6 @@ def main():
     finally:
         bpy.app.handlers.render_post.remove(after_frame)
 
-    failures = []
-
-    def check(cond, what):
-        print(("  ok: " if cond else "  FAIL: ") + what, flush=True)
-        if not cond:
-            failures.append(what)
-
     files = sorted(f for f in os.listdir(TMP) if f.endswith(".png"))
     check(len(files) == FRAMES, f"{FRAMES} frames written ({len(files)})")
     caches = sync.render_caches()
@@ -98,10 +79,12 @@ def main():
     cache = caches[0]
     c = cache.counters
     # Frame 1: plane, cube, sphere; frames 2..100: the deformed sphere only.
-    check(c["meshes_exported"] == 3 + (FRAMES - 1), f"meshes exported: {c['meshes_exported']} (expected {3 + FRAMES - 1})")
+    check(c["meshes_exported"] == 3 + (FRAMES - 1),
+          f"meshes exported: {c['meshes_exported']} (expected {3 + FRAMES - 1})")
     check(c["transforms_set"] >= FRAMES - 1, f"the cube's transform set each frame ({c['transforms_set']})")
     check(c["instance_resets"] == 1, f"instances laid out once ({c['instance_resets']})")
-    check(cache.scene.mesh_count == 3, f"the native scene holds 3 meshes after {FRAMES} frames ({cache.scene.mesh_count})")
+    check(cache.scene.mesh_count == 3,
+          f"the native scene holds 3 meshes after {FRAMES} frames ({cache.scene.mesh_count})")
 
     sphere_bytes = cache.scene.memory_bytes  # the whole scene: a bound above the sphere's own bytes
     growth = samples[FRAMES] - samples[10]
@@ -113,21 +96,11 @@ def main():
     # The cube (x from -2 to 2 over the animation) under the ortho camera, 10 m across 16 pixels:
     # its column moves from about 8 - 2 * 1.6 to 8 + 2 * 1.6.
     for frame, expect_x in ((1, -2.0), (FRAMES, 2.0)):
-        img = bpy.data.images.load(os.path.join(TMP, f"frame_{frame:04d}.png"))
-        px = np.array(img.pixels[:]).reshape(16, 16, 4)
-        bpy.data.images.remove(img)
+        px = kit.read_image(os.path.join(TMP, f"frame_{frame:04d}.png"))
         row = px[8, :, 0]  # through the cube's centre (y = 0), rows from the bottom
         col = (expect_x + 5.0) / 10.0 * 16.0
         inside, outside = row[int(col)], row[int(col) + 3 if expect_x < 0 else int(col) - 3]
         check(inside != outside, f"frame {frame}: the cube's top differs from the floor beside it at column {col:.0f}")
-    return failures
 
 
-try:
-    failed = main()
-finally:
-    shutil.rmtree(TMP, ignore_errors=True)
-if failed:
-    print(f"test_animation_memory: {len(failed)} failed", flush=True)
-    sys.exit(1)
-print("test_animation_memory: all checks passed", flush=True)
+run_script([main], "animation memory", TMP)

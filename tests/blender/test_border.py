@@ -10,16 +10,15 @@
 # The border is chosen on whole pixels (Blender: pixel x from border_min_x * width to
 # border_max_x * width), so the expected window is known exactly.
 import os
-import shutil
 import sys
 import tempfile
-import traceback
 
-import bpy
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # for harness (see there)
-from harness import RESULTS, check, finish  # noqa: E402
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit (see harness)
+import kit  # noqa: E402
+from harness import check, render_still, run_script  # noqa: E402
 
 TMP = tempfile.mkdtemp(prefix="toyrt-test-border-")
 W, H = 64, 48
@@ -28,45 +27,17 @@ X0, X1, Y0, Y1 = 16, 48, 12, 24             # the same in pixels (rows from the 
 
 
 def build_scene():
-    scene = bpy.context.scene
-    bpy.data.batch_remove(list(bpy.data.objects))
-    scene.world = None
-    mat = bpy.data.materials.new("white")
-    mat.use_nodes = True
-    nodes = mat.node_tree.nodes
-    nodes.clear()
-    out = nodes.new("ShaderNodeOutputMaterial")
-    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
-    bsdf.inputs["Color"].default_value = (0.8, 0.8, 0.8, 1.0)
-    mat.node_tree.links.new(bsdf.outputs[0], out.inputs["Surface"])
-    bpy.ops.mesh.primitive_plane_add(size=20)
-    bpy.context.object.data.materials.append(mat)
-    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0.3, 0.2, 0.5))
-    bpy.context.object.data.materials.append(mat)
-    light = bpy.data.lights.new("lamp", "POINT")
-    light.energy, light.shadow_soft_size = 400.0, 0.5      # a soft shadow: noise that must match too
-    lamp = bpy.data.objects.new("lamp", light)
-    lamp.location = (2.0, -1.0, 4.0)
-    scene.collection.objects.link(lamp)
-    cam = bpy.data.cameras.new("cam")
-    cam.type, cam.ortho_scale = "ORTHO", 6.0
-    co = bpy.data.objects.new("cam", cam)
-    co.location = (0, 0, 10)
-    scene.collection.objects.link(co)
-    scene.camera = co
+    scene = kit.clear_scene()
+    white = kit.diffuse("white", (0.8, 0.8, 0.8))
+    kit.plane("floor", 20.0, white)
+    kit.box("cube", 1.0, (0.3, 0.2, 0.5), white)
+    kit.point_light("lamp", (2.0, -1.0, 4.0), 400.0, radius=0.5)      # a soft shadow: noise that must match too
+    kit.camera((0, 0, 10), ortho_scale=6.0)
+    kit.output(scene, W, H)
     r = scene.render
-    r.engine = "TOYRT"
-    r.resolution_x, r.resolution_y, r.resolution_percentage = W, H, 100
-    r.pixel_aspect_x = r.pixel_aspect_y = 1.0
     r.border_min_x, r.border_max_x, r.border_min_y, r.border_max_y = BORDER
-    r.film_transparent = False
-    r.image_settings.file_format = "OPEN_EXR"
-    r.image_settings.color_depth = "32"
-    r.image_settings.color_mode = "RGBA"
-    scene.view_settings.view_transform = "Standard"
-    scene.view_settings.look = "None"
-    scene.toyrt.samples = 8
-    scene.toyrt.seed = 3
+    kit.float_exr(scene)
+    kit.toyrt(scene, samples=8, seed=3)
     return scene
 
 
@@ -74,16 +45,8 @@ def render(scene, name, use_border, crop):
     scene.render.use_border = use_border
     scene.render.use_crop_to_border = crop
     path = os.path.join(TMP, name + ".exr")
-    scene.render.filepath = path
-    result = bpy.ops.render.render(write_still=True)
-    img = bpy.data.images.load(path, check_existing=False)
-    try:
-        w, h = img.size[:]
-        px = np.empty(w * h * 4, np.float32)
-        img.pixels.foreach_get(px)
-    finally:
-        bpy.data.images.remove(img)
-    return result, px.reshape(h, w, 4)                     # rows from the bottom
+    result, _ = render_still(path)
+    return result, kit.read_image(path)                    # rows from the bottom
 
 
 def main():
@@ -110,14 +73,9 @@ def main():
           f"expected {X1 - X0}x{Y1 - Y0})")
     if cropped.shape == inside.shape:
         diff = float(np.abs(cropped - inside).max())
-        check(diff <= 1e-6, f"border with crop: the same pixels as the full render's region (max difference {diff:.2e})")
+        check(diff <= 1e-6,
+              f"border with crop: the same pixels as the full render's region (max difference {diff:.2e})")
     scene.render.use_border = False
 
 
-try:
-    main()
-except Exception:
-    traceback.print_exc()
-    RESULTS.append(False)
-shutil.rmtree(TMP, ignore_errors=True)
-finish("border")
+run_script([main], "border", TMP)

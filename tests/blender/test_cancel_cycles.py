@@ -22,13 +22,14 @@ import os
 import sys
 import threading
 import time
-import traceback
 
 import bpy
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # for harness (see there)
-from harness import RESULTS, check, finish  # noqa: E402
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit (see harness)
+import kit  # noqa: E402
+from harness import check, run_script  # noqa: E402
 
 CYCLES = int(os.environ.get("TOYRT_CANCEL_CYCLES", "50"))
 LATENCY_LIMIT = 0.2      # seconds, the figure, for cancels while rendering
@@ -85,9 +86,7 @@ def install_proxy():
 
 
 def build_scene():
-    scene = bpy.context.scene
-    bpy.data.batch_remove(list(bpy.data.objects))
-    scene.world = None
+    scene = kit.clear_scene()
     # A bumpy 300 x 300 grid (180,000 triangles, built with foreach_set: the primitive operators
     # are slow at this size), so the export and the BVH build each take a measurable time.
     n = 300
@@ -96,34 +95,12 @@ def build_scene():
     i, j = np.meshgrid(np.arange(n), np.arange(n))
     v0 = (j * (n + 1) + i).ravel()
     quads = np.stack([v0, v0 + 1, v0 + n + 2, v0 + n + 1], axis=1).astype(np.int32)
-    me = bpy.data.meshes.new("bumps")
-    me.vertices.add(len(co))
-    me.vertices.foreach_set("co", co.ravel())
-    me.loops.add(quads.size)
-    me.loops.foreach_set("vertex_index", quads.ravel())
-    me.polygons.add(len(quads))
-    me.polygons.foreach_set("loop_start", np.arange(0, quads.size, 4, dtype=np.int32))
-    me.polygons.foreach_set("loop_total", np.full(len(quads), 4, np.int32))
-    me.update()
-    scene.collection.objects.link(bpy.data.objects.new("bumps", me))
-    light = bpy.data.lights.new("lamp", "POINT")
-    light.energy, light.shadow_soft_size = 500.0, 0.5
-    lamp = bpy.data.objects.new("lamp", light)
-    lamp.location = (2.0, -2.0, 4.0)
-    scene.collection.objects.link(lamp)
-    cam = bpy.data.cameras.new("cam")
-    cam.type, cam.ortho_scale = "ORTHO", 6.0
-    co = bpy.data.objects.new("cam", cam)
-    co.location = (0, 0, 10)
-    scene.collection.objects.link(co)
-    scene.camera = co
-    r = scene.render
-    r.engine = "TOYRT"
-    r.resolution_x, r.resolution_y, r.resolution_percentage = 160, 120, 100
-    r.use_border = False
+    kit.mesh_object("bumps", co, quads)
+    kit.point_light("lamp", (2.0, -2.0, 4.0), 500.0, radius=0.5)
+    kit.camera((0, 0, 10), ortho_scale=6.0)
+    kit.output(scene, 160, 120)
     # 100,000 samples per pixel: uncancelled, this render would take hours.
-    scene.toyrt.samples = 100_000
-    scene.toyrt.builder = "sah"
+    kit.toyrt(scene, samples=100_000, builder="sah")
     return scene
 
 
@@ -190,7 +167,8 @@ def main():
 
     stopped = [s for done, s in bvh_cancels if not done and s is not None]
     check(len(stopped) == len(bvh_cancels),
-          f"cancelled during the BVH build: every build stopped before completing ({len(stopped)} of {len(bvh_cancels)})")
+          "cancelled during the BVH build: every build stopped before completing "
+          f"({len(stopped)} of {len(bvh_cancels)})")
     if stopped:
         check(float(np.median(stopped)) <= LATENCY_LIMIT,
               f"cancel during the BVH build returned within {LATENCY_LIMIT} s of Esc (median "
@@ -199,7 +177,8 @@ def main():
         print(f"  cancel during {p}: honoured when the phase ends, {np.median(phase_s[p]) * 1000:.0f} ms "
               f"(median of {len(phase_s[p])}; max {max(phase_s[p]) * 1000:.0f} ms) for 180,000 triangles", flush=True)
     print(f"  cancel while rendering: F12 returned {np.median(latencies) * 1000:.1f} ms after Esc (median of "
-          f"{len(latencies)}; max {max(latencies) * 1000:.1f} ms), {np.median(f12_s):.2f} s after it started", flush=True)
+          f"{len(latencies)}; max {max(latencies) * 1000:.1f} ms), {np.median(f12_s):.2f} s after it started",
+          flush=True)
     # The median, not the maximum: on a loaded machine one cancel in 17 has taken 0.4 s (the OS did
     # not schedule the process), while the median stays near 1 ms; a cancel that is not polled
     # inside pixels takes the whole 100,000-sample pixel (about 1 s) every time and fails this.
@@ -223,9 +202,4 @@ def main():
           f"({growth:+.1f} MB, trend {slope * 1024:+.0f} KB per cycle; max {max(rss[9:]):.0f} MB)")
 
 
-try:
-    main()
-except Exception:
-    traceback.print_exc()
-    RESULTS.append(False)
-finish("cancel cycles")
+run_script([main], "cancel cycles")

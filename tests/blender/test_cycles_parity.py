@@ -4,9 +4,10 @@
 #
 # TOYRT against Cycles on scenes built here with bpy: one point light with a hard shadow, three
 # coloured point lights, a rectangular area light with soft shadows, a glass sphere over a textured
-# floor (8-bit checker image), and the same with a float checker image. Cycles is restricted to TOYRT's light transport (max bounces 0; for the glass scene only
-# transmission/specular chains), Box filter of width 1, no denoising, no adaptive sampling,
-# Standard view transform, float EXR output read back linear.
+# floor (8-bit checker image), and the same with a float checker image. Cycles is restricted to
+# TOYRT's light transport (max bounces 0; for the glass scene only transmission/specular chains),
+# Box filter of width 1, no denoising, no adaptive sampling, Standard view transform, float EXR
+# output read back linear. The scenes are built with the scene kit (scenes/kit.py).
 #
 # Metrics per scene (Blender's own render tests use the second): mean |TOYRT - Cycles| over the
 # mean of Cycles (<= 1 %), and the fraction of pixels where a channel differs by more than 0.016
@@ -17,7 +18,6 @@
 import hashlib
 import importlib.util
 import json
-import math
 import os
 import sys
 import time
@@ -26,11 +26,11 @@ from pathlib import Path
 
 import bpy
 import numpy as np
-from mathutils import Vector
 
 REPO = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(REPO / "scenes"))
-from cycles_like_toyrt import configure_cycles  # noqa: E402
+sys.path.insert(0, str(REPO / "scenes"))  # the scene kit
+import kit  # noqa: E402
+
 # The build folder of this run (`make test-blender BUILD=...` and run_with_bpy.py set it).
 CACHE = Path(os.environ.get("TOYRT_BUILD_DIR", REPO / "build")) / "parity-cache"
 # Debian's Blender 3.4 writes docs/parity.md; a current Blender through the bpy module
@@ -58,224 +58,57 @@ def load_sync():
     return importlib.import_module(f"{package}.sync")
 
 
-# ---- scene building ---------------------------------------------------------------------------
+# ---- scene building: the kit (scenes/kit.py) --------------------------------------------------
 
-def clear_scene():
-    scene = bpy.context.scene
-    for obj in list(scene.collection.all_objects):
-        bpy.data.objects.remove(obj, do_unlink=True)
-    for coll in list(scene.collection.children):
-        bpy.data.collections.remove(coll)
-    for datablocks in (bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras,
-                       bpy.data.images, bpy.data.worlds):
-        for block in list(datablocks):
-            if block.name != "Render Result":
-                try:
-                    datablocks.remove(block)
-                except (RuntimeError, ReferenceError):
-                    pass
-    return scene
-
-
-def link(obj):
-    bpy.context.scene.collection.objects.link(obj)
-    return obj
-
-
-def diffuse_material(name, color):
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    nodes = mat.node_tree.nodes
-    nodes.clear()
-    out = nodes.new("ShaderNodeOutputMaterial")
-    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
-    bsdf.inputs["Color"].default_value = (*color, 1.0)
-    mat.node_tree.links.new(bsdf.outputs[0], out.inputs["Surface"])
-    return mat
-
-
-def glass_material(name, ior):
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    nodes = mat.node_tree.nodes
-    nodes.clear()
-    out = nodes.new("ShaderNodeOutputMaterial")
-    bsdf = nodes.new("ShaderNodeBsdfGlass")
-    if "SHARP" in bsdf.bl_rna.properties["distribution"].enum_items.keys():
-        bsdf.distribution = "SHARP"      # 3.x; 4.0 removed it: GGX at roughness 0 is sharp there
-    bsdf.inputs["Roughness"].default_value = 0.0
-    bsdf.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-    bsdf.inputs["IOR"].default_value = ior
-    mat.node_tree.links.new(bsdf.outputs[0], out.inputs["Surface"])
-    return mat
-
-
-def checker_material(name, n, c0, c1, float_buffer=False):
+def checker(name, n, c0, c1, float_buffer=False):
     """A diffuse material with an n x n checker image (packed, sRGB-encoded values), 8-bit or float."""
-    image = bpy.data.images.new(name, n, n, alpha=False, float_buffer=float_buffer)
     ij = np.add.outer(np.arange(n), np.arange(n)) % 2
     px = np.where(ij[..., None] == 0, np.float32(c0), np.float32(c1))
     rgba = np.concatenate([np.broadcast_to(px, (n, n, 1)).repeat(3, axis=2), np.ones((n, n, 1), np.float32)], axis=2)
-    image.pixels.foreach_set(rgba.astype(np.float32).ravel())
-    image.pack()
-    image.colorspace_settings.name = "sRGB"
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    nodes = mat.node_tree.nodes
-    nodes.clear()
-    out = nodes.new("ShaderNodeOutputMaterial")
-    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
-    tex = nodes.new("ShaderNodeTexImage")
-    tex.image = image
-    tex.interpolation = "Linear"
-    tex.extension = "REPEAT"
-    mat.node_tree.links.new(tex.outputs["Color"], bsdf.inputs["Color"])
-    mat.node_tree.links.new(bsdf.outputs[0], out.inputs["Surface"])
-    return mat
+    return kit.diffuse(name, image=kit.image(name, rgba, float_buffer=float_buffer, colorspace="sRGB"))
 
 
-def plane(name, size, material, uv_repeat=1.0):
-    h = size / 2
-    me = bpy.data.meshes.new(name)
-    me.from_pydata([(-h, -h, 0), (h, -h, 0), (h, h, 0), (-h, h, 0)], [], [(0, 1, 2, 3)])
-    uv = me.uv_layers.new(name="UVMap")
-    uv.data.foreach_set("uv", np.array([0, 0, 1, 0, 1, 1, 0, 1], np.float32) * uv_repeat)
-    me.materials.append(material)
-    me.update()
-    return link(bpy.data.objects.new(name, me))
-
-
-def cube(name, size, location, material):
-    h = size / 2
-    v = [(x, y, z) for x in (-h, h) for y in (-h, h) for z in (-h, h)]
-    f = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
-    me = bpy.data.meshes.new(name)
-    me.from_pydata(v, [], f)
-    me.materials.append(material)
-    me.update()
-    obj = link(bpy.data.objects.new(name, me))
-    obj.location = location
-    return obj
-
-
-def uv_sphere(name, radius, location, material, segments=48, rings=24):
-    bm_v = [(0.0, 0.0, radius)]
-    for i in range(1, rings):
-        th = math.pi * i / rings
-        for j in range(segments):
-            ph = 2 * math.pi * j / segments
-            bm_v.append((radius * math.sin(th) * math.cos(ph), radius * math.sin(th) * math.sin(ph), radius * math.cos(th)))
-    bm_v.append((0.0, 0.0, -radius))
-    faces = []
-    ring = lambda i, j: 1 + (i - 1) * segments + j % segments  # noqa: E731
-    for j in range(segments):
-        faces.append((0, ring(1, j), ring(1, j + 1)))
-    for i in range(1, rings - 1):
-        for j in range(segments):
-            faces.append((ring(i, j), ring(i + 1, j), ring(i + 1, j + 1), ring(i, j + 1)))
-    last = len(bm_v) - 1
-    for j in range(segments):
-        faces.append((ring(rings - 1, j), last, ring(rings - 1, j + 1)))
-    me = bpy.data.meshes.new(name)
-    me.from_pydata(bm_v, [], faces)
-    me.polygons.foreach_set("use_smooth", [True] * len(me.polygons))
-    me.materials.append(material)
-    me.update()
-    obj = link(bpy.data.objects.new(name, me))
-    obj.location = location
-    return obj
-
-
-def look_at(obj, target):
-    direction = Vector(target) - obj.location
-    obj.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
-
-
-def camera(location, target, lens=35.0):
-    cam = bpy.data.cameras.new("Camera")
-    cam.lens = lens
-    cam.sensor_fit = "AUTO"
-    cam.clip_start, cam.clip_end = 0.1, 100.0
-    obj = link(bpy.data.objects.new("Camera", cam))
-    obj.location = location
-    look_at(obj, target)
-    bpy.context.scene.camera = obj
-    return obj
-
-
-def point_light(name, location, power, color=(1, 1, 1), radius=0.0):
-    light = bpy.data.lights.new(name, "POINT")
-    light.energy, light.color, light.shadow_soft_size = power, color, radius
-    obj = link(bpy.data.objects.new(name, light))
-    obj.location = location
-    return obj
-
-
-def area_light(name, location, target, power, shape="RECTANGLE", size=1.0, size_y=1.0):
-    light = bpy.data.lights.new(name, "AREA")
-    light.energy, light.shape, light.size, light.size_y = power, shape, size, size_y
-    obj = link(bpy.data.objects.new(name, light))
-    obj.location = location
-    look_at(obj, target)
-    return obj
-
-
-def world(color, lights_diffuse=True):
-    w = bpy.data.worlds.new("World")
-    w.use_nodes = True
-    bg = w.node_tree.nodes.get("Background")
-    bg.inputs["Color"].default_value = (*color, 1.0)
-    bg.inputs["Strength"].default_value = 1.0
-    if not lights_diffuse:
-        # The world seen by camera, glossy and transmission rays but not lighting diffuse surfaces
-        # (the exporter passes the flag on).
-        w.cycles_visibility.diffuse = False
-    bpy.context.scene.world = w
+def camera(location, target):
+    return kit.camera(location, target, lens=35.0, clip=(0.1, 100.0))
 
 
 # The scenes: each a function of its parameters (the parameters also key the Cycles cache).
 
 def scene_point(p):
-    white = diffuse_material("white", (1.0, 1.0, 1.0))
-    grey = diffuse_material("grey", (0.5, 0.5, 0.5))
-    plane("floor", 8.0, white)
-    cube("occluder", 0.6, (0.0, 0.0, 0.5), grey)
-    point_light("lamp", p["light"], p["power"], radius=p["radius"])
+    kit.plane("floor", 8.0, kit.diffuse("white", (1.0, 1.0, 1.0)))
+    kit.box("occluder", 0.6, (0.0, 0.0, 0.5), kit.diffuse("grey", (0.5, 0.5, 0.5)))
+    kit.point_light("lamp", p["light"], p["power"], radius=p["radius"])
     camera(p["camera"], (0, 0, 0))
-    world((0, 0, 0))
+    kit.world((0, 0, 0))
 
 
 def scene_rgb(p):
-    white = diffuse_material("white", (0.9, 0.9, 0.9))
-    grey = diffuse_material("grey", (0.6, 0.6, 0.6))
-    plane("floor", 8.0, white)
-    cube("occluder", 0.7, (0.0, 0.2, 0.35), grey)
+    kit.plane("floor", 8.0, kit.diffuse("white", (0.9, 0.9, 0.9)))
+    kit.box("occluder", 0.7, (0.0, 0.2, 0.35), kit.diffuse("grey", (0.6, 0.6, 0.6)))
     for i, (loc, power, color) in enumerate(p["lights"]):
-        point_light(f"lamp{i}", loc, power, color=color)
+        kit.point_light(f"lamp{i}", loc, power, color=color)
     camera(p["camera"], (0, 0, 0))
-    world((0, 0, 0))
+    kit.world((0, 0, 0))
 
 
 def scene_area(p):
-    white = diffuse_material("white", (0.8, 0.8, 0.8))
-    red = diffuse_material("red", (0.7, 0.2, 0.1))
-    plane("floor", 8.0, white)
-    cube("occluder", 0.6, (0.2, -0.1, 0.6), red)
-    area_light("panel", p["light"], p["light_target"], p["power"], shape="RECTANGLE", size=p["size"], size_y=p["size_y"])
+    kit.plane("floor", 8.0, kit.diffuse("white", (0.8, 0.8, 0.8)))
+    kit.box("occluder", 0.6, (0.2, -0.1, 0.6), kit.diffuse("red", (0.7, 0.2, 0.1)))
+    kit.area_light("panel", p["light"], p["power"], p["size"], p["size_y"], target=p["light_target"])
     camera(p["camera"], (0, 0, 0))
-    world((0, 0, 0))
+    kit.world((0, 0, 0))
 
 
 def scene_glass(p):
-    floor = checker_material("checker", 8, p["checker"][0], p["checker"][1], float_buffer=p["float_texture"])
-    plane("floor", 6.0, floor, uv_repeat=p["uv_repeat"])
-    uv_sphere("ball", 0.7, (0.0, 0.0, 0.75), glass_material("glass", p["ior"]))
-    lamp = area_light("panel", p["light"], (0, 0, 0), p["power"], shape="RECTANGLE", size=1.5, size_y=1.0)
+    floor = checker("checker", 8, p["checker"][0], p["checker"][1], float_buffer=p["float_texture"])
+    kit.plane("floor", 6.0, floor, uv_repeat=p["uv_repeat"])
+    kit.uv_sphere("ball", 0.7, (0.0, 0.0, 0.75), kit.glass("glass", p["ior"]))
+    lamp = kit.area_light("panel", p["light"], p["power"], 1.5, 1.0, target=(0, 0, 0))
     if p["hide_light_from_specular"]:
         # The light hidden from camera and specular rays (the exporter passes the flags on).
         lamp.visible_glossy = lamp.visible_transmission = lamp.visible_camera = False
     camera(p["camera"], (0, 0, 0.4))
-    world(p["world"], lights_diffuse=p["world_lights_diffuse"])
+    kit.world(p["world"], lights_diffuse=p["world_lights_diffuse"])
 
 
 SCENES_SPEC = [
@@ -308,47 +141,20 @@ SCENES_SPEC = [
 
 # ---- Cycles ------------------------------------------------------------------------------------
 
-def setup_output(scene):
-    """Resolution and film settings: part of the scene, read by both engines."""
-    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = WIDTH, HEIGHT, 100
-    scene.render.pixel_aspect_x = scene.render.pixel_aspect_y = 1.0
-    scene.render.use_border = False
-    scene.render.film_transparent = False
-
-
-def setup_cycles(scene, samples, transmission):
-    """Cycles restricted to TOYRT's light transport (scenes/cycles_like_toyrt.py), Standard view,
-    float output."""
-    configure_cycles(scene, samples, transmission)
-    scene.view_settings.view_transform = "Standard"
-    scene.view_settings.look = "None"
-    scene.view_settings.exposure = 0.0
-    scene.view_settings.gamma = 1.0
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
-    scene.render.image_settings.color_mode = "RGBA"
-
-
 def render_cycles(scene, path):
     """Render with Cycles to an EXR; (rows from the top, (h, w, 4) float32, seconds)."""
     scene.render.filepath = str(path)
     t0 = time.perf_counter()
     bpy.ops.render.render(write_still=True)
     seconds = time.perf_counter() - t0
-    image = bpy.data.images.load(str(path), check_existing=False)
-    try:
-        w, h = image.size[:]
-        buf = np.empty(w * h * 4, np.float32)
-        image.pixels.foreach_get(buf)
-    finally:
-        bpy.data.images.remove(image)
-    return buf.reshape(h, w, 4)[::-1].copy(), seconds
+    return kit.read_image(path)[::-1].copy(), seconds
 
 
 def cache_key(name, params, transmission, samples):
-    # This file's text is part of the key: any change to how scenes are built or how Cycles is
-    # set up renders the references again (about 10 s for all of them).
-    source = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
+    # The text of this file, the kit and the Cycles settings is part of the key: any change to how
+    # scenes are built or how Cycles is set up renders the references again.
+    sources = (Path(__file__), REPO / "scenes" / "kit.py", REPO / "scenes" / "cycles_like_toyrt.py")
+    source = hashlib.sha256(b"".join(f.read_bytes() for f in sources)).hexdigest()
     blob = json.dumps(dict(name=name, params=params, transmission=transmission, samples=samples,
                            size=(WIDTH, HEIGHT), blender=bpy.app.version_string, source=source), sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
@@ -360,7 +166,7 @@ def cycles_reference(name, params, transmission, samples):
     npy, meta = CACHE / f"{name}-{key}.npy", CACHE / f"{name}-{key}.json"
     if npy.exists() and meta.exists():
         return np.load(npy), json.loads(meta.read_text())["seconds"], True
-    setup_cycles(bpy.context.scene, samples, transmission)
+    kit.cycles(bpy.context.scene, samples, transmission)
     img, seconds = render_cycles(bpy.context.scene, CACHE / f"{name}-{key}.exr")
     for stale in list(CACHE.glob(f"{name}-*.npy")) + list(CACHE.glob(f"{name}-*.json")):
         stale.unlink()  # references of older versions of this scene
@@ -409,9 +215,9 @@ def main():
         if wanted and name not in wanted:
             continue
         print(f"parity: {name}", flush=True)
-        clear_scene()
+        kit.clear_scene()
         build(params)
-        setup_output(bpy.context.scene)
+        kit.output(bpy.context.scene, WIDTH, HEIGHT)  # read by both engines
         bpy.context.view_layer.update()
         # Scenes where a bright light is seen through glass need more samples on both sides for the
         # noise to fall below the mean-difference threshold (a light's edge pixel has a standard
@@ -465,7 +271,8 @@ def write_doc(results):
         "Each scene is built with bpy, rendered by Cycles restricted to TOYRT's light transport (max bounces 0; "
         "for the glass scene transmission and glossy bounces 8 with diffuse bounces 0, so only specular chains "
         "through the glass; Box filter of width 1, no denoising, no adaptive sampling, light threshold 0, Standard "
-        f"view transform, float EXR) at {CYCLES_SAMPLES} samples per pixel (the table gives each scene's count), and by TOYRT through the add-on's "
+        f"view transform, float EXR) at {CYCLES_SAMPLES} samples per pixel (the table gives each scene's count), "
+        "and by TOYRT through the add-on's "
         f"scene sync (`addon/render_toyrt/sync.py`) at as many.",
         "",
         f"Pass: mean |TOYRT - Cycles| / mean(Cycles) <= {MEAN_LIMIT * 100:g} %, and at most {PIXEL_LIMIT * 100:g} % "
@@ -476,7 +283,8 @@ def write_doc(results):
         "|---|---|---|---|---|---|---|",
     ]
     for r in results:
-        lines.append(f"| {r['name']} | {r['mean_rel'] * 100:.3f} % | {r['bias'] * 100:+.3f} % | {r['frac'] * 100:.3f} % | "
+        lines.append(f"| {r['name']} | {r['mean_rel'] * 100:.3f} % | {r['bias'] * 100:+.3f} % | "
+                     f"{r['frac'] * 100:.3f} % | "
                      f"{'pass' if r['ok'] else 'FAIL'} | {r['toyrt_s']:.2f} s ({r['toyrt_spp']} spp) | "
                      f"{r['cycles_s']:.2f} s ({r['cycles_spp']} spp) |")
     lines += [

@@ -7,52 +7,28 @@ import os
 import subprocess
 import sys
 import tempfile
-import traceback
 
 import bpy
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # for harness (see there)
-from harness import RESULTS, check, finish  # noqa: E402
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit (see harness)
+import kit  # noqa: E402
+from harness import check, run_script  # noqa: E402
 
 
 def build_scene(with_camera=True):
-    for o in list(bpy.data.objects):
-        bpy.data.objects.remove(o)
-    s = bpy.context.scene
-    bpy.ops.mesh.primitive_plane_add(size=10)
-    plane = bpy.context.object
-    mat = bpy.data.materials.new("white_diffuse")
-    mat.use_nodes = True
-    nodes = mat.node_tree.nodes
-    for n in list(nodes):
-        if n.type != "OUTPUT_MATERIAL":
-            nodes.remove(n)
-    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = (1, 1, 1, 1)
-    mat.node_tree.links.new(diffuse.outputs[0], nodes["Material Output"].inputs["Surface"])
-    plane.data.materials.append(mat)
-    light = bpy.data.lights.new("point", "POINT")
-    light.energy = 100.0
-    light.shadow_soft_size = 0.0
-    lo = bpy.data.objects.new("point", light)
-    lo.location = (0, 0, 1)
-    s.collection.objects.link(lo)
+    """A white Diffuse plane 10 m wide, a 100 W point light 1 m above its centre, and (with_camera)
+    an orthographic camera seeing the middle 2 m from above, 32 x 32 pixels."""
+    s = kit.clear_scene()
+    kit.plane("plane", 10.0, kit.diffuse("white_diffuse", (1, 1, 1)))
+    kit.point_light("point", (0, 0, 1), 100.0)
     if with_camera:
-        cam = bpy.data.cameras.new("cam")
-        cam.type = "ORTHO"
-        cam.ortho_scale = 2.0
-        co = bpy.data.objects.new("cam", cam)
-        co.location = (0, 0, 5)
-        s.collection.objects.link(co)
-        s.camera = co
+        kit.camera((0, 0, 5), ortho_scale=2.0)
     else:
         s.camera = None
-    s.render.engine = "TOYRT"
-    s.render.resolution_x = s.render.resolution_y = 32
-    s.render.resolution_percentage = 100
-    s.toyrt.samples = 16
-    s.world = None
+    kit.output(s, 32, 32)
+    kit.toyrt(s, samples=16)
     return s
 
 
@@ -75,8 +51,7 @@ def main():
     s.render.filepath = out
     s.render.image_settings.file_format = "OPEN_EXR"
     bpy.ops.render.render(write_still=True)
-    img = bpy.data.images.load(out)
-    px = np.array(img.pixels[:], dtype=np.float32).reshape(32, 32, 4)
+    px = kit.read_image(out)
     err = np.abs(px[..., 0] - expected_image()).max() / expected_image().max()
     check(err < 0.01, f"F12 render matches I cos / r^2 in Blender's units (max error {err:.4f} of the peak)")
 
@@ -90,7 +65,8 @@ def main():
     frame_out = os.path.join(os.path.dirname(blend), "frame_")
     run = subprocess.run([bpy.app.binary_path, "-b", blend, "-E", "TOYRT", "-o", frame_out, "-F", "PNG", "-f", "1"],
                          capture_output=True, text=True)
-    check(run.returncode == 0 and os.path.exists(frame_out + "0001.png"), "blender -b file.blend -E TOYRT -f 1 writes the frame")
+    check(run.returncode == 0 and os.path.exists(frame_out + "0001.png"),
+          "blender -b file.blend -E TOYRT -f 1 writes the frame")
 
     # A render error (no camera) fails the command and writes nothing.
     build_scene(with_camera=False)
@@ -104,9 +80,4 @@ def main():
     check("camera" in (run.stdout + run.stderr).lower(), "the error says what is wrong")
 
 
-try:
-    main()
-except Exception:
-    traceback.print_exc()
-    RESULTS.append(False)
-finish("engine")
+run_script([main], "engine")

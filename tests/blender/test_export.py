@@ -20,19 +20,19 @@
 #      moves by the number of pixels the camera says, the seed depends on the frame.
 #   7. the command line: blender -b file.blend -E TOYRT -o ... -F PNG -s 1 -e 2 -a writes two frames.
 import os
-import shutil
 import subprocess
 import sys
 import tempfile
 import threading
 import time
-import traceback
 
 import bpy
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # for harness (see there)
-from harness import RESULTS, captured_output, check, finish, run_part  # noqa: E402
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit (see harness)
+import kit  # noqa: E402
+from harness import captured_output, check, render_still, run_script  # noqa: E402
 
 TMP = tempfile.mkdtemp(prefix="toyrt-test-export-")   # every file the test writes; removed at the end
 RENDERABLE = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
@@ -44,69 +44,24 @@ def addon():
     return sync, render_toyrt.native()
 
 
-# ---- scene building ---------------------------------------------------------------------------
+# ---- scene building: the kit (scenes/kit.py) --------------------------------------------------
 
 def clear_scene():
-    scene = bpy.context.scene
-    # One batch: removing 10,000 objects one by one takes minutes (each removal updates relations).
-    bpy.data.batch_remove(list(bpy.data.objects) + list(bpy.data.collections))
-    for blocks in (bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras,
-                   bpy.data.images, bpy.data.node_groups, bpy.data.particles, bpy.data.actions):
-        for block in list(blocks):
-            if block.name != "Render Result":
-                try:
-                    blocks.remove(block)
-                except (RuntimeError, ReferenceError):
-                    pass
-    scene.world = None
+    """An empty scene (kit.clear_scene) at frame 1 of 1, rendered whole by TOYRT at seed 0, Standard view."""
+    scene = kit.clear_scene()
     scene.frame_start, scene.frame_end = 1, 1
     scene.frame_set(1)
-    scene.render.engine = "TOYRT"
     scene.render.resolution_percentage = 100
     scene.render.use_border = False
-    scene.view_settings.view_transform = "Standard"
-    scene.view_settings.look = "None"
-    scene.view_settings.exposure = 0.0
-    scene.view_settings.gamma = 1.0
-    scene.toyrt.seed = 0
+    kit.standard_view(scene)
+    kit.toyrt(scene, seed=0)
     return scene
-
-
-def link(obj, collection=None):
-    (collection or bpy.context.scene.collection).objects.link(obj)
-    return obj
 
 
 def move_to(obj, collection):
     for c in list(obj.users_collection):
         c.objects.unlink(obj)
     collection.objects.link(obj)
-    return obj
-
-
-def diffuse(name, color):
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    nodes = mat.node_tree.nodes
-    nodes.clear()
-    out = nodes.new("ShaderNodeOutputMaterial")
-    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
-    bsdf.inputs["Color"].default_value = (*color, 1.0)
-    mat.node_tree.links.new(bsdf.outputs[0], out.inputs["Surface"])
-    return mat
-
-
-def plane(name, size, location=(0, 0, 0), material=None):
-    h = size / 2
-    me = bpy.data.meshes.new(name)
-    me.from_pydata([(-h, -h, 0), (h, -h, 0), (h, h, 0), (-h, h, 0)], [], [(0, 1, 2, 3)])
-    uv = me.uv_layers.new(name="UVMap")
-    uv.data.foreach_set("uv", np.float32([0, 0, 1, 0, 1, 1, 0, 1]))
-    if material is not None:
-        me.materials.append(material)
-    me.update()
-    obj = link(bpy.data.objects.new(name, me))
-    obj.location = location
     return obj
 
 
@@ -118,59 +73,17 @@ def geometry_output(ng):
         ng.outputs.new("NodeSocketGeometry", "Geometry")
 
 
-def cube(name, size, location, material=None):
-    h = size / 2
-    v = [(x, y, z) for x in (-h, h) for y in (-h, h) for z in (-h, h)]
-    f = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
-    me = bpy.data.meshes.new(name)
-    me.from_pydata(v, [], f)
-    if material is not None:
-        me.materials.append(material)
-    me.update()
-    obj = link(bpy.data.objects.new(name, me))
-    obj.location = location
-    return obj
-
-
 def ortho_camera(scale, location=(0, 0, 10), resolution=(32, 32)):
-    cam = bpy.data.cameras.new("cam")
-    cam.type = "ORTHO"
-    cam.ortho_scale = scale
-    cam.clip_start, cam.clip_end = 0.1, 100.0
-    obj = link(bpy.data.objects.new("cam", cam))
-    obj.location = location  # looking down -Z, image x along world x, image up along world y
+    """Looking down -Z: image x along world x, image up along world y; `resolution` pixels."""
     scene = bpy.context.scene
-    scene.camera = obj
     scene.render.resolution_x, scene.render.resolution_y = resolution
-    return obj
+    return kit.camera(location, ortho_scale=scale, clip=(0.1, 100.0))
 
 
-def point_light(location, power, radius=0.0):
-    light = bpy.data.lights.new("point", "POINT")
-    light.energy, light.shadow_soft_size = power, radius
-    obj = link(bpy.data.objects.new("point", light))
-    obj.location = location
-    return obj
-
-
-def render_to(path, file_format="OPEN_EXR"):
-    """F12's operator, writing the still to `path`; returns (operator result, captured output)."""
-    scene = bpy.context.scene
-    scene.render.filepath = path
-    scene.render.image_settings.file_format = file_format
-    with captured_output() as out:
-        result = bpy.ops.render.render(write_still=True)
-    return result, out[0]
-
-
-def load_pixels(path):
-    """(h, w, 4) float32 pixels of an image file, rows from the bottom (as Blender stores them)."""
-    img = bpy.data.images.load(path, check_existing=False)
-    w, h = img.size
-    px = np.empty(w * h * 4, np.float32)
-    img.pixels.foreach_get(px)
-    bpy.data.images.remove(img)
-    return px.reshape(h, w, 4)
+def render_to(path):
+    """F12's operator, writing an EXR still to `path`: (operator result, captured output)."""
+    bpy.context.scene.render.image_settings.file_format = "OPEN_EXR"
+    return render_still(path)
 
 
 # ---- 1. counts and transforms -----------------------------------------------------------------
@@ -190,7 +103,7 @@ def build_mixed_scene():
     bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=2, radius=0.5, location=(6, 0, 0))
     ico = bpy.context.object                                        # 80 triangles
     for i in (1, 2):
-        dup = link(bpy.data.objects.new(f"ico_dup{i}", ico.data))
+        dup = kit.link(bpy.data.objects.new(f"ico_dup{i}", ico.data))
         dup.location = (6, 2.2 * i, 0.3 * i)
         dup.rotation_euler = (0.3 * i, 0.2, 0.5)
         dup.scale = (1.0, 1.5, 0.7)
@@ -199,7 +112,7 @@ def build_mixed_scene():
     bpy.ops.mesh.primitive_cone_add(vertices=16, radius1=0.6, depth=1.0, location=(0, 0, 0))
     move_to(bpy.context.object, coll)                               # 16 + 14 = 30 triangles
     for i in (0, 1):
-        empty = link(bpy.data.objects.new(f"coll_inst{i}", None))
+        empty = kit.link(bpy.data.objects.new(f"coll_inst{i}", None))
         empty.instance_type, empty.instance_collection = "COLLECTION", coll
         empty.location = (9, 3 * i, 0.2 * i)
         empty.rotation_euler = (0.25 * i, 0, 0.4 * i)
@@ -234,7 +147,7 @@ def build_mixed_scene():
     ng.links.new(iop.outputs[0], out.inputs[0])
     gn_obj.modifiers.new("instancer", "NODES").node_group = ng
     ortho_camera(30)
-    point_light((0, 0, 20), 1000.0)
+    kit.point_light("point", (0, 0, 20), 1000.0)
     return scene
 
 
@@ -343,7 +256,8 @@ def test_counts_and_transforms():
             bad_prim.append((insts[r][0], got_p))
         own += got_i == r
     check(not bad_t, f"{len(insts)} rays down onto each instance's bounding-box centre hit at the distance "
-          f"computed from Blender's evaluated vertices and matrix_world (within 1e-4){'' if not bad_t else ': ' + str(bad_t[:5])}")
+          "computed from Blender's evaluated vertices and matrix_world (within 1e-4)"
+          f"{'' if not bad_t else ': ' + str(bad_t[:5])}")
     check(not bad_inst, "each ray hits the instance Blender has there (exported instance k = k-th depsgraph "
           f"instance){'' if not bad_inst else ': ' + str(bad_inst[:5])}")
     check(not bad_prim, "and the triangle of that instance's evaluated mesh (loop_triangles index)"
@@ -359,35 +273,15 @@ def sphere_20k():
 
 
 def uv_sphere_mesh(name, segments, rings):
-    """The topology of bpy.ops.mesh.primitive_uv_sphere_add (triangle fans at the poles, quads
-    between: 2 * segments * (rings - 1) triangles), built with foreach_set: the operator takes
-    minutes at a million triangles on Blender 3.4."""
-    th = np.pi * np.arange(1, rings) / rings
-    ph = 2 * np.pi * np.arange(segments) / segments
-    ring = np.stack([np.outer(np.sin(th), np.cos(ph)), np.outer(np.sin(th), np.sin(ph)),
-                     np.repeat(np.cos(th)[:, None], segments, axis=1)], axis=-1).reshape(-1, 3)
-    co = np.concatenate([[[0, 0, 1]], ring, [[0, 0, -1]]]).astype(np.float32)
-    j = np.arange(segments)
-    r = lambda i, jj: 1 + i * segments + jj % segments  # noqa: E731  (ring i = 0 .. rings-2)
-    top = np.stack([np.zeros(segments, int), r(0, j), r(0, j + 1)], axis=1)
-    i = np.arange(rings - 2)[:, None]
-    quads = np.stack([r(i, j), r(i + 1, j), r(i + 1, j + 1), r(i, j + 1)], axis=-1).reshape(-1, 4)
-    bottom = np.stack([r(rings - 2, j), np.full(segments, len(co) - 1), r(rings - 2, j + 1)], axis=1)
-    loops = np.concatenate([top.ravel(), quads.ravel(), bottom.ravel()]).astype(np.int32)
-    sizes = np.concatenate([np.full(segments, 3), np.full(len(quads), 4), np.full(segments, 3)]).astype(np.int32)
-    me = bpy.data.meshes.new(name)
-    me.vertices.add(len(co))
-    me.vertices.foreach_set("co", co.ravel())
-    me.loops.add(len(loops))
-    me.loops.foreach_set("vertex_index", loops)
-    me.polygons.add(len(sizes))
-    me.polygons.foreach_set("loop_start", np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int32))
-    me.polygons.foreach_set("loop_total", sizes)
-    # A UV map, as the operator makes (the exporter reads it per corner): longitude, latitude.
-    lon_lat = np.column_stack([np.arctan2(co[:, 1], co[:, 0]) / (2 * np.pi) + 0.5, np.arccos(np.clip(co[:, 2], -1, 1)) / np.pi])
-    me.uv_layers.new(name="UVMap").data.foreach_set("uv", lon_lat.astype(np.float32)[loops].ravel())
-    me.update()
-    return me
+    """The topology of bpy.ops.mesh.primitive_uv_sphere_add (kit.uv_sphere_arrays: 2 * segments *
+    (rings - 1) triangles), from arrays: the operator takes minutes at a million triangles on
+    Blender 3.4. A UV map, as the operator makes (the exporter reads it per corner): longitude, latitude."""
+    vertices, faces = kit.uv_sphere_arrays(rings, segments)
+    co = vertices.astype(np.float32)
+    lon_lat = np.column_stack([np.arctan2(co[:, 1], co[:, 0]) / (2 * np.pi) + 0.5,
+                               np.arccos(np.clip(co[:, 2], -1, 1)) / np.pi])
+    corners = np.concatenate([f.ravel() for f in faces])
+    return kit.mesh_data(name, co, faces, uvs=lon_lat.astype(np.float32)[corners])
 
 
 def test_instancing_memory():
@@ -406,7 +300,7 @@ def test_instancing_memory():
     coll = bpy.data.collections.new("duplicates")
     bpy.context.scene.collection.children.link(coll)
     for i in range(1, n):
-        link(bpy.data.objects.new("dup", sphere.data), coll).location = ((i % 100) * 3.0, (i // 100) * 3.0, 0.0)
+        kit.link(bpy.data.objects.new("dup", sphere.data), coll).location = ((i % 100) * 3.0, (i // 100) * 3.0, 0.0)
     t0 = time.perf_counter()
     depsgraph = bpy.context.evaluated_depsgraph_get()
     dg_s = time.perf_counter() - t0
@@ -456,12 +350,13 @@ def test_instancing_memory():
 
     # A 1M-triangle mesh (measured, for docs/blender.md; not a timed check).
     clear_scene()
-    link(bpy.data.objects.new("sphere_1m", uv_sphere_mesh("sphere_1m", 1000, 500)))
+    kit.link(bpy.data.objects.new("sphere_1m", uv_sphere_mesh("sphere_1m", 1000, 500)))
     ortho_camera(3)
     depsgraph = bpy.context.evaluated_depsgraph_get()
     scene, _, stats = sync.export_scene(depsgraph, toyrt)
     check(stats["meshes"] == 1 and stats["triangles_stored"] == 1000 * 498 * 2 + 2 * 1000,
-          f"a {stats['triangles_stored']:,}-triangle UV sphere with a UV map exports as one mesh in {stats['export_s']:.2f} s")
+          f"a {stats['triangles_stored']:,}-triangle UV sphere with a UV map exports as one mesh in "
+          f"{stats['export_s']:.2f} s")
     del scene
     clear_scene()
 
@@ -474,23 +369,14 @@ def test_missing_texture():
     image = bpy.data.images.new("missing_checker", 4, 4)
     image.source = "FILE"
     image.filepath = os.path.join(tempfile.gettempdir(), "toyrt-no-such-dir", "missing_checker.png")
-    mat = bpy.data.materials.new("textured")
-    mat.use_nodes = True
-    nodes = mat.node_tree.nodes
-    nodes.clear()
-    out = nodes.new("ShaderNodeOutputMaterial")
-    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
-    tex = nodes.new("ShaderNodeTexImage")
-    tex.image = image
-    mat.node_tree.links.new(tex.outputs["Color"], bsdf.inputs["Color"])
-    mat.node_tree.links.new(bsdf.outputs[0], out.inputs["Surface"])
-    plane("textured_plane", 2.0, material=mat)
-    point_light((0, 0, 1), 100.0)
+    kit.plane("textured_plane", 2.0, material=kit.diffuse("textured", image=image))
+    kit.point_light("point", (0, 0, 1), 100.0)
     ortho_camera(1.0, resolution=(8, 8))
     scene.toyrt.samples = 4
 
     reports = []
-    sync.export_scene(bpy.context.evaluated_depsgraph_get(), toyrt, report=lambda kind, msg: reports.append((kind, msg)))
+    sync.export_scene(bpy.context.evaluated_depsgraph_get(), toyrt,
+                      report=lambda kind, msg: reports.append((kind, msg)))
     warnings = [m for k, m in reports if "WARNING" in k]
     check(len(warnings) == 1 and "missing_checker" in warnings[0] and "magenta" in warnings[0],
           f"the export reports one warning naming the image: {warnings}")
@@ -498,9 +384,9 @@ def test_missing_texture():
     path = os.path.join(tempfile.mkdtemp(dir=TMP), "missing.exr")
     result, log = render_to(path)
     check(result == {"FINISHED"} and os.path.exists(path), f"the render succeeds ({result}) and writes the image")
-    lines = [l for l in log.splitlines() if "missing_checker" in l]
-    check(any("Warning" in l for l in lines), f"Blender shows the warning: {lines[:1]}")
-    px = load_pixels(path)[2:6, 2:6, :3].reshape(-1, 3)
+    lines = [line for line in log.splitlines() if "missing_checker" in line]
+    check(any("Warning" in line for line in lines), f"Blender shows the warning: {lines[:1]}")
+    px = kit.read_image(path)[2:6, 2:6, :3].reshape(-1, 3)
     r, g, b = px.mean(0)
     check(r > 0.5 and abs(r - b) <= 1e-3 * r and g <= 1e-6,
           f"the placeholder is magenta: mean lit pixel R {r:.4f} G {g:.6f} B {b:.4f}")
@@ -511,17 +397,10 @@ def test_missing_texture():
 def test_unsupported_node():
     sync, toyrt = addon()
     scene = clear_scene()
-    mat = bpy.data.materials.new("glowing")
-    mat.use_nodes = True
-    nodes = mat.node_tree.nodes
-    nodes.clear()
-    out = nodes.new("ShaderNodeOutputMaterial")
-    emission = nodes.new("ShaderNodeEmission")
-    emission.inputs["Color"].default_value = (0.2, 0.6, 0.9, 1.0)
-    mat.node_tree.links.new(emission.outputs[0], out.inputs["Surface"])
-    plane("glowing_plane", 2.0, material=mat)
-    cube("glowing_cube", 0.4, (0, 0, 0.2), material=mat)            # same material twice: still one note
-    point_light((0, 0, 2), 100.0)
+    mat = kit.emission("glowing", (0.2, 0.6, 0.9))
+    kit.plane("glowing_plane", 2.0, material=mat)
+    kit.box("glowing_cube", 0.4, (0, 0, 0.2), material=mat)            # same material twice: still one note
+    kit.point_light("point", (0, 0, 2), 100.0)
     ortho_camera(1.5, resolution=(8, 8))
     scene.toyrt.samples = 4
 
@@ -530,14 +409,15 @@ def test_unsupported_node():
                                       report=lambda kind, msg: reports.append((kind, msg)))
     warnings = [m for k, m in reports if "WARNING" in k]
     check(len(reports) == 1 and len(warnings) == 1 and "ShaderNodeEmission" in warnings[0]
-          and stats["approximated"] == [a for a in stats["approximated"] if "glowing" in a] and len(stats["approximated"]) == 1,
+          and stats["approximated"] == [a for a in stats["approximated"] if "glowing" in a]
+          and len(stats["approximated"]) == 1,
           f"exactly one approximation warning, naming the Emission node: {warnings}")
     path = os.path.join(tempfile.mkdtemp(dir=TMP), "emission.exr")
     result, log = render_to(path)
-    shown = [l for l in log.splitlines() if "approximated" in l]
+    shown = [line for line in log.splitlines() if "approximated" in line]
     check(result == {"FINISHED"} and os.path.exists(path) and len(shown) == 1 and "ShaderNodeEmission" in shown[0],
           f"the render succeeds and Blender shows that one warning: {shown}")
-    px = load_pixels(path)[..., :3]
+    px = kit.read_image(path)[..., :3]
     check(np.isfinite(px).all() and px.mean() > 0, "the image is lit (the Emission colour as a diffuse)")
 
 
@@ -549,10 +429,10 @@ def os_threads():
 
 def test_cancel():
     sync, toyrt = addon()
-    scene = clear_scene()
-    plane("floor", 10.0, material=diffuse("grey", (0.8, 0.8, 0.8)))
+    clear_scene()
+    kit.plane("floor", 10.0, material=kit.diffuse("grey", (0.8, 0.8, 0.8)))
     bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=1.0, location=(0, 0, 1))
-    point_light((2, -2, 4), 500.0, radius=0.5)
+    kit.point_light("point", (2, -2, 4), 500.0, radius=0.5)
     ortho_camera(8.0, resolution=(320, 240))
     t_scene, camera, stats = sync.export_scene(bpy.context.evaluated_depsgraph_get(), toyrt)
     t_scene.commit(threads=2)
@@ -570,9 +450,11 @@ def test_cancel():
     took, info = time.perf_counter() - start, t_scene.last_render
     check(info["cancelled"] and info["tiles_done"] < info["tiles_total"] and took < 0.3 + 0.5,
           f"cancelled 0.3 s into a long render, render() returned after {took:.2f} s "
-          f"(cancel latency {info.get('cancel_latency_ms', float('nan')):.0f} ms, {info['tiles_done']} of {info['tiles_total']} tiles)")
+          f"(cancel latency {info.get('cancel_latency_ms', float('nan')):.0f} ms, "
+          f"{info['tiles_done']} of {info['tiles_total']} tiles)")
     os_after2 = os_threads()
-    check(threading.active_count() == py_before, f"no Python thread left behind ({threading.active_count()} = {py_before})")
+    check(threading.active_count() == py_before,
+          f"no Python thread left behind ({threading.active_count()} = {py_before})")
     cores = os.cpu_count() or 1
     check(os_after1 <= os_before + cores and os_after2 <= os_after1,
           f"OS threads: {os_before} before, {os_after1} after one render (at most the worker pool of {cores} more), "
@@ -584,8 +466,8 @@ def test_cancel():
 def animated_scene():
     """A red cube moving 1 unit per frame along x over a white floor, seen from above: 8 px per unit."""
     scene = clear_scene()
-    plane("floor", 20.0, material=diffuse("white", (0.8, 0.8, 0.8)))
-    mover = cube("mover", 1.0, (-1.0, 0, 0.5), material=diffuse("red", (0.8, 0.0, 0.0)))
+    kit.plane("floor", 20.0, material=kit.diffuse("white", (0.8, 0.8, 0.8)))
+    mover = kit.box("mover", 1.0, (-1.0, 0, 0.5), material=kit.diffuse("red", (0.8, 0.0, 0.0)))
     # Linear keys through the preference new keys take (Action.fcurves is gone in 5.0's layered actions).
     edit = bpy.context.preferences.edit
     saved, edit.keyframe_new_interpolation_type = edit.keyframe_new_interpolation_type, "LINEAR"
@@ -593,7 +475,7 @@ def animated_scene():
         mover.location = (x, 0, 0.5)
         mover.keyframe_insert("location", frame=frame)
     edit.keyframe_new_interpolation_type = saved
-    point_light((0, 0, 30), 200_000.0)
+    kit.point_light("point", (0, 0, 30), 200_000.0)
     ortho_camera(4.0, resolution=(32, 32))
     scene.frame_start, scene.frame_end = 1, 3
     scene.toyrt.samples = 4
@@ -617,19 +499,20 @@ def test_animation():
     files = [os.path.join(folder, f"frame_{f:04d}.png") for f in (1, 2, 3)]
     check(result == {"FINISHED"} and all(map(os.path.exists, files)) and len(os.listdir(folder)) == 3,
           f"render(animation=True) writes three PNG files: {sorted(os.listdir(folder))}")
-    done = [l for l in out[0].splitlines() if l.startswith("TOYRT: frame ") and " done in " in l]
+    done = [line for line in out[0].splitlines() if line.startswith("TOYRT: frame ") and " done in " in line]
     check(len(done) == 3, f"one 'done' line per frame on stdout: {done}")
-    cx = [red_centroid_x(load_pixels(f)) for f in files]
+    cx = [red_centroid_x(kit.read_image(f)) for f in files]
     # 32 px over an ortho scale of 4: 8 px per unit; the cube (1 unit) at x = -1, 0, 1.
     expected = [16 - 8, 16, 16 + 8]
     check(all(abs(c - e) < 0.75 for c, e in zip(cx, expected)),
-          f"the cube moves 8 px per frame as the camera says: centres at x = {[round(c, 2) for c in cx]}, expected {expected}")
+          "the cube moves 8 px per frame as the camera says: centres at x = "
+          f"{[round(c, 2) for c in cx]}, expected {expected}")
 
     # Frame-dependent seed: a static scene with a soft shadow, 1 sample per pixel.
     scene = clear_scene()
-    plane("floor", 20.0, material=diffuse("white", (0.8, 0.8, 0.8)))
-    cube("blocker", 1.0, (0, 0, 1.0), material=diffuse("grey", (0.5, 0.5, 0.5)))
-    point_light((0, 0, 3), 300.0, radius=1.0)
+    kit.plane("floor", 20.0, material=kit.diffuse("white", (0.8, 0.8, 0.8)))
+    kit.box("blocker", 1.0, (0, 0, 1.0), material=kit.diffuse("grey", (0.5, 0.5, 0.5)))
+    kit.point_light("point", (0, 0, 3), 300.0, radius=1.0)
     ortho_camera(6.0, resolution=(32, 32))
     scene.toyrt.samples = 1
     folder = tempfile.mkdtemp(dir=TMP)
@@ -638,7 +521,7 @@ def test_animation():
         scene.frame_set(frame)
         path = os.path.join(folder, name + ".exr")
         render_to(path)
-        images[name] = load_pixels(path)[..., :3]
+        images[name] = kit.read_image(path)[..., :3]
     same = np.array_equal(images["a"], images["a_again"])
     diff = np.abs(images["a"] - images["b"]).max(axis=2)
     check(same and (diff > 0.01).sum() >= 10,
@@ -668,16 +551,6 @@ def test_command_line_range():
         print(run.stdout[-2000:], run.stderr[-2000:])
 
 
-def main():
-    for part in (test_counts_and_transforms, test_instancing_memory, test_missing_texture,
-                 test_unsupported_node, test_cancel, test_animation, test_command_line_range):
-        run_part(part)
-
-
-try:
-    main()
-except Exception:
-    traceback.print_exc()
-    RESULTS.append(False)
-shutil.rmtree(TMP, ignore_errors=True)
-finish("export")
+PARTS = [test_counts_and_transforms, test_instancing_memory, test_missing_texture, test_unsupported_node, test_cancel,
+         test_animation, test_command_line_range]
+run_script(PARTS, "export", TMP)

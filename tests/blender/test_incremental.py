@@ -8,49 +8,31 @@
 #     its child's instance too, without a walk over the scene; deleting an object frees its mesh;
 #   - after every edit, the incrementally updated scene renders exactly the image a fresh export of
 #     the same depsgraph renders (same meshes, transforms, materials, lights): the known answer.
+import os
 import sys
 
 import bpy
 import numpy as np
 
-failures = []
-
-
-def check(cond, what):
-    print(("  ok: " if cond else "  FAIL: ") + what, flush=True)
-    if not cond:
-        failures.append(what)
-
-
-def material(name, color):
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (*color, 1)
-    return mat
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit (see harness)
+import kit  # noqa: E402
+from harness import check, run_script  # noqa: E402
 
 
 def build():
-    bpy.data.batch_remove(list(bpy.data.objects) + list(bpy.data.meshes) + list(bpy.data.lights))
-    scene = bpy.context.scene
-    scene.render.engine = "TOYRT"
+    scene = kit.clear_scene()
+    kit.toyrt(scene)
     scene.render.resolution_x = scene.render.resolution_y = 24
     scene.render.resolution_percentage = 100
+    # The operators: the test edits Blender's own "Cube" and "Icosphere".
     bpy.ops.mesh.primitive_plane_add(size=6)
-    bpy.context.object.data.materials.append(material("floor", (0.8, 0.8, 0.8)))
+    bpy.context.object.data.materials.append(kit.principled("floor", (0.8, 0.8, 0.8)))
     bpy.ops.mesh.primitive_cube_add(size=1, location=(-1, 0, 0.5))
-    bpy.context.object.data.materials.append(material("red", (0.8, 0.1, 0.1)))
+    bpy.context.object.data.materials.append(kit.principled("red", (0.8, 0.1, 0.1)))
     bpy.ops.mesh.primitive_ico_sphere_add(radius=0.5, location=(1, 0, 0.5))
-    light = bpy.data.lights.new("lamp", "POINT")
-    light.energy = 300
-    lo = bpy.data.objects.new("lamp", light)
-    lo.location = (0, -1, 3)
-    scene.collection.objects.link(lo)
-    cam = bpy.data.cameras.new("cam")
-    co = bpy.data.objects.new("cam", cam)
-    co.location = (0, -6, 4)
-    co.rotation_euler = (0.9, 0, 0)
-    scene.collection.objects.link(co)
-    scene.camera = co
+    kit.point_light("lamp", (0, -1, 3), 300.0, radius=0.25)    # Blender 3.4's default radius
+    kit.camera((0, -6, 4), rotation=(0.9, 0, 0))
     bpy.context.view_layer.update()
     return scene
 
@@ -102,7 +84,8 @@ def main():
         edit("mesh edit", mesh_edit, dict(meshes_exported=1, mesh_bvhs_built=1, transforms_set=0, light_sends=0))
 
         def material_edit():
-            bpy.data.materials["red"].node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (0.1, 0.2, 0.9, 1)
+            bsdf = bpy.data.materials["red"].node_tree.nodes["Principled BSDF"]
+            bsdf.inputs["Base Color"].default_value = (0.1, 0.2, 0.9, 1)
         edit("material edit", material_edit, dict(materials_converted=1, meshes_exported=0, mesh_bvhs_built=0))
 
         def light_edit():
@@ -118,8 +101,4 @@ def main():
         bpy.app.handlers.depsgraph_update_post.remove(on_update)
 
 
-main()
-if failures:
-    print(f"test_incremental: {len(failures)} failed", flush=True)
-    sys.exit(1)
-print("test_incremental: all checks passed", flush=True)
+run_script([main], "incremental")

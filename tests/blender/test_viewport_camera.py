@@ -5,19 +5,17 @@
 # the image it renders must be the image of the camera itself (camera.export_camera): perspective
 # with lens shift, horizontal and vertical sensor fit, and orthographic. Known answer: the same
 # picture, to float rounding of the recovered parameters.
+import os
 import sys
 import types
 
 import bpy
 import numpy as np
 
-failures = []
-
-
-def check(cond, what):
-    print(("  ok: " if cond else "  FAIL: ") + what, flush=True)
-    if not cond:
-        failures.append(what)
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit (see harness)
+import kit  # noqa: E402
+from harness import check, run_script  # noqa: E402
 
 
 def main():
@@ -26,23 +24,14 @@ def main():
     from render_toyrt.camera import export_camera
 
     toyrt = render_toyrt.native()
-    bpy.data.batch_remove(list(bpy.data.objects) + list(bpy.data.meshes))
-    scene = bpy.context.scene
-    scene.render.engine = "TOYRT"
+    scene = kit.clear_scene()
+    kit.toyrt(scene)
     for x in (-2, 0, 2):
-        bpy.ops.mesh.primitive_cube_add(size=0.8, location=(x, x * 0.5, 0.4))
-    bpy.ops.mesh.primitive_plane_add(size=10)
-    light = bpy.data.lights.new("lamp", "POINT")
-    light.energy = 400
-    lo = bpy.data.objects.new("lamp", light)
-    lo.location = (1, -2, 4)
-    scene.collection.objects.link(lo)
-    cam = bpy.data.cameras.new("cam")
-    co = bpy.data.objects.new("cam", cam)
-    co.location = (1, -7, 4)
-    co.rotation_euler = (1.05, 0, 0.15)
-    scene.collection.objects.link(co)
-    scene.camera = co
+        kit.box(f"cube{x}", 0.8, (x, x * 0.5, 0.4))
+    kit.plane("floor", 10.0)
+    kit.point_light("lamp", (1, -2, 4), 400.0, radius=0.25)    # Blender 3.4's default radius
+    co = kit.camera((1, -7, 4), rotation=(1.05, 0, 0.15))
+    cam = co.data
     scene.render.resolution_percentage = 100
     depsgraph = bpy.context.evaluated_depsgraph_get()
     cache = sync.SceneSync(toyrt)
@@ -77,8 +66,4 @@ def main():
               f"{label}: the view's camera renders the camera's picture ({100 * changed:.2f} % of pixels differ)")
 
 
-main()
-if failures:
-    print(f"test_viewport_camera: {len(failures)} failed", flush=True)
-    sys.exit(1)
-print("test_viewport_camera: all checks passed", flush=True)
+run_script([main], "viewport camera")
