@@ -10,6 +10,8 @@
 # data (mesh.py, materials.py, lights.py, world.py, camera.py), engine.py (the render loop) and
 # viewport.py (the 3D viewport's Rendered mode). No rendering logic in Python.
 
+import types
+
 bl_info = {
     "name": "TOYRT",
     "author": "TOYRT developers",
@@ -22,7 +24,7 @@ bl_info = {
 _native = None  # the imported native module, once native() has succeeded
 
 
-def native():
+def native() -> types.ModuleType:
     """Return the native `toyrt` module shipped in this add-on's folder, importing it on first use.
 
     Raises ImportError with a hint when the module is missing or cannot be loaded (for example
@@ -41,7 +43,7 @@ def native():
     return _native
 
 
-def register():
+def register() -> None:
     from . import engine, properties, ui
 
     properties.register()
@@ -55,7 +57,7 @@ def register():
         print(err if isinstance(err, ImportError) else f"TOYRT: loading the native module failed: {err!r}")
 
 
-def unregister():
+def unregister() -> None:
     from . import engine, properties, ui
 
     ui.unregister()

@@ -27,7 +27,7 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             session.close()
 
     # ---- 3D viewport (viewport.py) ----------------------------------------------------------------
-    def view_update(self, context, depsgraph):
+    def view_update(self, context, depsgraph) -> None:
         from . import native, viewport
 
         try:
@@ -38,13 +38,13 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             self.report({"ERROR"}, f"TOYRT: {err}")
             print(f"TOYRT: viewport update failed: {err!r}", flush=True)
 
-    def view_draw(self, context, depsgraph):
+    def view_draw(self, context, depsgraph) -> None:
         if self._viewport is not None:
             self._viewport.draw(context, depsgraph)
 
     # ---- F12 and command-line renders ---------------------------------------------------------------
 
-    def render(self, depsgraph):
+    def render(self, depsgraph) -> None:
         from . import native
 
         try:
@@ -156,7 +156,7 @@ def _on_load_pre(*_args):
     sync.free_render_caches()
 
 
-def register():
+def register() -> None:
     import atexit
 
     from . import viewport
@@ -166,7 +166,7 @@ def register():
     atexit.register(viewport.close_all)  # Blender quitting: no render thread may outlive it
 
 
-def unregister():
+def unregister() -> None:
     import atexit
 
     from . import sync, viewport

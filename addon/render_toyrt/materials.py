@@ -112,7 +112,7 @@ def image_notes(image, pixels: np.ndarray | None) -> tuple[str, ...]:
 # ---------------------------------------------------------------------------------------------
 # node helpers
 
-def input_socket(node, *names):
+def input_socket(node, *names: str) -> object | None:
     """The first of the named input sockets the node has (names moved between versions)."""
     for n in names:
         sock = node.inputs.get(n)
@@ -121,7 +121,7 @@ def input_socket(node, *names):
     return None
 
 
-def linked_node(socket):
+def linked_node(socket) -> object | None:
     """The node feeding `socket`, following reroutes; None when unlinked."""
     seen = 0
     while socket is not None and socket.is_linked and seen < 64:
@@ -137,7 +137,7 @@ def linked_node(socket):
     return None
 
 
-def output_node(ntree, output_type: str):
+def output_node(ntree, output_type: str) -> object | None:
     """The active output node of a node tree for Cycles (or for all renderers)."""
     get = getattr(ntree, "get_output_node", None)
     if get is not None:

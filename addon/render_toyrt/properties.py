@@ -36,11 +36,11 @@ class TOYRTRenderSettings(bpy.types.PropertyGroup):
         default=0, min=0)
 
 
-def register():
+def register() -> None:
     bpy.utils.register_class(TOYRTRenderSettings)
     bpy.types.Scene.toyrt = bpy.props.PointerProperty(type=TOYRTRenderSettings)
 
 
-def unregister():
+def unregister() -> None:
     del bpy.types.Scene.toyrt
     bpy.utils.unregister_class(TOYRTRenderSettings)

@@ -44,13 +44,13 @@ def _panels():
             yield panel
 
 
-def register():
+def register() -> None:
     bpy.utils.register_class(RENDER_PT_toyrt)
     for panel in _panels():
         panel.COMPAT_ENGINES.add("TOYRT")
 
 
-def unregister():
+def unregister() -> None:
     for panel in _panels():
         panel.COMPAT_ENGINES.discard("TOYRT")
     bpy.utils.unregister_class(RENDER_PT_toyrt)

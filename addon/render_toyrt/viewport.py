@@ -25,7 +25,7 @@ COARSE_DIVIDER = 4      # the first pass renders 1/4 of the width and height
 MAX_PASS_SAMPLES = 16   # samples per pass once the image is refined: a restart never waits long
 
 
-def close_all():
+def close_all() -> None:
     """Stop every viewport render (file load, unregister, Blender quitting)."""
     for session in list(_sessions):
         session.close()
@@ -66,7 +66,7 @@ def _view_key(camera):
 
 
 class ViewportSession:
-    def __init__(self, toyrt, engine):
+    def __init__(self, toyrt, engine) -> None:
         from .sync import SceneSync
 
         self.cache = SceneSync(toyrt)
@@ -86,7 +86,7 @@ class ViewportSession:
         _sessions.add(self)
 
     # ---- on Blender's main thread -----------------------------------------------------------------
-    def update(self, context, depsgraph):
+    def update(self, context, depsgraph) -> None:
         self._stop_thread()  # the thread reads the native scene: never edit it under its feet
         first = not self.cache.synced
         self.cache.sync(depsgraph, None if first else depsgraph.updates)
@@ -103,7 +103,7 @@ class ViewportSession:
         self.cache.commit(builder=s.builder, threads=threads, expected_rays=rays)
         self._stale = True
 
-    def draw(self, context, depsgraph):
+    def draw(self, context, depsgraph) -> None:
         import gpu
         from gpu_extras.presets import draw_texture_2d
 
@@ -133,7 +133,7 @@ class ViewportSession:
         engine.unbind_display_space_shader()
         gpu.state.blend_set("NONE")
 
-    def close(self):
+    def close(self) -> None:
         """Stop and join the render thread, drop the texture and the native scene."""
         self._engine = lambda: None
         self._stop_thread()
@@ -142,7 +142,7 @@ class ViewportSession:
         _sessions.discard(self)
 
     @property
-    def rendering(self):
+    def rendering(self) -> bool:
         return self._thread is not None and self._thread.is_alive()
 
     # ---- the render thread -------------------------------------------------------------------------
