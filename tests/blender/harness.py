@@ -77,6 +77,43 @@ def render_still(path):
     return result, out[0]
 
 
+@contextmanager
+def live_sync(sync, toyrt):
+    """A SceneSync (`sync`: the add-on's sync module) of the current scene, synced and committed,
+    then kept up to date as the viewport's is: with Blender's own depsgraph.updates, through a
+    depsgraph_update_post handler removed when the block ends."""
+    import bpy
+
+    live = sync.SceneSync(toyrt)
+    live.sync(bpy.context.evaluated_depsgraph_get())
+    live.commit()
+
+    def on_update(_scene, depsgraph):
+        live.sync(depsgraph, depsgraph.updates)
+        live.commit()
+
+    bpy.app.handlers.depsgraph_update_post.append(on_update)
+    try:
+        yield live
+    finally:
+        bpy.app.handlers.depsgraph_update_post.remove(on_update)
+
+
+def counted_edit(live, label, fn, expect=None):
+    """Makes the edit fn() and lets Blender evaluate it (live_sync's handler syncs it), then checks
+    that the SceneSync's counters moved by `expect` ({counter: change}) when given."""
+    import bpy
+
+    before = dict(live.counters)
+    fn()
+    bpy.context.view_layer.update()  # Blender evaluates and calls depsgraph_update_post
+    if expect:
+        delta = {k: live.counters[k] - before[k] for k in live.counters}
+        wrong = {k: (delta[k], v) for k, v in expect.items() if delta[k] != v}
+        check(not wrong, f"{label}: {', '.join(f'{k} {v}' for k, v in expect.items())}"
+                         + (f" -- got (got, expected) {wrong}" if wrong else ""))
+
+
 def run_script(parts, label, tmp=None):
     """A script's last line: runs its parts in turn (run_part: an exception fails one check and the
     next part still runs), removes the folder `tmp` they wrote to, then finish(label)."""

@@ -17,7 +17,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit (see harness)
 import kit  # noqa: E402
-from harness import check, run_script  # noqa: E402
+from harness import check, counted_edit, live_sync, run_script  # noqa: E402
 
 
 def build():
@@ -44,33 +44,18 @@ def main():
 
     toyrt = render_toyrt.native()
     scene = build()
-    cache = sync.SceneSync(toyrt)
-    cache.sync(bpy.context.evaluated_depsgraph_get())
-    cache.commit()
+    with live_sync(sync, toyrt) as cache:
+        def edit(label, fn, expect):
+            counted_edit(cache, label, fn, expect)
+            depsgraph = bpy.context.evaluated_depsgraph_get()
+            camera = export_camera(depsgraph)
+            fresh, _, _ = sync.export_scene(depsgraph, toyrt)
+            fresh.commit()
+            a = cache.scene.render(camera, samples=4)
+            b = fresh.render(camera, samples=4)
+            check(np.array_equal(a, b), f"{label}: the updated scene renders what a fresh export renders "
+                                        f"(max difference {np.abs(a - b).max():.3g})")
 
-    def on_update(scn, depsgraph):
-        cache.sync(depsgraph, depsgraph.updates)
-        cache.commit()
-
-    def edit(label, fn, expect):
-        before = dict(cache.counters)
-        fn()
-        bpy.context.view_layer.update()  # Blender evaluates and calls depsgraph_update_post
-        delta = {k: cache.counters[k] - before[k] for k in cache.counters}
-        wrong = {k: (delta[k], v) for k, v in expect.items() if delta[k] != v}
-        check(not wrong, f"{label}: {', '.join(f'{k} {v}' for k, v in expect.items())}"
-                         + (f" -- got (got, expected) {wrong}" if wrong else ""))
-        depsgraph = bpy.context.evaluated_depsgraph_get()
-        camera = export_camera(depsgraph)
-        fresh, _, _ = sync.export_scene(depsgraph, toyrt)
-        fresh.commit()
-        a = cache.scene.render(camera, samples=4)
-        b = fresh.render(camera, samples=4)
-        check(np.array_equal(a, b), f"{label}: the updated scene renders what a fresh export renders "
-                                    f"(max difference {np.abs(a - b).max():.3g})")
-
-    bpy.app.handlers.depsgraph_update_post.append(on_update)
-    try:
         cube, sphere = bpy.data.objects["Cube"], bpy.data.objects["Icosphere"]
         nothing = dict(meshes_exported=0, commits=0, mesh_bvhs_built=0, light_sends=0, materials_converted=0)
         edit("camera move", lambda: setattr(scene.camera, "location", (0.5, -6, 4)), nothing)
@@ -97,8 +82,6 @@ def main():
         edit("delete an object", lambda: bpy.data.objects.remove(sphere),
              dict(meshes_freed=1, meshes_exported=0, instance_resets=1))
         check(cache.scene.instance_count == 2, f"two instances left ({cache.scene.instance_count})")
-    finally:
-        bpy.app.handlers.depsgraph_update_post.remove(on_update)
 
 
 run_script([main], "incremental")
