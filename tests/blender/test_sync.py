@@ -16,7 +16,6 @@
 #   3. DefaultsMatchTheCore: properties.py's defaults (literal, so the add-on registers without
 #      the native module) equal the core's toyrt.defaults, where the module has them.
 import os
-import shutil
 import sys
 import tempfile
 
@@ -24,8 +23,9 @@ import bpy
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
-from harness import check, finish, run_part  # noqa: E402
+sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit (see harness)
+import kit  # noqa: E402
+from harness import check, render_still, run_script  # noqa: E402
 
 TMP = tempfile.mkdtemp(prefix="toyrt-test-sync-")
 SAMPLES = 4
@@ -37,78 +37,38 @@ def addon():
     return sync, render_toyrt.native()
 
 
-# ---- the scene ----------------------------------------------------------------------------------
-
-def diffuse(name, color):
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (*color, 1.0)
-    return mat
-
+# ---- the scene: the kit (scenes/kit.py) ---------------------------------------------------------
 
 def build():
-    """Floor, a red cube flattened to a square (scale z = 0), a collection (ico sphere + small
-    cube) instanced twice by empties, a blue sphere, a point light and an area light, seen from
-    above at an angle."""
-    bpy.data.batch_remove(list(bpy.data.objects) + list(bpy.data.meshes) + list(bpy.data.lights)
-                          + list(bpy.data.materials) + list(bpy.data.collections))
-    scene = bpy.context.scene
-    scene.render.engine = "TOYRT"
-    scene.render.resolution_x, scene.render.resolution_y = 48, 36
-    scene.render.resolution_percentage = 100
-    scene.render.use_border = False
+    """Floor, a red cube flattened to a square (scale z = 0), a collection (a small sphere and a
+    small cube) instanced twice by empties, a blue sphere, a point light and an area light, seen
+    from above at an angle."""
+    scene = kit.clear_scene()
     scene.frame_start = scene.frame_end = 1
     scene.frame_set(1)
-    scene.toyrt.samples, scene.toyrt.seed = SAMPLES, 0
-    scene.view_settings.view_transform = "Standard"
-    if scene.world is not None:
-        scene.world.use_nodes = False
-        scene.world.color = (0.05, 0.05, 0.05)
-
-    bpy.ops.mesh.primitive_plane_add(size=12)
-    bpy.context.object.data.materials.append(diffuse("floor", (0.8, 0.8, 0.8)))
-    bpy.ops.mesh.primitive_cube_add(size=2, location=(-2.0, 0.0, 0.5))
-    flat = bpy.context.object
-    flat.name = "flat"
+    kit.output(scene, 48, 36)
+    kit.toyrt(scene, samples=SAMPLES, seed=0)
+    kit.world((0.05, 0.05, 0.05))
+    kit.plane("floor", 12.0, kit.diffuse("floor"))
+    flat = kit.box("flat", 2.0, (-2.0, 0.0, 0.5), kit.diffuse("red", (0.8, 0.1, 0.1)))
     flat.scale = (1.0, 1.0, 0.0)            # a square at z = 0.5: Cycles renders it, so must TOYRT
-    flat.data.materials.append(diffuse("red", (0.8, 0.1, 0.1)))
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.7, location=(2.0, -1.0, 0.7))
-    bpy.context.object.name = "ball"
-    bpy.context.object.data.materials.append(diffuse("blue", (0.1, 0.2, 0.8)))
+    kit.uv_sphere("ball", 0.7, (2.0, -1.0, 0.7), kit.diffuse("blue", (0.1, 0.2, 0.8)), segments=24, rings=12)
 
-    coll = bpy.data.collections.new("kit")
-    scene.collection.children.link(coll)
-    bpy.ops.mesh.primitive_ico_sphere_add(radius=0.4, location=(0.0, 0.0, 0.4))
-    ico = bpy.context.object
-    bpy.ops.mesh.primitive_cube_add(size=0.4, location=(0.6, 0.0, 0.2))
-    small = bpy.context.object
-    for obj in (ico, small):
-        for c in list(obj.users_collection):
-            c.objects.unlink(obj)
-        coll.objects.link(obj)
-    bpy.context.view_layer.layer_collection.children["kit"].exclude = True  # shown through the instances only
-    for i, loc in enumerate(((0.0, 2.0, 0.0), (1.0, 3.0, 0.0))):
-        empty = bpy.data.objects.new(f"instancer{i}", None)
-        empty.instance_type, empty.instance_collection = "COLLECTION", coll
-        empty.location = loc
-        scene.collection.objects.link(empty)
+    parts = bpy.data.collections.new("parts")
+    scene.collection.children.link(parts)
+    for obj in (kit.uv_sphere("pebble", 0.4, (0.0, 0.0, 0.4), None, segments=16, rings=8),
+                kit.box("brick", 0.4, (0.6, 0.0, 0.2))):
+        scene.collection.objects.unlink(obj)
+        parts.objects.link(obj)
+    bpy.context.view_layer.layer_collection.children["parts"].exclude = True  # shown through the instances only
+    for i, location in enumerate(((0.0, 2.0, 0.0), (1.0, 3.0, 0.0))):
+        empty = kit.link(bpy.data.objects.new(f"instancer{i}", None))
+        empty.instance_type, empty.instance_collection = "COLLECTION", parts
+        empty.location = location
 
-    point = bpy.data.lights.new("lamp", "POINT")
-    point.energy = 400.0
-    lo = bpy.data.objects.new("lamp", point)
-    lo.location = (1.0, -2.0, 4.0)
-    scene.collection.objects.link(lo)
-    area = bpy.data.lights.new("panel", "AREA")
-    area.energy, area.size = 200.0, 2.0
-    ao = bpy.data.objects.new("panel", area)
-    ao.location = (-2.0, 1.0, 3.0)
-    scene.collection.objects.link(ao)
-
-    cam = bpy.data.objects.new("cam", bpy.data.cameras.new("cam"))
-    cam.location = (0.0, -9.0, 9.0)
-    cam.rotation_euler = (0.785, 0.0, 0.0)
-    scene.collection.objects.link(cam)
-    scene.camera = cam
+    kit.point_light("lamp", (1.0, -2.0, 4.0), 400.0, radius=0.1)
+    kit.area_light("panel", (-2.0, 1.0, 3.0), 200.0, 2.0, target=(-2.0, 1.0, 0.0), visible_camera=True)
+    kit.camera((0.0, -9.0, 9.0), rotation=(0.785, 0.0, 0.0))
     bpy.context.view_layer.update()
     return scene
 
@@ -137,19 +97,11 @@ def render(t_scene, camera):
 def f12_image(name):
     """F12 (the engine's final-render sync) written as a 32-bit float EXR, read back linear:
     (height, width, 4), rows from the top."""
-    s = bpy.context.scene
-    s.render.image_settings.file_format = "OPEN_EXR"
-    s.render.image_settings.color_depth = "32"
-    s.render.image_settings.color_mode = "RGBA"
+    kit.float_exr(bpy.context.scene)
     path = os.path.join(TMP, f"{name}.exr")
-    s.render.filepath = path
-    bpy.ops.render.render(write_still=True)
-    img = bpy.data.images.load(path)
-    w, h = img.size
-    px = np.empty(w * h * 4, np.float32)
-    img.pixels.foreach_get(px)
-    bpy.data.images.remove(img)
-    return px.reshape(h, w, 4)[::-1]
+    result, log = render_still(path)
+    check(result == {"FINISHED"}, f"F12 finished ({result!r:.120})")
+    return kit.read_image(path)[::-1]
 
 
 # ---- 1. one scene, every path ---------------------------------------------------------------------
@@ -238,8 +190,8 @@ def test_incremental_equals_one_shot():
              dict(light_sends=1, meshes_exported=0))
 
         def material_edit():
-            bpy.data.materials["red"].node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = \
-                (0.1, 0.8, 0.1, 1.0)
+            color = bpy.data.materials["red"].node_tree.nodes["Diffuse BSDF"].inputs["Color"]
+            color.default_value = (0.1, 0.8, 0.1, 1.0)
         edit("material edit", material_edit, dict(materials_converted=1, meshes_exported=0, light_sends=0))
         flat = bpy.data.objects["flat"]
         edit("move the flattened cube (baked again)", lambda: setattr(flat, "location", (-2.5, 0.5, 0.8)),
@@ -276,9 +228,5 @@ def test_defaults_match_the_core():
     check(compared > 0, f"{compared} defaults compared")
 
 
-try:
-    for part in (test_same_scene_on_every_path, test_incremental_equals_one_shot, test_defaults_match_the_core):
-        run_part(part)
-finally:
-    shutil.rmtree(TMP, ignore_errors=True)
-finish("sync")
+run_script((test_same_scene_on_every_path, test_incremental_equals_one_shot, test_defaults_match_the_core), "sync",
+           tmp=TMP)
