@@ -25,7 +25,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit (see harness)
 import kit  # noqa: E402
-from harness import check, render_still, run_script  # noqa: E402
+from harness import check, counted_edit, live_sync, render_still, run_script  # noqa: E402
 
 TMP = tempfile.mkdtemp(prefix="toyrt-test-sync-")
 SAMPLES = 4
@@ -153,39 +153,23 @@ def test_same_scene_on_every_path():
 def test_incremental_equals_one_shot():
     sync, toyrt = addon()
     build()
-    cache = sync.SceneSync(toyrt)
-    cache.sync(bpy.context.evaluated_depsgraph_get())
-    cache.commit()
+    with live_sync(sync, toyrt) as cache:
+        def edit(label, fn, expect=None):
+            counted_edit(cache, label, fn, expect)
+            depsgraph = bpy.context.evaluated_depsgraph_get()
+            fresh, camera, stats = sync.export_scene(depsgraph, toyrt)
+            fresh.commit()
+            same_counts = (fresh.instance_count == cache.scene.instance_count
+                           and fresh.triangle_count == cache.scene.triangle_count
+                           and stats["triangles_instanced"] == cache.stats["triangles_instanced"]
+                           and stats["lights"] == len(cache.lights))
+            check(same_counts, f"{label}: the same instances ({cache.scene.instance_count}, "
+                               f"fresh {fresh.instance_count}), stored triangles ({cache.scene.triangle_count}, "
+                               f"fresh {fresh.triangle_count}), lights ({len(cache.lights)}, fresh {stats['lights']})")
+            a, b = render(cache.scene, camera), render(fresh, camera)
+            check(np.array_equal(a, b), f"{label}: the updated scene renders what a fresh export renders "
+                                        f"(max difference {np.abs(a - b).max():.3g})")
 
-    def on_update(_scene, depsgraph):
-        cache.sync(depsgraph, depsgraph.updates)
-        cache.commit()
-
-    def edit(label, fn, expect=None):
-        before = dict(cache.counters)
-        fn()
-        bpy.context.view_layer.update()  # Blender evaluates and calls depsgraph_update_post
-        delta = {k: cache.counters[k] - before[k] for k in cache.counters}
-        if expect:
-            wrong = {k: (delta[k], v) for k, v in expect.items() if delta[k] != v}
-            check(not wrong, f"{label}: {', '.join(f'{k} {v}' for k, v in expect.items())}"
-                             + (f" -- got (got, expected) {wrong}" if wrong else ""))
-        depsgraph = bpy.context.evaluated_depsgraph_get()
-        fresh, camera, stats = sync.export_scene(depsgraph, toyrt)
-        fresh.commit()
-        same_counts = (fresh.instance_count == cache.scene.instance_count
-                       and fresh.triangle_count == cache.scene.triangle_count
-                       and stats["triangles_instanced"] == cache.stats["triangles_instanced"]
-                       and stats["lights"] == len(cache.lights))
-        check(same_counts, f"{label}: the same instances ({cache.scene.instance_count}, fresh {fresh.instance_count}), "
-                           f"stored triangles ({cache.scene.triangle_count}, fresh {fresh.triangle_count}), "
-                           f"lights ({len(cache.lights)}, fresh {stats['lights']})")
-        a, b = render(cache.scene, camera), render(fresh, camera)
-        check(np.array_equal(a, b), f"{label}: the updated scene renders what a fresh export renders "
-                                    f"(max difference {np.abs(a - b).max():.3g})")
-
-    bpy.app.handlers.depsgraph_update_post.append(on_update)
-    try:
         edit("light edit", lambda: setattr(bpy.data.lights["lamp"], "energy", 150.0),
              dict(light_sends=1, meshes_exported=0))
 
@@ -203,8 +187,6 @@ def test_incremental_equals_one_shot():
         edit("then move it (instance matrices only)", lambda: setattr(flat, "location", (-2.0, 0.0, 0.5)),
              dict(meshes_exported=0, walks=0, transforms_set=1))
         edit("move a collection instance", lambda: setattr(bpy.data.objects["instancer1"], "location", (1.5, 3.0, 0.0)))
-    finally:
-        bpy.app.handlers.depsgraph_update_post.remove(on_update)
 
 
 # ---- 3. defaults ----------------------------------------------------------------------------------------
