@@ -6,7 +6,7 @@
 //
 //   bench_accel --csv FILE.csv [--dump DIR] [--runs N] [--quick]
 #include "accel/binned_sah_builder.h"
-#include "accel/builder_choice.h"
+#include "accel/builder.h"
 #include "accel/lbvh_builder.h"
 #include "bench_util.h"
 #include "embree_oracle.h"

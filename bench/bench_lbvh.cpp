@@ -204,7 +204,7 @@ int main(int argc, char** argv) {
     md << line;
   }
   md << "\n\n## What `auto` picks\n\nTotal time = build + rays / measured trace speed, per mesh and workload; "
-        "`auto` decides from its cost model (native/accel/builder_choice.h) before building anything.\n\n"
+        "`auto` decides from its cost model (native/accel/builder.h) before building anything.\n\n"
      << "| triangles | workload | rays | SAH total s | LBVH total s | auto picks | auto's total vs the better |\n"
      << "|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows)

@@ -171,12 +171,12 @@ struct EstimatorCase {
 // One-sample irradiance estimates E = L cos / pdf at p (normal n) from a 1 m x 1 m light at the
 // origin emitting down (-Z); mean and relative standard deviation over `n` independent samples.
 std::pair<double, double> estimate(AreaSampling sampling, const Vec3& p, const Vec3& n, int count) {
-  const AreaLight light = AreaLight::make(AreaShape::Square, 1.0f, 1.0f, Mat4(1.0f), 4.0f, Vec3(1.0f), sampling);
+  const AreaLight light = AreaLight::make(AreaShape::Square, 1.0f, 1.0f, Mat4(1.0f), 4.0f, Vec3(1.0f));
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   double sum = 0.0, sum2 = 0.0;
   for (int i = 0; i < count; ++i) {
-    const LightSample s = sample(light, p, Vec2(unit(rng), unit(rng)));
+    const LightSample s = sample(light, p, Vec2(unit(rng), unit(rng)), sampling);
     double e = 0.0;
     if (s.valid()) e = double(s.radiance.x) * std::max(0.0f, glm::dot(n, s.wi)) / double(s.pdf);
     sum += e;

@@ -57,20 +57,12 @@ void Mesh::prepare(std::vector<BBox>& boxes, std::vector<Vec3>& centers, std::ve
   }
 }
 
-void Mesh::build(const BinnedSahConfig& config) {
+void Mesh::build(BuilderKind kind, const BuildConfig& config, BuildStats* stats) {
   std::vector<BBox> boxes;
   std::vector<Vec3> centers;
   std::vector<uint32_t> valid;
   prepare(boxes, centers, valid);
-  finish(build_binned_sah(boxes.data(), centers.data(), boxes.size(), config), valid);
-}
-
-void Mesh::build_lbvh(const LbvhConfig& config, LbvhStats* stats) {
-  std::vector<BBox> boxes;
-  std::vector<Vec3> centers;
-  std::vector<uint32_t> valid;
-  prepare(boxes, centers, valid);
-  finish(toyrt::build_lbvh(boxes.data(), centers.data(), boxes.size(), config, stats), valid);
+  finish(build_bvh(kind, boxes.data(), centers.data(), boxes.size(), config, stats), valid);
 }
 
 void Mesh::finish(Bvh bvh, const std::vector<uint32_t>& valid) {

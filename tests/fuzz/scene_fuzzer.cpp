@@ -324,10 +324,10 @@ void fuzz_transport(FuzzedDataProvider& in) {
   }
   try {
     const AreaLight light = AreaLight::make(AreaShape(in.ConsumeIntegralInRange<int>(0, 3)), fuzz_float(in),
-                                            fuzz_float(in), fuzz_matrix(in), fuzz_float(in), fuzz_vec3(in),
-                                            in.ConsumeBool() ? AreaSampling::Area : AreaSampling::SolidAngle);
-    (void)sample(light, shading_point, u);
-    (void)evaluate(light, shading_point, normal);
+                                            fuzz_float(in), fuzz_matrix(in), fuzz_float(in), fuzz_vec3(in));
+    const AreaSampling sampling = in.ConsumeBool() ? AreaSampling::Area : AreaSampling::SolidAngle;
+    (void)sample(light, shading_point, u, sampling);
+    (void)evaluate(light, shading_point, normal, sampling);
     (void)importance(light, shading_point, normal);
   } catch (const std::invalid_argument&) {
   }
