@@ -5,9 +5,9 @@
 //
 // Pixel coordinates: continuous (px, py) with px in [0, width) from the left and py in
 // [0, height) from the TOP row, the order images are stored in memory here; pixel (i, j) covers
-// [i, i + 1) x [j, j + 1), so its centre is (i + 0.5, j + 0.5). Blender's RenderResult (and
-// Image.pixels) store rows bottom-up: the integrator writes row j of this camera to Blender's
-// row height - 1 - j.
+// [i, i + 1) x [j, j + 1), so its centre is (i + 0.5, j + 0.5). render() returns rows in this
+// order too; Blender's RenderResult (and Image.pixels) store rows bottom-up, so the add-on flips
+// them (addon/render_toyrt/engine.py and viewport.py, pixels[::-1]) when it hands them over.
 #pragma once
 
 #include "core/math.h"

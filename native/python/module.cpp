@@ -9,6 +9,8 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 
 namespace py = pybind11;
@@ -17,7 +19,19 @@ using namespace toyrt::binding;
 
 namespace {
 
-py::tuple as_tuple(const Vec3& v) { return py::make_tuple(v.x, v.y, v.z); }
+// A float default as the shortest decimal that rounds to it (0.8f shows as 0.8, not
+// 0.800000011920929): what the signature and toyrt.defaults print; the same float32 either way.
+double tidy(float x) {
+  char digits[32];
+  std::snprintf(digits, sizeof digits, "%.9g", double(x));  // 9 significant digits identify a float
+  for (int precision = 1; precision < 9; ++precision) {
+    char shorter[32];
+    std::snprintf(shorter, sizeof shorter, "%.*g", precision, double(x));
+    if (std::strtof(shorter, nullptr) == x) return std::strtod(shorter, nullptr);
+  }
+  return std::strtod(digits, nullptr);
+}
+py::tuple as_tuple(const Vec3& v) { return py::make_tuple(tidy(v.x), tidy(v.y), tidy(v.z)); }
 
 // The core's defaults in one dict (toyrt.defaults), so the add-on's property defaults can be
 // tested equal to them.
@@ -37,7 +51,7 @@ py::dict core_defaults() {
   d["all_lights_up_to"] = kAllLightsUpTo;
   d["builder"] = builder_name(commit.builder);
   d["material_color"] = as_tuple(Lambert{}.albedo);
-  d["ior"] = PerfectRefraction{}.ior;
+  d["ior"] = tidy(PerfectRefraction{}.ior);
   return d;
 }
 
@@ -78,7 +92,7 @@ PYBIND11_MODULE(toyrt, m) {
            "uvs (M, 3, 2) or (N, 2), material_ids: one int or (M,) ints into the scene's materials.")
       .def("add_material", &PyScene::add_material, py::arg("kind") = "diffuse",
            py::arg("color") = as_tuple(Lambert{}.albedo), py::arg("texture") = Lambert{}.texture,
-           py::arg("ior") = PerfectRefraction{}.ior,
+           py::arg("ior") = tidy(PerfectRefraction{}.ior),
            "Adds a material; returns its id. kind: 'diffuse' (Lambert, linear RGB colour or a texture id),\n"
            "'refraction' (perfect refraction, Blender's Refraction BSDF, with its ior) or 'glass' (Fresnel\n"
            "reflection and refraction, Blender's Glass BSDF).")
@@ -132,7 +146,7 @@ PYBIND11_MODULE(toyrt, m) {
                              "samples, light_sampling.")
       .def("set_material", &PyScene::set_material, py::arg("material"), py::arg("kind") = "diffuse",
            py::arg("color") = as_tuple(Lambert{}.albedo), py::arg("texture") = Lambert{}.texture,
-           py::arg("ior") = PerfectRefraction{}.ior,
+           py::arg("ior") = tidy(PerfectRefraction{}.ior),
            "Replaces material `material` in place (same arguments as add_material); meshes keep their ids.")
       .def("set_texture", &PyScene::set_texture, py::arg("texture"), py::arg("pixels"), py::arg("srgb") = true,
            "Replaces texture `texture` in place (same arguments as add_texture).")
