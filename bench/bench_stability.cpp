@@ -45,7 +45,7 @@
 
 using namespace toyrt;
 using namespace toyrt::testing;
-using toyrt::bench::best_ms;
+using namespace toyrt::bench;
 
 namespace {
 
@@ -74,17 +74,6 @@ bool mt_hits_any(const MeshData& m, const Ray& r) {
   for (const Triangle& tri : m.triangles)
     if (moller_trumbore(r, m.vertices[tri[0]], m.vertices[tri[1]], m.vertices[tri[2]], t)) return true;
   return false;
-}
-
-std::unique_ptr<Scene> scene_of(const MeshData& m, BuilderKind kind = BuilderKind::Sah,
-                                MortonBits bits = MortonBits::k30) {
-  auto s = std::make_unique<Scene>();
-  s->add_instance(s->add_mesh(m.vertices, m.triangles), Mat4(1.0f));
-  CommitOptions o;
-  o.builder = kind;
-  o.lbvh.bits = bits;
-  s->commit(o);
-  return s;
 }
 
 template <class F>
@@ -132,7 +121,7 @@ AcneCase acne(const std::string& name, const MeshData& base, float scale, float 
   const BBox box = bounds_of(m);
   const auto scene = scene_of(m);
   const std::vector<Ray> cams = primary_rays(box, res, res);
-  const Vec3 light = box.center() + glm::length(box.extent()) * Vec3(-0.4f, -0.9f, 1.3f);
+  const Vec3 light = light_for(box);
   AcneCase c{name, scale, distance};
   std::vector<std::array<Ray, 3>> shadow;
   for (const Ray& r : cams) {
@@ -207,17 +196,10 @@ double fresnel_exact(double cos_i, double eta) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string out_path;
-  bool quick = false, smoke = false;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out_path = argv[++i];
-    else if (!std::strcmp(argv[i], "--quick")) quick = true;
-    else if (!std::strcmp(argv[i], "--smoke")) smoke = true;
-    else {
-      std::fprintf(stderr, "usage: %s [--out FILE.json] [--quick] [--smoke]\n", argv[0]);
-      return 2;
-    }
-  }
+  const std::optional<Args> args = parse_args(argc, argv, "[--out FILE.json] [--quick] [--smoke]");
+  if (!args) return 2;
+  const std::string& out_path = args->out;
+  const bool quick = args->quick, smoke = args->smoke;
 
   if (smoke) {
     // A fan of 64 triangles around each apex of a double cone: rays at the apexes and edges.
@@ -339,11 +321,7 @@ int main(int argc, char** argv) {
     }
     auto speed = [&](BuilderKind kind, MortonBits bits) {
       const auto scene = scene_of(room, kind, bits);
-      const double ms = best_ms(3, [&] {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-          for (size_t i = r.begin(); i != r.end(); ++i) scene->intersect(rays[i]);
-        });
-      });
+      const double ms = best_ms(3, [&] { for_each_ray(rays, [&](const Ray& ray) { scene->intersect(ray); }); });
       return rays.size() / ms / 1e3;
     };
     const double v_sah = speed(BuilderKind::Sah, MortonBits::k30), v30 = speed(BuilderKind::Lbvh, MortonBits::k30),

@@ -29,8 +29,7 @@
 
 using namespace toyrt;
 using namespace toyrt::testing;
-using toyrt::bench::best_ms;
-using toyrt::bench::cpu_model;
+using namespace toyrt::bench;
 
 namespace {
 
@@ -61,18 +60,11 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string out_path;
-  int runs = 5;
-  bool quick = false;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out_path = argv[++i];
-    else if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--quick")) quick = true;
-    else {
-      std::fprintf(stderr, "usage: %s [--out FILE] [--runs N] [--quick]\n", argv[0]);
-      return 2;
-    }
-  }
+  const std::optional<Args> args = parse_args(argc, argv, "[--out FILE] [--runs N] [--quick]", 5);
+  if (!args) return 2;
+  const std::string& out_path = args->out;
+  const int runs = args->runs;
+  const bool quick = args->quick;
   const int all = int(std::thread::hardware_concurrency());
   const int width = quick ? 320 : 1024, height = quick ? 240 : 768;
 
