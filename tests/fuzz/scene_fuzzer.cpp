@@ -7,7 +7,8 @@
 //   - on moderately sized inputs the scene finds a hit exactly when a brute-force loop over every
 //     triangle of every instance does (the BVH's boxes are conservative);
 //   - batch queries equal single-ray queries;
-//   - every builder's tree passes Bvh::validate.
+//   - every builder's tree passes Bvh::validate;
+//   - a whole scene (shading, materials, lights, world) renders to finite, non-negative pixels.
 // First input byte (from the end, FuzzedDataProvider's integer order) picks the part.
 #include "accel/binned_sah_builder.h"
 #include "accel/lbvh_builder.h"
@@ -17,6 +18,7 @@
 #include "lights/area_light.h"
 #include "lights/point_light.h"
 #include "materials/texture.h"
+#include "render/renderer.h"
 #include "scene/scene.h"
 
 #include <fuzzer/FuzzedDataProvider.h>
@@ -285,6 +287,77 @@ void fuzz_builders(FuzzedDataProvider& in) {
 }
 
 // Constructors refuse bad settings with std::invalid_argument; what they accept must be usable.
+// The whole scene rendered: fuzzed shading (refused exactly when MeshShading::check says so),
+// materials of every kind with fuzzed settings, a light, the background; a 2 x 2 render must
+// give finite, non-negative pixels or refuse a material id it does not have.
+void fuzz_render(FuzzedDataProvider& in) {
+  Scene scene;
+  std::vector<Vec3> vertices(in.ConsumeIntegralInRange<size_t>(0, 6));
+  for (Vec3& v : vertices) v = Vec3(fuzz_float(in) * 0.25f, fuzz_float(in) * 0.25f, fuzz_float(in) * 0.1f);
+  std::vector<Triangle> triangles(in.ConsumeIntegralInRange<size_t>(0, 4));
+  for (Triangle& t : triangles)
+    for (int k = 0; k < 3; ++k) t[k] = in.ConsumeIntegralInRange<uint32_t>(0, uint32_t(std::max<size_t>(vertices.size(), 1) - 1));
+  MeshShading sh;
+  const size_t corners = 3 * triangles.size() + (in.ConsumeIntegralInRange<int>(0, 7) == 0 ? 1 : 0);  // rarely wrong
+  if (in.ConsumeBool()) sh.corner_normals.resize(corners);
+  for (Vec3& n : sh.corner_normals) n = fuzz_vec3(in);
+  if (in.ConsumeBool()) sh.corner_uvs.resize(corners);
+  for (Vec2& uv : sh.corner_uvs) uv = Vec2(fuzz_float(in), fuzz_float(in));
+  if (in.ConsumeBool()) sh.material_ids.resize(triangles.size());
+  for (int32_t& id : sh.material_ids) id = in.ConsumeIntegralInRange<int32_t>(-1, 4);
+  bool shading_ok = true;
+  try {
+    (void)sh.check(triangles.size());
+  } catch (const std::invalid_argument&) {
+    shading_ok = false;
+  }
+  try {
+    scene.add_instance(scene.add_mesh(vertices, triangles, sh), Mat4(1.0f));
+    FUZZ_CHECK(shading_ok);
+  } catch (const std::invalid_argument&) {
+    FUZZ_CHECK(scene.mesh_count() == 0);  // refused shading or vertices: nothing added
+  }
+  if (in.ConsumeBool()) scene.add_texture(Texture::from_floats(2, 1, 3, {0, 0.5f, 1, 1, 0.5f, 0}, ColorEncoding::Linear));
+  for (int m = in.ConsumeIntegralInRange<int>(0, 4); m > 0; --m) {
+    static const char* kinds[] = {"diffuse", "refraction", "glass", "metal"};
+    try {
+      scene.add_material(make_material(kinds[in.ConsumeIntegralInRange<int>(0, 3)], fuzz_vec3(in),
+                                       in.ConsumeIntegralInRange<int64_t>(-2, 1), fuzz_float(in)));
+    } catch (const std::invalid_argument&) {
+    }
+  }
+  try {
+    scene.add_light(PointLight::make(fuzz_vec3(in), fuzz_float(in), Vec3(1.0f), fuzz_float(in)),
+                    {in.ConsumeBool(), in.ConsumeBool()});
+  } catch (const std::invalid_argument&) {
+  }
+  try {
+    scene.set_background(fuzz_vec3(in));
+  } catch (const std::invalid_argument&) {
+  }
+  scene.set_background_lighting(in.ConsumeBool());
+  CommitOptions options;
+  options.threads = 1;
+  scene.commit(options);
+  CameraParams p;
+  p.type = CameraType::Orthographic;
+  p.ortho_scale = 2.0f;
+  p.resolution_x = p.resolution_y = 2;
+  p.matrix_world[3] = glm::vec4(0.0f, 0.0f, 3.0f, 1.0f);
+  RenderSettings settings;
+  settings.samples = 1;
+  settings.threads = 1;
+  settings.integrator.max_specular_depth = in.ConsumeIntegralInRange<int>(0, 4);
+  settings.integrator.split_depth = in.ConsumeIntegralInRange<int>(0, 2);
+  settings.integrator.light_sampling = LightSampling(in.ConsumeIntegralInRange<int>(0, 2));
+  try {
+    const RenderResult r = render(scene, Camera::make(p), settings);
+    for (float x : r.rgba) FUZZ_CHECK(std::isfinite(x) && x >= 0.0f);
+  } catch (const std::invalid_argument& e) {
+    FUZZ_CHECK(std::strstr(e.what(), "uses material id") != nullptr);  // the only refusal left
+  }
+}
+
 void fuzz_transport(FuzzedDataProvider& in) {
   CameraParams p;
   p.type = in.ConsumeBool() ? CameraType::Perspective : CameraType::Orthographic;
@@ -340,6 +413,7 @@ void fuzz_transport(FuzzedDataProvider& in) {
     (void)tex.lookup(Vec2(fuzz_float(in), fuzz_float(in)));
   } catch (const std::invalid_argument&) {
   }
+  fuzz_render(in);  // last, so the inputs above read the bytes they read before it existed
 }
 
 }  // namespace
