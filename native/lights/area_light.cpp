@@ -143,6 +143,16 @@ AreaShape parse_area_shape(const std::string& name) {
   throw std::invalid_argument("area light shape must be 'RECTANGLE', 'SQUARE', 'DISK' or 'ELLIPSE', got '" + name + "'");
 }
 
+const char* area_shape_name(AreaShape shape) {
+  switch (shape) {
+    case AreaShape::Rectangle: return "RECTANGLE";
+    case AreaShape::Square: return "SQUARE";
+    case AreaShape::Disk: return "DISK";
+    case AreaShape::Ellipse: return "ELLIPSE";
+  }
+  return "?";
+}
+
 AreaSampling parse_area_sampling(const std::string& name) {
   if (name == "solid_angle") return AreaSampling::SolidAngle;
   if (name == "area") return AreaSampling::Area;

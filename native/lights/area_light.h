@@ -43,6 +43,15 @@ struct AreaLight {
   Vec3 corner() const { return center - 0.5f * edge_x - 0.5f * edge_y; }
 };
 
+// What an area light is when the caller does not say (the Python binding's argument defaults):
+// Blender's new area light, a 1 m square of 10 W, white.
+struct AreaLightDefaults {
+  AreaShape shape = AreaShape::Square;
+  float size = 1.0f;  // m
+  float power = 10.0f;  // W
+  Vec3 color{1.0f};
+};
+
 // A point on the light seen from shading point p (u: two uniform numbers). No sample when p is
 // behind or in the light's plane.
 // `sampling` applies to rectangles and squares; other shapes are always sampled by area.
@@ -52,6 +61,7 @@ LightEval evaluate(const AreaLight& light, const Vec3& p, const Vec3& wi, AreaSa
 
 // Blender's shape names: "RECTANGLE", "SQUARE", "DISK", "ELLIPSE"; throws std::invalid_argument.
 AreaShape parse_area_shape(const std::string& name);
+const char* area_shape_name(AreaShape shape);
 // "solid_angle" and "area"; throws std::invalid_argument.
 AreaSampling parse_area_sampling(const std::string& name);
 const char* area_sampling_name(AreaSampling sampling);

@@ -30,6 +30,13 @@ struct PointLight {
   static PointLight make(const Vec3& position, float power, const Vec3& color, float radius = 0.0f);
 };
 
+// What a point light is when the caller does not say (the Python binding's argument defaults):
+// white, radius 0 (a delta light, hard shadows).
+struct PointLightDefaults {
+  Vec3 color{1.0f};
+  float radius = 0.0f;
+};
+
 // A direction towards the light from shading point p (u: two uniform numbers, used for R > 0).
 LightSample sample(const PointLight& light, const Vec3& p, const Vec2& u);
 // The sphere along direction wi from p (nothing for radius 0: a delta light cannot be hit).

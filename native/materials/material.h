@@ -28,6 +28,7 @@ inline int32_t texture_of(const Material& material) {
 // or texture `texture`; -1: none), "refraction" (PerfectRefraction) or "glass"
 // (FresnelDielectric), both with `ior`. Throws std::invalid_argument for another kind or a bad
 // value. Texture ids are checked against the scene's textures by Scene::add_material.
+inline constexpr const char* kDefaultMaterialKind = "diffuse";
 Material make_material(const std::string& kind, const Vec3& color, int64_t texture, float ior);
 
 }  // namespace toyrt

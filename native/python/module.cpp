@@ -77,6 +77,27 @@ PYBIND11_MODULE(toyrt, m) {
     }
   });
 
+  // The render() docstring names the "auto" light count from the core's constant.
+  static const std::string render_doc =
+      std::string("Renders the committed scene; returns (height, width, 4) float32 linear RGBA, rows from the top, of\n"
+           "the camera's pixel window (the border region, if set).\n"
+           "camera: a dict of Blender's camera and render settings: type ('PERSP', 'ORTHO'), lens, sensor_width,\n"
+           "sensor_height, sensor_fit ('AUTO', 'HORIZONTAL', 'VERTICAL'), shift_x, shift_y, clip_start, clip_end,\n"
+           "ortho_scale, resolution_x, resolution_y, resolution_percentage, pixel_aspect_x, pixel_aspect_y,\n"
+           "use_border, border_min_x/y, border_max_x/y, matrix_world (4, 4).\n"
+           "area_light_sampling: 'solid_angle' (spherical rectangles) or 'area'. light_sampling: 'all' (every\n"
+           "light at every hit), 'one' (one light chosen by expected contribution) or 'auto' ('all' up to " +
+           std::to_string(kAllLightsUpTo) + "\n"
+           "lights). on_tile(x, y, width, height, pixels) is called on this thread as tiles finish;\n"
+           "should_cancel() is polled every 10 ms and stops the render when true (so does Ctrl-C).\n"
+           "Results are the same for any thread count and tile size.\n"
+           "first_sample: render samples [first_sample, first_sample + samples) of the same sequence, the\n"
+           "mean of that pass: passes weighted by their sample counts average to one render of them all\n"
+           "(progressive rendering). A window too large for the memory available raises MemoryError\n"
+           "before anything is allocated.\n"
+           "split_depth: glass (Fresnel) surfaces among the first split_depth path vertices trace both reflection\n"
+           "and refraction, weighted by F and 1 - F; deeper ones choose one. 0: never split.");
+
   py::class_<PyScene>(m, "Scene", "A two-level scene: meshes stored once, placed by instances.")
       .def(py::init<>())
       .def("add_mesh", &PyScene::add_mesh, py::arg("vertices"), py::arg("triangles"), py::arg("transform") = py::none(),
@@ -90,7 +111,7 @@ PYBIND11_MODULE(toyrt, m) {
            "Degenerate (zero-area) triangles are kept but can never be hit.\n"
            "For rendering: normals (M, 3, 3) per corner or (N, 3) per vertex (smooth shading; None: flat),\n"
            "uvs (M, 3, 2) or (N, 2), material_ids: one int or (M,) ints into the scene's materials.")
-      .def("add_material", &PyScene::add_material, py::arg("kind") = "diffuse",
+      .def("add_material", &PyScene::add_material, py::arg("kind") = kDefaultMaterialKind,
            py::arg("color") = as_tuple(Lambert{}.albedo), py::arg("texture") = Lambert{}.texture,
            py::arg("ior") = tidy(PerfectRefraction{}.ior),
            "Adds a material; returns its id. kind: 'diffuse' (Lambert, linear RGB colour or a texture id),\n"
@@ -100,13 +121,15 @@ PYBIND11_MODULE(toyrt, m) {
            "Adds an image; returns its id. pixels: (height, width, 3 or 4), float 0..1 or uint8, rows from\n"
            "the bottom (Blender's Image.pixels order); srgb: decode from sRGB to linear, as Blender does.")
       .def("add_point_light", &PyScene::add_point_light, py::arg("position"), py::arg("power"),
-           py::arg("color") = py::make_tuple(1.0, 1.0, 1.0), py::arg("radius") = 0.0f, py::arg("visible_camera") = LightVisibility{}.camera,
+           py::arg("color") = as_tuple(PointLightDefaults{}.color), py::arg("radius") = PointLightDefaults{}.radius,
+           py::arg("visible_camera") = LightVisibility{}.camera,
            py::arg("visible_specular") = LightVisibility{}.specular,
            "Adds a point light in Blender's units: power in watts, linear colour, radius in metres (0: hard shadows).\n"
            "visible_camera / visible_specular: whether camera rays / rays through glass see the sphere itself.")
-      .def("add_area_light", &PyScene::add_area_light, py::arg("matrix"), py::arg("shape") = "SQUARE",
-           py::arg("size") = 1.0f, py::arg("size_y") = py::none(), py::arg("power") = 10.0f,
-           py::arg("color") = py::make_tuple(1.0, 1.0, 1.0), py::arg("visible_camera") = LightVisibility{}.camera,
+      .def("add_area_light", &PyScene::add_area_light, py::arg("matrix"),
+           py::arg("shape") = area_shape_name(AreaLightDefaults{}.shape), py::arg("size") = AreaLightDefaults{}.size,
+           py::arg("size_y") = py::none(), py::arg("power") = AreaLightDefaults{}.power,
+           py::arg("color") = as_tuple(AreaLightDefaults{}.color), py::arg("visible_camera") = LightVisibility{}.camera,
            py::arg("visible_specular") = LightVisibility{}.specular,
            "Adds an area light in Blender's units: the light object's (4, 4) world matrix (it emits along its\n"
            "local -Z, one-sided), shape 'RECTANGLE', 'SQUARE', 'DISK' or 'ELLIPSE', size (and size_y) in metres,\n"
@@ -124,27 +147,11 @@ PYBIND11_MODULE(toyrt, m) {
            py::arg("on_tile") = py::none(), py::arg("should_cancel") = py::none(),
            py::arg("first_sample") = RenderSettings{}.first_sample,
            py::arg("split_depth") = IntegratorSettings{}.split_depth,
-           "Renders the committed scene; returns (height, width, 4) float32 linear RGBA, rows from the top, of\n"
-           "the camera's pixel window (the border region, if set).\n"
-           "camera: a dict of Blender's camera and render settings: type ('PERSP', 'ORTHO'), lens, sensor_width,\n"
-           "sensor_height, sensor_fit ('AUTO', 'HORIZONTAL', 'VERTICAL'), shift_x, shift_y, clip_start, clip_end,\n"
-           "ortho_scale, resolution_x, resolution_y, resolution_percentage, pixel_aspect_x, pixel_aspect_y,\n"
-           "use_border, border_min_x/y, border_max_x/y, matrix_world (4, 4).\n"
-           "area_light_sampling: 'solid_angle' (spherical rectangles) or 'area'. light_sampling: 'all' (every\n"
-           "light at every hit), 'one' (one light chosen by expected contribution) or 'auto' ('all' up to 4\n"
-           "lights). on_tile(x, y, width, height, pixels) is called on this thread as tiles finish;\n"
-           "should_cancel() is polled every 10 ms and stops the render when true (so does Ctrl-C).\n"
-           "Results are the same for any thread count and tile size.\n"
-           "first_sample: render samples [first_sample, first_sample + samples) of the same sequence, the\n"
-           "mean of that pass: passes weighted by their sample counts average to one render of them all\n"
-           "(progressive rendering). A window too large for the memory available raises MemoryError\n"
-           "before anything is allocated.\n"
-           "split_depth: glass (Fresnel) surfaces among the first split_depth path vertices trace both reflection\n"
-           "and refraction, weighted by F and 1 - F; deeper ones choose one. 0: never split.")
+           render_doc.c_str())
       .def_property_readonly("last_render", &PyScene::last_render,
                              "What the last render did: cancelled, cancel_latency_ms, tiles_done, tiles_total, render_ms,\n"
                              "samples, light_sampling.")
-      .def("set_material", &PyScene::set_material, py::arg("material"), py::arg("kind") = "diffuse",
+      .def("set_material", &PyScene::set_material, py::arg("material"), py::arg("kind") = kDefaultMaterialKind,
            py::arg("color") = as_tuple(Lambert{}.albedo), py::arg("texture") = Lambert{}.texture,
            py::arg("ior") = tidy(PerfectRefraction{}.ior),
            "Replaces material `material` in place (same arguments as add_material); meshes keep their ids.")

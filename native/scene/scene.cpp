@@ -91,7 +91,7 @@ void Scene::clear_instances() {
 namespace {
 void check_texture_id(const Material& m, size_t textures) {
   const int32_t texture = texture_of(m);
-  if (texture >= int32_t(textures))
+  if (texture < -1 || texture >= int64_t(textures))
     throw std::invalid_argument("unknown texture id " + std::to_string(texture) + " (the scene has " +
                                 std::to_string(textures) + " textures)");
 }
