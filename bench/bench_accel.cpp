@@ -86,17 +86,18 @@ int main(int argc, char** argv) {
     const char* pick_final = model.choose(n, final_rays) == BuilderKind::Lbvh ? "lbvh" : "sah";
     auto row = [&](const char* name, double build, double cost, double p, double d, double s) {
       char line[512];
-      std::snprintf(line, sizeof line, "%zu,%s,%.3f,%.3f,%.4f,%.4f,%.4f,%zu,%zu,%zu,%s,%s,%s\n", n, name, build, cost, p, d,
-                    s, primary.size(), diffuse.size(), shadow.size(), pick_preview, pick_final,
+      std::snprintf(line, sizeof line, "%zu,%s,%.3f,%.3f,%.4f,%.4f,%.4f,%zu,%zu,%zu,%s,%s,%s\n", n, name, build, cost,
+                    p, d, s, primary.size(), diffuse.size(), shadow.size(), pick_preview, pick_final,
                     opencl::device().name.c_str());
       csv << line;
       std::fprintf(stderr, "%s", line);
     };
     for (BuilderKind kind : {BuilderKind::Sah, BuilderKind::Lbvh}) {
       Bvh tree;
-      const double build = kind == BuilderKind::Sah
-          ? best_ms(args->runs, [&] { tree = build_binned_sah(prims.boxes.data(), prims.centers.data(), n); })
-          : best_ms(args->runs, [&] { tree = build_lbvh(prims.boxes.data(), prims.centers.data(), n, {}); });
+      const double build =
+          kind == BuilderKind::Sah
+              ? best_ms(args->runs, [&] { tree = build_binned_sah(prims.boxes.data(), prims.centers.data(), n); })
+              : best_ms(args->runs, [&] { tree = build_lbvh(prims.boxes.data(), prims.centers.data(), n, {}); });
       const auto s = scene_of(m, kind);
       auto hit = [&](const Ray& ray) { s->intersect(ray); };
       auto occ = [&](const Ray& ray) { s->occluded(ray); };
@@ -106,7 +107,8 @@ int main(int argc, char** argv) {
     const double build = best_ms(args->runs, [&] { EmbreeScene e(m.vertices, m.triangles); });
     auto hit = [&](const Ray& ray) { embree.intersect(ray); };
     auto occ = [&](const Ray& ray) { embree.occluded(ray); };
-    row("embree", build, 0.0, mrays(primary, args->runs, hit), mrays(diffuse, args->runs, hit), mrays(shadow, args->runs, occ));
+    row("embree", build, 0.0, mrays(primary, args->runs, hit), mrays(diffuse, args->runs, hit),
+        mrays(shadow, args->runs, occ));
   }
   return 0;
 }

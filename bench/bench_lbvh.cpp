@@ -5,10 +5,10 @@
 //
 //   bench_lbvh [--out FILE.md] [--csv FILE.csv] [--runs N] [--quick]
 #include "accel/lbvh_builder.h"
-#include "opencl/device.h"
 #include "bench_util.h"
 #include "core/parallel.h"
 #include "embree_oracle.h"
+#include "opencl/device.h"
 #include "scene/scene.h"
 #include "test_scenes.h"
 
@@ -34,18 +34,18 @@ using namespace toyrt::bench;
 
 namespace {
 
-
 // A mixed set: shadow rays (finite tfar) ask occluded(), the others intersect().
 template <class Tracer>
 double trace_ms(const Tracer& tracer, const std::vector<Ray>& rays, int runs) {
   return best_ms(runs, [&] {
     for_each_ray(rays, [&](const Ray& ray) {
-      if (ray.tfar < kInfinity) tracer.occluded(ray);
-      else tracer.intersect(ray);
+      if (ray.tfar < kInfinity)
+        tracer.occluded(ray);
+      else
+        tracer.intersect(ray);
     });
   });
 }
-
 
 struct Row {
   size_t triangles;
@@ -113,7 +113,10 @@ int main(int argc, char** argv) {
 
   // What auto picks, against the better total, for two workloads (rays per pixel: one primary,
   // one shadow, one bounce per sample).
-  struct Workload { const char* name; double rays; };
+  struct Workload {
+    const char* name;
+    double rays;
+  };
   const Workload workloads[] = {{"preview, 640x360, 1 sample", 640.0 * 360 * 3},
                                 {"final, 1920x1080, 64 samples", 1920.0 * 1080 * 64 * 3}};
   const BuilderCostModel model;
@@ -124,12 +127,13 @@ int main(int argc, char** argv) {
   std::ostringstream md;
   md << "# Builders: LBVH on OpenCL against SAH and Embree\n\n"
      << "Written by `make bench-lbvh` (`build/bench/bench_lbvh`) on " << date << ": " << cpu_model() << ", "
-     << std::thread::hardware_concurrency() << " hardware threads; OpenCL device: " << device << ". Best of " << args->runs
+     << std::thread::hardware_concurrency() << " hardware threads; OpenCL device: " << device << ". Best of "
+     << args->runs
      << " runs. Meshes: bumpy UV spheres. Build times are the builders alone (SAH with TBB on all cores, LBVH "
      << "kernels on PoCL on the same cores, Embree's default build with its own TBB), without the collapse to the "
      << "8-wide traversal layout that TOYRT's builders then share. SAH cost: expected node visits plus triangle tests "
-     << "of a random ray (traversal and intersection cost 1) of the binary tree. Trace speed: a mixed set of "
-     << width << "x" << height << " primary rays, one diffuse bounce and one shadow ray per primary hit, on all threads.\n\n"
+     << "of a random ray (traversal and intersection cost 1) of the binary tree. Trace speed: a mixed set of " << width
+     << "x" << height << " primary rays, one diffuse bounce and one shadow ray per primary hit, on all threads.\n\n"
      << "Kernel compilation on first use (once per process, not in any build time below): **" << compile_ms
      << " ms**.\n\n"
      << "| triangles | SAH build ms | LBVH build ms | LBVH-63 build ms | Embree build ms | SAH / LBVH build time | "
@@ -137,11 +141,11 @@ int main(int argc, char** argv) {
      << "|---|---|---|---|---|---|---|---|---|\n";
   char line[1024];
   for (const Row& r : rows) {
-    std::snprintf(line, sizeof line,
-                  "| %zu | %.1f | %.1f | %.1f | %.1f | **%.2fx** | %.1f / %.1f / %.1f | %.2f / %.2f / %.2f / %.2f | %.0f %% |\n",
-                  r.triangles, r.sah_ms, r.lbvh_ms, r.lbvh63_ms, r.embree_ms, r.sah_ms / r.lbvh_ms, r.sah_cost,
-                  r.lbvh_cost, r.lbvh63_cost, r.sah_mrays, r.lbvh_mrays, r.lbvh63_mrays, r.embree_mrays,
-                  100.0 * r.lbvh_mrays / r.sah_mrays);
+    std::snprintf(
+        line, sizeof line,
+        "| %zu | %.1f | %.1f | %.1f | %.1f | **%.2fx** | %.1f / %.1f / %.1f | %.2f / %.2f / %.2f / %.2f | %.0f %% |\n",
+        r.triangles, r.sah_ms, r.lbvh_ms, r.lbvh63_ms, r.embree_ms, r.sah_ms / r.lbvh_ms, r.sah_cost, r.lbvh_cost,
+        r.lbvh63_cost, r.sah_mrays, r.lbvh_mrays, r.lbvh63_mrays, r.embree_mrays, 100.0 * r.lbvh_mrays / r.sah_mrays);
     md << line;
   }
   md << "\nLBVH stages at the largest size (ms): ";
@@ -159,8 +163,9 @@ int main(int argc, char** argv) {
       const double lbvh = r.lbvh_ms / 1e3 + w.rays / (r.lbvh_mrays * 1e6);
       const BuilderKind pick = model.choose(r.triangles, w.rays);
       const double picked = pick == BuilderKind::Lbvh ? lbvh : sah;
-      std::snprintf(line, sizeof line, "| %zu | %s | %.3g | %.3f | %.3f | %s | %+.1f %% |\n", r.triangles, w.name, w.rays,
-                    sah, lbvh, pick == BuilderKind::Lbvh ? "LBVH" : "SAH", 100.0 * (picked / std::min(sah, lbvh) - 1.0));
+      std::snprintf(line, sizeof line, "| %zu | %s | %.3g | %.3f | %.3f | %s | %+.1f %% |\n", r.triangles, w.name,
+                    w.rays, sah, lbvh, pick == BuilderKind::Lbvh ? "LBVH" : "SAH",
+                    100.0 * (picked / std::min(sah, lbvh) - 1.0));
       md << line;
     }
   md << "\n![build time and trace speed against triangle count](lbvh.png)\n";
@@ -168,11 +173,12 @@ int main(int argc, char** argv) {
   if (!args->out.empty()) std::ofstream(args->out) << md.str();
   if (!args->csv.empty()) {
     std::ofstream csv(args->csv);
-    csv << "triangles,sah_ms,lbvh_ms,lbvh63_ms,embree_ms,sah_cost,lbvh_cost,lbvh63_cost,sah_mrays,lbvh_mrays,lbvh63_mrays,embree_mrays\n";
+    csv << "triangles,sah_ms,lbvh_ms,lbvh63_ms,embree_ms,sah_cost,lbvh_cost,lbvh63_cost,sah_mrays,lbvh_mrays,lbvh63_"
+           "mrays,embree_mrays\n";
     for (const Row& r : rows)
       csv << r.triangles << ',' << r.sah_ms << ',' << r.lbvh_ms << ',' << r.lbvh63_ms << ',' << r.embree_ms << ','
-          << r.sah_cost << ',' << r.lbvh_cost << ',' << r.lbvh63_cost << ',' << r.sah_mrays << ',' << r.lbvh_mrays << ','
-          << r.lbvh63_mrays << ',' << r.embree_mrays << '\n';
+          << r.sah_cost << ',' << r.lbvh_cost << ',' << r.lbvh63_cost << ',' << r.sah_mrays << ',' << r.lbvh_mrays
+          << ',' << r.lbvh63_mrays << ',' << r.embree_mrays << '\n';
   }
   return 0;
 }

@@ -215,7 +215,11 @@ int main(int argc, char** argv) {
   js << "{\n";
 
   // ---- leaks ----
-  struct Placement { const char* name; float scale; Vec3 offset; };
+  struct Placement {
+    const char* name;
+    float scale;
+    Vec3 offset;
+  };
   std::vector<Placement> placements = {{"origin", 1.0f, Vec3(0.0f)},
                                        {"offset 1e3", 1.0f, Vec3(1e3f, -7e2f, 4e2f)},
                                        {"offset 1e4", 1.0f, Vec3(1e4f, -7e3f, 4e3f)},
@@ -227,8 +231,8 @@ int main(int argc, char** argv) {
   const MeshData sphere = uv_sphere(24, 48), fan = bicone_fan(256);
   js << " \"leaks\": [\n";
   bool first = true;
-  for (const auto& [mesh_name, mesh] : {std::pair<std::string, const MeshData*>{"uv_sphere", &sphere},
-                                        {"bicone_fan", &fan}})
+  for (const auto& [mesh_name, mesh] :
+       {std::pair<std::string, const MeshData*>{"uv_sphere", &sphere}, {"bicone_fan", &fan}})
     for (const Placement& p : placements) {
       const LeakCase c = leaks(mesh_name, *mesh, p.name, p.scale, p.offset, per_edge);
       std::fprintf(stderr, "leaks %s %s: %zu rays, watertight %zu, MT %zu, Embree %zu / robust %zu\n", c.mesh.c_str(),
@@ -306,7 +310,8 @@ int main(int argc, char** argv) {
     const PrimitiveBounds prims = triangle_bounds(room);
     const Bvh sah = build_binned_sah(prims.boxes.data(), prims.centers.data(), prims.boxes.size());
     const Bvh l30 = build_lbvh(prims.boxes.data(), prims.centers.data(), prims.boxes.size(), {});
-    const Bvh l63 = build_lbvh(prims.boxes.data(), prims.centers.data(), prims.boxes.size(), LbvhConfig{MortonBits::k63});
+    const Bvh l63 =
+        build_lbvh(prims.boxes.data(), prims.centers.data(), prims.boxes.size(), LbvhConfig{MortonBits::k63});
     // Rays at the object (camera outside its box, inside the room), then diffuse bounces from the hits.
     MeshData object_only;
     object_only.vertices.assign(room.vertices.begin(), room.vertices.begin() + b);
@@ -326,12 +331,13 @@ int main(int argc, char** argv) {
     };
     const double v_sah = speed(BuilderKind::Sah, MortonBits::k30), v30 = speed(BuilderKind::Lbvh, MortonBits::k30),
                  v63 = speed(BuilderKind::Lbvh, MortonBits::k63);
-    std::fprintf(stderr, "room: SAH cost %.1f / %.1f / %.1f, Mrays/s %.2f / %.2f / %.2f\n", sah.sah_cost(), l30.sah_cost(),
-                 l63.sah_cost(), v_sah, v30, v63);
+    std::fprintf(stderr, "room: SAH cost %.1f / %.1f / %.1f, Mrays/s %.2f / %.2f / %.2f\n", sah.sah_cost(),
+                 l30.sah_cost(), l63.sah_cost(), v_sah, v30, v63);
     js << " \"lbvh_room\": {\"triangles\": " << room.triangles.size() << ", \"object_triangles\": " << object_tris
-       << ", \"room_size_m\": " << 2 * s << ", \"rays\": " << rays.size() << ", \"sah_cost\": {\"sah\": " << sah.sah_cost()
-       << ", \"lbvh30\": " << l30.sah_cost() << ", \"lbvh63\": " << l63.sah_cost() << "}, \"mrays\": {\"sah\": " << v_sah
-       << ", \"lbvh30\": " << v30 << ", \"lbvh63\": " << v63 << "}},\n";
+       << ", \"room_size_m\": " << 2 * s << ", \"rays\": " << rays.size()
+       << ", \"sah_cost\": {\"sah\": " << sah.sah_cost() << ", \"lbvh30\": " << l30.sah_cost()
+       << ", \"lbvh63\": " << l63.sah_cost() << "}, \"mrays\": {\"sah\": " << v_sah << ", \"lbvh30\": " << v30
+       << ", \"lbvh63\": " << v63 << "}},\n";
   }
 
   // ---- total internal reflection: glass seen from inside ----
@@ -353,13 +359,15 @@ int main(int argc, char** argv) {
       const SpecularSample pr = sample(refr, wo, ng, ng);
       const double expected = 1.0 - fresnel_exact(std::cos(th), 1.0 / ior);  // eta = n_t / n_i = 1 / 1.5
       js << (deg ? ",\n" : "") << "  {\"deg\": " << deg << ", \"transmitted\": " << double(transmitted) / n
-         << ", \"expected\": " << expected << ", \"refraction_tir\": " << (pr.total_internal_reflection ? "true" : "false")
-         << "}";
+         << ", \"expected\": " << expected
+         << ", \"refraction_tir\": " << (pr.total_internal_reflection ? "true" : "false") << "}";
     }
     js << "\n ]}\n";
   }
   js << "}\n";
-  if (!out_path.empty()) std::ofstream(out_path) << js.str();
-  else std::cout << js.str();
+  if (!out_path.empty())
+    std::ofstream(out_path) << js.str();
+  else
+    std::cout << js.str();
   return 0;
 }

@@ -59,12 +59,18 @@ inline std::optional<Args> parse_args(int argc, char** argv, const std::string& 
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
     const bool has_value = i + 1 < argc;
-    if (flag == "--out" && has_value && accepts("--out")) args.out = argv[++i];
-    else if (flag == "--csv" && has_value && accepts("--csv")) args.csv = argv[++i];
-    else if (flag == "--dump" && has_value && accepts("--dump")) args.dump = argv[++i];
-    else if (flag == "--runs" && has_value && accepts("--runs")) args.runs = std::max(1, std::atoi(argv[++i]));
-    else if (flag == "--quick" && accepts("--quick")) args.quick = true;
-    else if (flag == "--smoke" && accepts("--smoke")) args.smoke = true;
+    if (flag == "--out" && has_value && accepts("--out"))
+      args.out = argv[++i];
+    else if (flag == "--csv" && has_value && accepts("--csv"))
+      args.csv = argv[++i];
+    else if (flag == "--dump" && has_value && accepts("--dump"))
+      args.dump = argv[++i];
+    else if (flag == "--runs" && has_value && accepts("--runs"))
+      args.runs = std::max(1, std::atoi(argv[++i]));
+    else if (flag == "--quick" && accepts("--quick"))
+      args.quick = true;
+    else if (flag == "--smoke" && accepts("--smoke"))
+      args.smoke = true;
     else {
       std::fprintf(stderr, "usage: %s %s\n", argv[0], usage.c_str());
       return std::nullopt;

@@ -12,7 +12,8 @@ struct BuilderName {
   BuilderKind kind;
 };
 // The parse table: a new builder adds its name here.
-constexpr BuilderName kBuilderNames[] = {{"auto", BuilderKind::Auto}, {"sah", BuilderKind::Sah}, {"lbvh", BuilderKind::Lbvh}};
+constexpr BuilderName kBuilderNames[] = {
+    {"auto", BuilderKind::Auto}, {"sah", BuilderKind::Sah}, {"lbvh", BuilderKind::Lbvh}};
 }  // namespace
 
 BuilderKind parse_builder(const std::string& name) {

@@ -29,10 +29,10 @@ const char* builder_name(BuilderKind kind);
 
 struct BuilderCostModel {
   // Measured by `make bench-lbvh` on 2 cores (docs/lbvh-bench.md), 10K to 4M triangles:
-  double sah_build_ns = 450.0;    // per triangle, binned SAH with TBB (420-750)
-  double lbvh_build_ns = 150.0;   // per triangle, LBVH kernels on PoCL (125-260)
-  double trace_ns = 130.0;        // per ray through a SAH tree, primary/diffuse/shadow mixed (100-230)
-  double lbvh_trace_factor = 1.2; // an LBVH tree's ray cost relative to SAH's (1.06-1.28)
+  double sah_build_ns = 450.0;     // per triangle, binned SAH with TBB (420-750)
+  double lbvh_build_ns = 150.0;    // per triangle, LBVH kernels on PoCL (125-260)
+  double trace_ns = 130.0;         // per ray through a SAH tree, primary/diffuse/shadow mixed (100-230)
+  double lbvh_trace_factor = 1.2;  // an LBVH tree's ray cost relative to SAH's (1.06-1.28)
 
   // expected_rays < 0: unknown, which keeps the SAH tree (the faster to trace).
   BuilderKind choose(size_t triangles, double expected_rays) const {

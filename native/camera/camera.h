@@ -29,9 +29,9 @@ struct CameraParams {
   float sensor_width = 36.0f;   // mm
   float sensor_height = 24.0f;  // mm (used by VERTICAL fit only)
   SensorFit sensor_fit = SensorFit::Auto;
-  float shift_x = 0.0f, shift_y = 0.0f;  // fractions of the fitted (AUTO: larger) image dimension
+  float shift_x = 0.0f, shift_y = 0.0f;        // fractions of the fitted (AUTO: larger) image dimension
   float clip_start = 0.1f, clip_end = 100.0f;  // distances along the view axis, m
-  float ortho_scale = 6.0f;     // extent of the fitted dimension, m (orthographic)
+  float ortho_scale = 6.0f;                    // extent of the fitted dimension, m (orthographic)
   int resolution_x = 1920, resolution_y = 1080, resolution_percentage = 100;
   float pixel_aspect_x = 1.0f, pixel_aspect_y = 1.0f;
   bool use_border = false;  // render only the border region (Blender's border_min/max, y from the bottom)

@@ -26,8 +26,7 @@ class Mesh {
   bool built() const { return built_; }
 
   // Closest hit within [tnear, tfar): shrinks tfar and writes u, v, prim on a hit.
-  bool intersect(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v,
-                 int32_t& prim) const;
+  bool intersect(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim) const;
   // Any hit within [tnear, tfar).
   bool occluded(const Vec3& org, const Vec3& dir, float tnear, float tfar) const;
 
@@ -45,8 +44,7 @@ class Mesh {
   void finish(Bvh bvh, const std::vector<uint32_t>& valid);
 
   template <bool AnyHit>
-  bool trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v,
-             int32_t& prim) const;
+  bool trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim) const;
 
   std::vector<Vec3> vertices_;
   std::vector<Triangle> triangles_;

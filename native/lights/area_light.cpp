@@ -140,15 +140,20 @@ AreaShape parse_area_shape(const std::string& name) {
   if (name == "SQUARE") return AreaShape::Square;
   if (name == "DISK") return AreaShape::Disk;
   if (name == "ELLIPSE") return AreaShape::Ellipse;
-  throw std::invalid_argument("area light shape must be 'RECTANGLE', 'SQUARE', 'DISK' or 'ELLIPSE', got '" + name + "'");
+  throw std::invalid_argument("area light shape must be 'RECTANGLE', 'SQUARE', 'DISK' or 'ELLIPSE', got '" + name +
+                              "'");
 }
 
 const char* area_shape_name(AreaShape shape) {
   switch (shape) {
-    case AreaShape::Rectangle: return "RECTANGLE";
-    case AreaShape::Square: return "SQUARE";
-    case AreaShape::Disk: return "DISK";
-    case AreaShape::Ellipse: return "ELLIPSE";
+    case AreaShape::Rectangle:
+      return "RECTANGLE";
+    case AreaShape::Square:
+      return "SQUARE";
+    case AreaShape::Disk:
+      return "DISK";
+    case AreaShape::Ellipse:
+      return "ELLIPSE";
   }
   return "?";
 }

@@ -28,9 +28,9 @@ struct AreaLight {
   AreaShape shape = AreaShape::Rectangle;
   Vec3 center{0.0f};
   Vec3 edge_x{1.0f, 0.0f, 0.0f}, edge_y{0.0f, 1.0f, 0.0f};  // full extents along local x and y (orthogonal)
-  Vec3 normal{0.0f, 0.0f, -1.0f};  // unit, the emitting side
-  float area = 1.0f;               // m^2 (pi/4 |edge_x| |edge_y| for disks and ellipses)
-  Vec3 radiance{0.0f};             // L = P colour / (4 area), W / (m^2 sr)
+  Vec3 normal{0.0f, 0.0f, -1.0f};                           // unit, the emitting side
+  float area = 1.0f;                                        // m^2 (pi/4 |edge_x| |edge_y| for disks and ellipses)
+  Vec3 radiance{0.0f};                                      // L = P colour / (4 area), W / (m^2 sr)
 
   // Blender's settings: shape; size (and size_y for RECTANGLE and ELLIPSE; SQUARE and DISK use
   // size for both, a disk's size being its diameter); the object's world matrix; power (W);
@@ -47,7 +47,7 @@ struct AreaLight {
 // Blender's new area light, a 1 m square of 10 W, white.
 struct AreaLightDefaults {
   AreaShape shape = AreaShape::Square;
-  float size = 1.0f;  // m
+  float size = 1.0f;    // m
   float power = 10.0f;  // W
   Vec3 color{1.0f};
 };

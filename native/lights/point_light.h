@@ -21,9 +21,9 @@ namespace toyrt {
 
 struct PointLight {
   Vec3 position{0.0f};
-  float radius = 0.0f;      // m; 0: a delta light
-  Vec3 intensity{0.0f};     // I = P colour / (4 pi), W/sr
-  Vec3 radiance{0.0f};      // of the sphere's surface, I / (pi R^2); 0 when radius is 0
+  float radius = 0.0f;   // m; 0: a delta light
+  Vec3 intensity{0.0f};  // I = P colour / (4 pi), W/sr
+  Vec3 radiance{0.0f};   // of the sphere's surface, I / (pi R^2); 0 when radius is 0
 
   // Blender's settings: location, power (W), colour (linear RGB), radius (shadow_soft_size, m).
   // Throws std::invalid_argument for non-finite values, negative power, colour or radius.

@@ -18,10 +18,10 @@ using Material = std::variant<Lambert, PerfectRefraction, FresnelDielectric>;
 
 // The texture a material reads (-1: none).
 inline int32_t texture_of(const Material& material) {
-  return std::visit(Overloaded{[](const Lambert& m) { return m.texture; },
-                               [](const PerfectRefraction&) { return int32_t(-1); },
-                               [](const FresnelDielectric&) { return int32_t(-1); }},
-                    material);
+  return std::visit(
+      Overloaded{[](const Lambert& m) { return m.texture; }, [](const PerfectRefraction&) { return int32_t(-1); },
+                 [](const FresnelDielectric&) { return int32_t(-1); }},
+      material);
 }
 
 // A material from Blender-facing settings: kind "diffuse" (Lambert with `color`, linear RGB >= 0,

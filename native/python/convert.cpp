@@ -46,15 +46,16 @@ std::vector<Triangle> to_triangles(py::handle obj) {
   if (!a) throw py::type_error("triangles must be an integer array of shape (M, 3)");
   const char kind = a.dtype().kind();
   if (kind != 'i' && kind != 'u')
-    throw py::type_error("triangles must be an integer array (vertex indices), not dtype " + std::string(py::str(a.dtype())));
-  if (a.ndim() != 2 || a.shape(1) != 3)
-    throw py::value_error("triangles must have shape (M, 3), got " + shape_of(a));
+    throw py::type_error("triangles must be an integer array (vertex indices), not dtype " +
+                         std::string(py::str(a.dtype())));
+  if (a.ndim() != 2 || a.shape(1) != 3) throw py::value_error("triangles must have shape (M, 3), got " + shape_of(a));
   auto idx = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
   if (kind == 'u' && a.itemsize() == 8) {
     // uint64 above 2^63 would wrap to negative int64: check the originals.
     auto u = py::array_t<uint64_t, py::array::c_style | py::array::forcecast>::ensure(a);
     for (py::ssize_t i = 0; i < u.size(); ++i)
-      if (u.data()[i] > UINT32_MAX) throw py::value_error("triangle " + std::to_string(i / 3) + " has an index out of range");
+      if (u.data()[i] > UINT32_MAX)
+        throw py::value_error("triangle " + std::to_string(i / 3) + " has an index out of range");
   }
   std::vector<Triangle> out(size_t(a.shape(0)));
   const int64_t* p = idx.data();
@@ -62,7 +63,8 @@ std::vector<Triangle> to_triangles(py::handle obj) {
     for (int k = 0; k < 3; ++k) {
       const int64_t v = p[3 * i + k];
       if (v < 0) throw py::value_error("triangle " + std::to_string(i) + " has a negative vertex index");
-      if (v > int64_t(UINT32_MAX)) throw py::value_error("triangle " + std::to_string(i) + " has an index out of range");
+      if (v > int64_t(UINT32_MAX))
+        throw py::value_error("triangle " + std::to_string(i) + " has an index out of range");
       out[i][k] = uint32_t(v);
     }
   }
@@ -110,7 +112,8 @@ PerRay per_ray(py::handle obj, size_t count, const char* name) {
       out.scalar = FloatArray::ensure(a).data()[0];
     } else {
       if (a.ndim() != 1 || size_t(a.shape(0)) != count)
-        throw py::value_error(std::string(name) + " must be a number or have shape (" + std::to_string(count) + ",), got " + shape_of(a));
+        throw py::value_error(std::string(name) + " must be a number or have shape (" + std::to_string(count) +
+                              ",), got " + shape_of(a));
       out.storage = FloatArray::ensure(a);
       out.data = out.storage.data();
       out.stride = 1;
@@ -123,7 +126,7 @@ PerRay per_ray(py::handle obj, size_t count, const char* name) {
 }
 
 MeshShading to_shading(size_t vertex_count, const std::vector<Triangle>& tris, py::handle normals, py::handle uvs,
-                     py::handle material_ids) {
+                       py::handle material_ids) {
   MeshShading sh;
   const size_t m = tris.size();
   // Writes 3 m k floats to `out` (the shading vector's storage: one copy from numpy).
@@ -166,7 +169,7 @@ MeshShading to_shading(size_t vertex_count, const std::vector<Triangle>& tris, p
       sh.material_ids.resize(m);
       for (size_t t = 0; t < m; ++t) {
         if (ids.data()[t] < INT32_MIN || ids.data()[t] > INT32_MAX)
-            throw py::value_error("material_ids must be >= 0 and below 2^31");
+          throw py::value_error("material_ids must be >= 0 and below 2^31");
         sh.material_ids[t] = int32_t(ids.data()[t]);
       }
     }
@@ -195,10 +198,27 @@ Texture to_texture(py::handle pixels, bool srgb) {
 }
 
 CameraParams to_camera(const py::dict& camera) {
-  static const std::set<std::string> known = {
-      "type", "lens", "sensor_width", "sensor_height", "sensor_fit", "shift_x", "shift_y", "clip_start", "clip_end",
-      "ortho_scale", "resolution_x", "resolution_y", "resolution_percentage", "pixel_aspect_x", "pixel_aspect_y",
-      "use_border", "border_min_x", "border_min_y", "border_max_x", "border_max_y", "matrix_world"};
+  static const std::set<std::string> known = {"type",
+                                              "lens",
+                                              "sensor_width",
+                                              "sensor_height",
+                                              "sensor_fit",
+                                              "shift_x",
+                                              "shift_y",
+                                              "clip_start",
+                                              "clip_end",
+                                              "ortho_scale",
+                                              "resolution_x",
+                                              "resolution_y",
+                                              "resolution_percentage",
+                                              "pixel_aspect_x",
+                                              "pixel_aspect_y",
+                                              "use_border",
+                                              "border_min_x",
+                                              "border_min_y",
+                                              "border_max_x",
+                                              "border_max_y",
+                                              "matrix_world"};
   CameraParams p;
   for (auto item : camera) {
     const std::string key = py::str(item.first);
@@ -221,15 +241,22 @@ CameraParams to_camera(const py::dict& camera) {
     };
     if (key == "type") {
       const std::string t = py::str(v);
-      if (t == "PERSP") p.type = CameraType::Perspective;
-      else if (t == "ORTHO") p.type = CameraType::Orthographic;
-      else throw py::value_error("camera: type must be 'PERSP' or 'ORTHO', got '" + t + "'");
+      if (t == "PERSP")
+        p.type = CameraType::Perspective;
+      else if (t == "ORTHO")
+        p.type = CameraType::Orthographic;
+      else
+        throw py::value_error("camera: type must be 'PERSP' or 'ORTHO', got '" + t + "'");
     } else if (key == "sensor_fit") {
       const std::string f = py::str(v);
-      if (f == "AUTO") p.sensor_fit = SensorFit::Auto;
-      else if (f == "HORIZONTAL") p.sensor_fit = SensorFit::Horizontal;
-      else if (f == "VERTICAL") p.sensor_fit = SensorFit::Vertical;
-      else throw py::value_error("camera: sensor_fit must be 'AUTO', 'HORIZONTAL' or 'VERTICAL', got '" + f + "'");
+      if (f == "AUTO")
+        p.sensor_fit = SensorFit::Auto;
+      else if (f == "HORIZONTAL")
+        p.sensor_fit = SensorFit::Horizontal;
+      else if (f == "VERTICAL")
+        p.sensor_fit = SensorFit::Vertical;
+      else
+        throw py::value_error("camera: sensor_fit must be 'AUTO', 'HORIZONTAL' or 'VERTICAL', got '" + f + "'");
     } else if (key == "matrix_world") {
       p.matrix_world = to_matrix(v, "camera matrix_world");
     } else if (key == "use_border") {
@@ -242,20 +269,34 @@ CameraParams to_camera(const py::dict& camera) {
       p.resolution_percentage = count();
     } else {
       const float x = float(number());
-      if (key == "lens") p.lens = x;
-      else if (key == "sensor_width") p.sensor_width = x;
-      else if (key == "sensor_height") p.sensor_height = x;
-      else if (key == "shift_x") p.shift_x = x;
-      else if (key == "shift_y") p.shift_y = x;
-      else if (key == "clip_start") p.clip_start = x;
-      else if (key == "clip_end") p.clip_end = x;
-      else if (key == "ortho_scale") p.ortho_scale = x;
-      else if (key == "pixel_aspect_x") p.pixel_aspect_x = x;
-      else if (key == "pixel_aspect_y") p.pixel_aspect_y = x;
-      else if (key == "border_min_x") p.border_min_x = x;
-      else if (key == "border_min_y") p.border_min_y = x;
-      else if (key == "border_max_x") p.border_max_x = x;
-      else if (key == "border_max_y") p.border_max_y = x;
+      if (key == "lens")
+        p.lens = x;
+      else if (key == "sensor_width")
+        p.sensor_width = x;
+      else if (key == "sensor_height")
+        p.sensor_height = x;
+      else if (key == "shift_x")
+        p.shift_x = x;
+      else if (key == "shift_y")
+        p.shift_y = x;
+      else if (key == "clip_start")
+        p.clip_start = x;
+      else if (key == "clip_end")
+        p.clip_end = x;
+      else if (key == "ortho_scale")
+        p.ortho_scale = x;
+      else if (key == "pixel_aspect_x")
+        p.pixel_aspect_x = x;
+      else if (key == "pixel_aspect_y")
+        p.pixel_aspect_y = x;
+      else if (key == "border_min_x")
+        p.border_min_x = x;
+      else if (key == "border_min_y")
+        p.border_min_y = x;
+      else if (key == "border_max_x")
+        p.border_max_x = x;
+      else if (key == "border_max_y")
+        p.border_max_y = x;
     }
   }
   return p;

@@ -78,25 +78,26 @@ PYBIND11_MODULE(toyrt, m) {
   });
 
   // The render() docstring names the "auto" light count from the core's constant.
-  static const std::string render_doc =
-      std::string("Renders the committed scene; returns (height, width, 4) float32 linear RGBA, rows from the top, of\n"
-           "the camera's pixel window (the border region, if set).\n"
-           "camera: a dict of Blender's camera and render settings: type ('PERSP', 'ORTHO'), lens, sensor_width,\n"
-           "sensor_height, sensor_fit ('AUTO', 'HORIZONTAL', 'VERTICAL'), shift_x, shift_y, clip_start, clip_end,\n"
-           "ortho_scale, resolution_x, resolution_y, resolution_percentage, pixel_aspect_x, pixel_aspect_y,\n"
-           "use_border, border_min_x/y, border_max_x/y, matrix_world (4, 4).\n"
-           "area_light_sampling: 'solid_angle' (spherical rectangles) or 'area'. light_sampling: 'all' (every\n"
-           "light at every hit), 'one' (one light chosen by expected contribution) or 'auto' ('all' up to " +
-           std::to_string(kAllLightsUpTo) + "\n"
-           "lights). on_tile(x, y, width, height, pixels) is called on this thread as tiles finish;\n"
-           "should_cancel() is polled every 10 ms and stops the render when true (so does Ctrl-C).\n"
-           "Results are the same for any thread count and tile size.\n"
-           "first_sample: render samples [first_sample, first_sample + samples) of the same sequence, the\n"
-           "mean of that pass: passes weighted by their sample counts average to one render of them all\n"
-           "(progressive rendering). A window too large for the memory available raises MemoryError\n"
-           "before anything is allocated.\n"
-           "split_depth: glass (Fresnel) surfaces among the first split_depth path vertices trace both reflection\n"
-           "and refraction, weighted by F and 1 - F; deeper ones choose one. 0: never split.");
+  static const std::string render_doc = std::string(
+      "Renders the committed scene; returns (height, width, 4) float32 linear RGBA, rows from the top, of\n"
+      "the camera's pixel window (the border region, if set).\n"
+      "camera: a dict of Blender's camera and render settings: type ('PERSP', 'ORTHO'), lens, sensor_width,\n"
+      "sensor_height, sensor_fit ('AUTO', 'HORIZONTAL', 'VERTICAL'), shift_x, shift_y, clip_start, clip_end,\n"
+      "ortho_scale, resolution_x, resolution_y, resolution_percentage, pixel_aspect_x, pixel_aspect_y,\n"
+      "use_border, border_min_x/y, border_max_x/y, matrix_world (4, 4).\n"
+      "area_light_sampling: 'solid_angle' (spherical rectangles) or 'area'. light_sampling: 'all' (every\n"
+      "light at every hit), 'one' (one light chosen by expected contribution) or 'auto' ('all' up to " +
+      std::to_string(kAllLightsUpTo) +
+      "\n"
+      "lights). on_tile(x, y, width, height, pixels) is called on this thread as tiles finish;\n"
+      "should_cancel() is polled every 10 ms and stops the render when true (so does Ctrl-C).\n"
+      "Results are the same for any thread count and tile size.\n"
+      "first_sample: render samples [first_sample, first_sample + samples) of the same sequence, the\n"
+      "mean of that pass: passes weighted by their sample counts average to one render of them all\n"
+      "(progressive rendering). A window too large for the memory available raises MemoryError\n"
+      "before anything is allocated.\n"
+      "split_depth: glass (Fresnel) surfaces among the first split_depth path vertices trace both reflection\n"
+      "and refraction, weighted by F and 1 - F; deeper ones choose one. 0: never split.");
 
   py::class_<PyScene>(m, "Scene", "A two-level scene: meshes stored once, placed by instances.")
       .def(py::init<>())
@@ -140,17 +141,18 @@ PYBIND11_MODULE(toyrt, m) {
       .def_property("background_lighting", &PyScene::background_lighting, &PyScene::set_background_lighting,
                     "Whether the background also lights diffuse surfaces, as Cycles' world does (default True).")
       .def("render", &PyScene::render, py::arg("camera"), py::arg("samples") = RenderSettings{}.samples,
-           py::arg("seed") = IntegratorSettings{}.seed, py::arg("max_specular_depth") = IntegratorSettings{}.max_specular_depth,
+           py::arg("seed") = IntegratorSettings{}.seed,
+           py::arg("max_specular_depth") = IntegratorSettings{}.max_specular_depth,
            py::arg("area_light_sampling") = area_sampling_name(IntegratorSettings{}.area_sampling),
            py::arg("light_sampling") = light_sampling_name(IntegratorSettings{}.light_sampling),
            py::arg("threads") = RenderSettings{}.threads, py::arg("tile_size") = RenderSettings{}.tile_size,
            py::arg("on_tile") = py::none(), py::arg("should_cancel") = py::none(),
            py::arg("first_sample") = RenderSettings{}.first_sample,
-           py::arg("split_depth") = IntegratorSettings{}.split_depth,
-           render_doc.c_str())
-      .def_property_readonly("last_render", &PyScene::last_render,
-                             "What the last render did: cancelled, cancel_latency_ms, tiles_done, tiles_total, render_ms,\n"
-                             "samples, light_sampling.")
+           py::arg("split_depth") = IntegratorSettings{}.split_depth, render_doc.c_str())
+      .def_property_readonly(
+          "last_render", &PyScene::last_render,
+          "What the last render did: cancelled, cancel_latency_ms, tiles_done, tiles_total, render_ms,\n"
+          "samples, light_sampling.")
       .def("set_material", &PyScene::set_material, py::arg("material"), py::arg("kind") = kDefaultMaterialKind,
            py::arg("color") = as_tuple(Lambert{}.albedo), py::arg("texture") = Lambert{}.texture,
            py::arg("ior") = tidy(PerfectRefraction{}.ior),
@@ -170,8 +172,8 @@ PYBIND11_MODULE(toyrt, m) {
       .def("add_instance", &PyScene::add_instance, py::arg("mesh"), py::arg("transform"),
            "Places mesh `mesh` again with a (4, 4) row-major affine world matrix; returns the instance id.")
       .def("commit", &PyScene::commit, py::arg("builder") = builder_name(CommitOptions{}.builder),
-           py::arg("threads") = CommitOptions{}.threads,
-           py::arg("expected_rays") = py::none(), py::arg("should_cancel") = py::none(),
+           py::arg("threads") = CommitOptions{}.threads, py::arg("expected_rays") = py::none(),
+           py::arg("should_cancel") = py::none(),
            "Builds the BVHs of new meshes and the top level; returns True, or False when cancelled.\n"
            "should_cancel(): polled every 10 ms while building; when it returns true the build stops\n"
            "within a few milliseconds and the scene stays uncommitted (meshes already built keep their BVH,\n"
@@ -180,9 +182,10 @@ PYBIND11_MODULE(toyrt, m) {
            "kernels: the faster builds; falls back to 'sah' with a RuntimeWarning when no OpenCL device or\n"
            "kernel build is available), or 'auto' (per mesh, whichever makes build + tracing cheaper for\n"
            "`expected_rays` rays; without that estimate, 'sah'). threads: 0 for all cores.")
-      .def_property_readonly("last_commit", &PyScene::last_commit,
-           "What the last commit did: build_ms, lbvh_compile_ms (OpenCL compilation, first LBVH build of\n"
-           "the process only), meshes_built, sah_meshes, lbvh_meshes, warning.")
+      .def_property_readonly(
+          "last_commit", &PyScene::last_commit,
+          "What the last commit did: build_ms, lbvh_compile_ms (OpenCL compilation, first LBVH build of\n"
+          "the process only), meshes_built, sah_meshes, lbvh_meshes, warning.")
       .def("intersect", &PyScene::intersect, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0f,
            py::arg("tfar") = std::numeric_limits<float>::infinity(), py::arg("threads") = 0,
            "Nearest hits of rays org + t * dir with tnear <= t < tfar (world units of t: the direction's\n"

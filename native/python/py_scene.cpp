@@ -66,8 +66,8 @@ void PyScene::set_texture(int64_t id, py::handle pixels, bool srgb) {
   write([&] { scene_.set_texture(id, std::move(t)); });
 }
 
-uint32_t PyScene::add_point_light(py::handle position, float power, py::handle color, float radius,
-                                  bool visible_camera, bool visible_specular) {
+uint32_t PyScene::add_point_light(py::handle position, float power, py::handle color, float radius, bool visible_camera,
+                                  bool visible_specular) {
   const PointLight l = PointLight::make(to_vec3(position, "position"), power, to_vec3(color, "color"), radius);
   return write([&] { return scene_.add_light(l, {visible_camera, visible_specular}); });
 }
@@ -145,10 +145,10 @@ py::dict PyScene::last_commit() {
   return d;
 }
 
-py::array_t<float> PyScene::render(const py::dict& camera_settings, int samples, uint32_t seed,
-                                   int max_specular_depth, const std::string& area_light_sampling,
-                                   const std::string& light_sampling, int threads, int tile_size, py::object on_tile,
-                                   py::object should_cancel, int first_sample, int split_depth) {
+py::array_t<float> PyScene::render(const py::dict& camera_settings, int samples, uint32_t seed, int max_specular_depth,
+                                   const std::string& area_light_sampling, const std::string& light_sampling,
+                                   int threads, int tile_size, py::object on_tile, py::object should_cancel,
+                                   int first_sample, int split_depth) {
   const Camera camera = Camera::make(to_camera(camera_settings));
   RenderSettings settings;
   settings.samples = samples;
@@ -210,8 +210,7 @@ std::pair<FloatArray, FloatArray> rays(py::handle origins, py::handle directions
 }
 }  // namespace
 
-py::dict PyScene::intersect(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar,
-                            int threads) {
+py::dict PyScene::intersect(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads) {
   auto [org, dir] = rays(origins, directions);
   const size_t n = size_t(org.shape(0));
   const PerRay near = per_ray(tnear, n, "tnear"), far = per_ray(tfar, n, "tfar");

@@ -20,8 +20,8 @@ namespace py = pybind11;
 
 class PyScene {
  public:
-  uint32_t add_mesh(py::handle vertices, py::handle triangles, py::handle transform, py::handle normals,
-                    py::handle uvs, py::handle material_ids, bool instance);
+  uint32_t add_mesh(py::handle vertices, py::handle triangles, py::handle transform, py::handle normals, py::handle uvs,
+                    py::handle material_ids, bool instance);
   void replace_mesh(int64_t mesh, py::handle vertices, py::handle triangles, py::handle normals, py::handle uvs,
                     py::handle material_ids);
   uint32_t add_instance(int64_t mesh, py::handle transform);

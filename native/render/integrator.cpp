@@ -15,9 +15,9 @@ constexpr uint32_t kDimsPerVertex = 64;
 uint32_t vertex_dimension(int depth, uint32_t k) { return 1 + uint32_t(depth) * kDimsPerVertex + k; }
 
 struct SurfaceHit {
-  Vec3 p;       // world position, from the barycentrics (more accurate than org + t dir)
-  Vec3 ng;      // unit geometric normal, world space
-  Vec3 ns;      // unit shading normal, world space
+  Vec3 p;   // world position, from the barycentrics (more accurate than org + t dir)
+  Vec3 ng;  // unit geometric normal, world space
+  Vec3 ns;  // unit shading normal, world space
   Vec2 uv{0.0f};
   int32_t material = -1;
 };
@@ -48,14 +48,14 @@ SurfaceHit surface_at(const Scene& scene, const Hit& hit) {
 }
 
 // Light arriving at a diffuse point: one sample per light, or one light chosen by contribution.
-Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f,
-                     int depth, uint32_t pixel, uint32_t sample, const IntegratorSettings& settings) {
+Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f, int depth,
+                     uint32_t pixel, uint32_t sample, const IntegratorSettings& settings) {
   const World& world = scene.world();
   const Vec3 origin = offset_ray_origin(s.p, ng);
   Vec3 sum(0.0f);
   auto add = [&](const Light& light, float select_probability, uint32_t dim) {
-    const LightSample ls = sample_light(light, s.p, sobol_owen_2d(pixel, sample, vertex_dimension(depth, dim), settings.seed),
-                                        settings.area_sampling);
+    const LightSample ls = sample_light(
+        light, s.p, sobol_owen_2d(pixel, sample, vertex_dimension(depth, dim), settings.seed), settings.area_sampling);
     if (!ls.valid()) return;
     const float cos_s = glm::dot(ns, ls.wi);
     if (cos_s <= 0.0f || glm::dot(ng, ls.wi) <= 0.0f) return;  // below the shading or the true surface
@@ -67,7 +67,8 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
   // The world as a light: a constant background seen over the hemisphere. A cosine-distributed
   // direction makes the estimate f L cos / pdf = albedo L when nothing blocks it.
   if (world.background_lights_surfaces && world.background != Vec3(0.0f)) {
-    const Vec3 local = sample_cosine_hemisphere(sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 1), settings.seed));
+    const Vec3 local = sample_cosine_hemisphere(
+        sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 1), settings.seed));
     const Vec3 wi = Frame::from_normal(ns).to_world(local);
     if (glm::dot(ng, wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, wi, kInfinity}))
       sum += f * world.background * kPi;  // f = albedo / pi
@@ -77,7 +78,8 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     for (size_t j = 0; j < lights.size(); ++j) add(lights[j], 1.0f, 1 + uint32_t(j));
   } else {
     const LightSelector selector(lights);
-    const LightSelection pick = selector.select(s.p, ns, sobol_owen_1d(pixel, sample, vertex_dimension(depth, 0), settings.seed));
+    const LightSelection pick =
+        selector.select(s.p, ns, sobol_owen_1d(pixel, sample, vertex_dimension(depth, 0), settings.seed));
     if (pick.found()) add(lights[size_t(pick.index)], pick.probability, 1);
   }
   return sum;
@@ -130,7 +132,8 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     const bool front = glm::dot(s.ng, wo) > 0.0f;
     const Vec3 ng = front ? s.ng : -s.ng;
     const Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;
-    const Material& m = s.material >= 0 && size_t(s.material) < materials.size() ? materials[size_t(s.material)] : kDefault;
+    const Material& m =
+        s.material >= 0 && size_t(s.material) < materials.size() ? materials[size_t(s.material)] : kDefault;
     // One dispatch per hit, one case per material type: a type added to Material without its
     // case here does not compile. Each case either ends the path (returns false) or sets the
     // next ray of the chain (returns true).

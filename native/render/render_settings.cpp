@@ -16,9 +16,12 @@ LightSampling parse_light_sampling(const std::string& name) {
 
 const char* light_sampling_name(LightSampling sampling) {
   switch (sampling) {
-    case LightSampling::Auto: return "auto";
-    case LightSampling::All: return "all";
-    case LightSampling::One: return "one";
+    case LightSampling::Auto:
+      return "auto";
+    case LightSampling::All:
+      return "all";
+    case LightSampling::One:
+      return "one";
   }
   return "?";
 }

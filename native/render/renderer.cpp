@@ -10,11 +10,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <limits>
 #include <condition_variable>
+#include <cstdio>
 #include <deque>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -25,9 +25,12 @@ namespace {
 std::string format_bytes(size_t bytes) {
   char buf[32];
   const double b = double(bytes);
-  if (b >= 1e12) std::snprintf(buf, sizeof buf, "%.1f TB", b / 1e12);
-  else if (b >= 1e9) std::snprintf(buf, sizeof buf, "%.1f GB", b / 1e9);
-  else std::snprintf(buf, sizeof buf, "%.1f MB", b / 1e6);
+  if (b >= 1e12)
+    std::snprintf(buf, sizeof buf, "%.1f TB", b / 1e12);
+  else if (b >= 1e9)
+    std::snprintf(buf, sizeof buf, "%.1f GB", b / 1e9);
+  else
+    std::snprintf(buf, sizeof buf, "%.1f MB", b / 1e6);
   return buf;
 }
 }  // namespace
@@ -58,8 +61,8 @@ size_t available_memory_bytes() {
   return pages > 0 && page > 0 ? size_t(pages) * size_t(page) : SIZE_MAX;
 }
 
-RenderResult render(const Scene& scene, const Camera& camera, const RenderSettings& requested,
-                    const TileSink& on_tile, const CancelPoll& should_cancel) {
+RenderResult render(const Scene& scene, const Camera& camera, const RenderSettings& requested, const TileSink& on_tile,
+                    const CancelPoll& should_cancel) {
   requested.check();
   scene.check_renderable();
   // The settings with "auto" light sampling resolved for this scene: a copy of a few ints, the
@@ -82,7 +85,8 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
   std::vector<Tile> tiles;
   for (int y = 0; y < result.height; y += settings.tile_size)
     for (int x = 0; x < result.width; x += settings.tile_size)
-      tiles.push_back({x, y, std::min(settings.tile_size, result.width - x), std::min(settings.tile_size, result.height - y)});
+      tiles.push_back(
+          {x, y, std::min(settings.tile_size, result.width - x), std::min(settings.tile_size, result.height - y)});
   result.tiles_total = tiles.size();
 
   std::atomic<bool> cancel{false};
@@ -175,7 +179,8 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
   if (failure) std::rethrow_exception(failure);
   result.cancelled = cancel;
   if (result.cancelled)
-    result.cancel_latency_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cancelled_at).count();
+    result.cancel_latency_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cancelled_at).count();
   result.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

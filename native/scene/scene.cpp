@@ -3,9 +3,9 @@
 #include "accel/traverse.h"
 #include "core/parallel.h"
 
-#include <glm/gtc/matrix_inverse.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <glm/gtc/matrix_inverse.hpp>
 
 #include <chrono>
 #include <future>
@@ -196,7 +196,7 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
   const auto start = std::chrono::steady_clock::now();
   stats_ = {};
   instances_.shrink_to_fit();  // many instances are added one by one: drop the growth slack
-  committed_ = false;  // until this commit completes (it may be cancelled)
+  committed_ = false;          // until this commit completes (it may be cancelled)
   BuildConfig config;
   config.sah = options.sah;
   config.sah.cancel = cancel;

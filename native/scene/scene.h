@@ -84,7 +84,8 @@ class Scene {
   // valid. replace_mesh swaps a mesh's geometry and shading (its BVH is rebuilt by the next
   // commit, the instances placing it stay); set_instance_transform moves one instance (the next
   // commit rebuilds only the top level); clear_instances removes every instance (meshes stay).
-  void replace_mesh(int64_t mesh, std::vector<Vec3> vertices, std::vector<Triangle> triangles, MeshShading shading = {});
+  void replace_mesh(int64_t mesh, std::vector<Vec3> vertices, std::vector<Triangle> triangles,
+                    MeshShading shading = {});
   void set_instance_transform(int64_t instance, const Mat4& to_world);
   void clear_instances();
   // The transform checks of add_instance alone; returns the inverse.
@@ -98,7 +99,7 @@ class Scene {
   uint32_t add_texture(Texture texture);
   void set_texture(int64_t texture, Texture replacement);
   uint32_t add_light(const Light& light, LightVisibility visibility = {});
-  void clear_lights();  // lights are re-sent as a whole on an edit: they are few and cheap
+  void clear_lights();                        // lights are re-sent as a whole on an edit: they are few and cheap
   void set_background(const Vec3& radiance);  // finite and >= 0
   void set_background_lighting(bool on) { world_.background_lights_surfaces = on; }
 
@@ -134,7 +135,7 @@ class Scene {
   const Instance& instance(uint32_t id) const { return instances_.at(id); }
   const Bvh& top_level() const { return top_; }
   const MeshShading& shading(uint32_t mesh) const { return shading_[mesh]; }  // one per mesh, always
-  const std::vector<Material>& materials() const { return materials_; }  // empty: all default grey
+  const std::vector<Material>& materials() const { return materials_; }       // empty: all default grey
   const std::vector<Texture>& textures() const { return textures_; }
   const World& world() const { return world_; }
   // Triangles stored (each mesh counted once) and placed (each instance counting its mesh).
@@ -150,8 +151,8 @@ class Scene {
   void check_mesh_id(int64_t mesh) const;
 
   std::vector<std::unique_ptr<Mesh>> meshes_;
-  std::vector<MeshShading> shading_;            // parallel to meshes_
-  std::vector<int32_t> max_material_id_;        // parallel to meshes_: MeshShading::check's answer
+  std::vector<MeshShading> shading_;      // parallel to meshes_
+  std::vector<int32_t> max_material_id_;  // parallel to meshes_: MeshShading::check's answer
   std::vector<Material> materials_;
   std::vector<Texture> textures_;
   World world_;

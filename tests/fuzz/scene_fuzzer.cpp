@@ -46,12 +46,15 @@ using namespace toyrt;
 // Floats that reach the interesting cases: a coarse grid (shared vertices and edges, rays along
 // axes and through vertices), special values, small reals, and arbitrary bit patterns.
 float fuzz_float(FuzzedDataProvider& in) {
-  static const float special[] = {0.0f, -0.0f, NAN, INFINITY, -INFINITY, FLT_MAX, -FLT_MAX,
-                                  FLT_MIN, 1e-40f, 1e30f, -1e30f, 1e-30f, 1e6f};
+  static const float special[] = {0.0f,    -0.0f,  NAN,   INFINITY, -INFINITY, FLT_MAX, -FLT_MAX,
+                                  FLT_MIN, 1e-40f, 1e30f, -1e30f,   1e-30f,    1e6f};
   switch (in.ConsumeIntegralInRange<int>(0, 3)) {
-    case 0: return float(in.ConsumeIntegralInRange<int>(-8, 8)) * 0.5f;
-    case 1: return special[in.ConsumeIntegralInRange<size_t>(0, sizeof(special) / sizeof(float) - 1)];
-    case 2: return in.ConsumeFloatingPointInRange<float>(-4.0f, 4.0f);
+    case 0:
+      return float(in.ConsumeIntegralInRange<int>(-8, 8)) * 0.5f;
+    case 1:
+      return special[in.ConsumeIntegralInRange<size_t>(0, sizeof(special) / sizeof(float) - 1)];
+    case 2:
+      return in.ConsumeFloatingPointInRange<float>(-4.0f, 4.0f);
     default: {
       const uint32_t bits = in.ConsumeIntegral<uint32_t>();
       float f;
@@ -69,8 +72,9 @@ Vec3 fuzz_vec3(FuzzedDataProvider& in) {
 Mat4 fuzz_matrix(FuzzedDataProvider& in) {
   Mat4 m(1.0f);
   switch (in.ConsumeIntegralInRange<int>(0, 3)) {
-    case 0: break;  // identity
-    case 1:         // scale and translation
+    case 0:
+      break;  // identity
+    case 1:   // scale and translation
       for (int a = 0; a < 3; ++a) m[a][a] = fuzz_float(in);
       m[3] = glm::vec4(fuzz_vec3(in), 1.0f);
       break;
@@ -99,8 +103,8 @@ bool degenerate(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
 
 // The documented contract of Scene::intersect: these rays find nothing.
 bool valid_ray(const Ray& r) {
-  return is_finite(r.org) && is_finite(r.dir) && r.dir != Vec3(0.0f) && !std::isnan(r.tnear) &&
-         !std::isnan(r.tfar) && r.tnear <= r.tfar;
+  return is_finite(r.org) && is_finite(r.dir) && r.dir != Vec3(0.0f) && !std::isnan(r.tnear) && !std::isnan(r.tfar) &&
+         r.tnear <= r.tfar;
 }
 
 // Every triangle of every instance, with the scene's own object-space ray (scene.cpp).
@@ -225,7 +229,8 @@ void fuzz_scene(FuzzedDataProvider& in) {
     } else {
       FUZZ_CHECK(h.t == kInfinity && h.instance == kInvalidId);
     }
-    if (all_moderate && moderate(r.org) && moderate(r.dir) && moderate(r.tnear) && (moderate(r.tfar) || r.tfar == kInfinity)) {
+    if (all_moderate && moderate(r.org) && moderate(r.dir) && moderate(r.tnear) &&
+        (moderate(r.tfar) || r.tfar == kInfinity)) {
       const bool brute = brute_force_hits(scene, r);
       if (brute != h.found()) dump(scene, r, h);
       FUZZ_CHECK(h.found() == brute);
@@ -296,7 +301,8 @@ void fuzz_render(FuzzedDataProvider& in) {
   for (Vec3& v : vertices) v = Vec3(fuzz_float(in) * 0.25f, fuzz_float(in) * 0.25f, fuzz_float(in) * 0.1f);
   std::vector<Triangle> triangles(in.ConsumeIntegralInRange<size_t>(0, 4));
   for (Triangle& t : triangles)
-    for (int k = 0; k < 3; ++k) t[k] = in.ConsumeIntegralInRange<uint32_t>(0, uint32_t(std::max<size_t>(vertices.size(), 1) - 1));
+    for (int k = 0; k < 3; ++k)
+      t[k] = in.ConsumeIntegralInRange<uint32_t>(0, uint32_t(std::max<size_t>(vertices.size(), 1) - 1));
   MeshShading sh;
   const size_t corners = 3 * triangles.size() + (in.ConsumeIntegralInRange<int>(0, 7) == 0 ? 1 : 0);  // rarely wrong
   if (in.ConsumeBool()) sh.corner_normals.resize(corners);
@@ -317,7 +323,8 @@ void fuzz_render(FuzzedDataProvider& in) {
   } catch (const std::invalid_argument&) {
     FUZZ_CHECK(scene.mesh_count() == 0);  // refused shading or vertices: nothing added
   }
-  if (in.ConsumeBool()) scene.add_texture(Texture::from_floats(2, 1, 3, {0, 0.5f, 1, 1, 0.5f, 0}, ColorEncoding::Linear));
+  if (in.ConsumeBool())
+    scene.add_texture(Texture::from_floats(2, 1, 3, {0, 0.5f, 1, 1, 0.5f, 0}, ColorEncoding::Linear));
   for (int m = in.ConsumeIntegralInRange<int>(0, 4); m > 0; --m) {
     static const char* kinds[] = {"diffuse", "refraction", "glass", "metal"};
     try {
@@ -409,7 +416,8 @@ void fuzz_transport(FuzzedDataProvider& in) {
     const int c = in.ConsumeIntegralInRange<int>(0, 5);
     std::vector<float> texels(in.ConsumeIntegralInRange<size_t>(0, 100));
     for (float& x : texels) x = fuzz_float(in);
-    const Texture tex = Texture::from_floats(w, h, c, texels, in.ConsumeBool() ? ColorEncoding::Srgb : ColorEncoding::Linear);
+    const Texture tex =
+        Texture::from_floats(w, h, c, texels, in.ConsumeBool() ? ColorEncoding::Srgb : ColorEncoding::Linear);
     (void)tex.lookup(Vec2(fuzz_float(in), fuzz_float(in)));
   } catch (const std::invalid_argument&) {
   }
@@ -421,9 +429,15 @@ void fuzz_transport(FuzzedDataProvider& in) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzedDataProvider in(data, size);
   switch (in.ConsumeIntegralInRange<int>(0, 2)) {
-    case 0: fuzz_scene(in); break;
-    case 1: fuzz_builders(in); break;
-    default: fuzz_transport(in); break;
+    case 0:
+      fuzz_scene(in);
+      break;
+    case 1:
+      fuzz_builders(in);
+      break;
+    default:
+      fuzz_transport(in);
+      break;
   }
   return 0;
 }

@@ -73,8 +73,7 @@ double corner_solid_angle(double a, double b, double h) {
 }
 // Any rectangle [x0, x1] x [y0, y1] (relative to the foot of p) from corner rectangles by
 // inclusion-exclusion, with the quantity extended oddly to negative coordinates.
-double over_rectangle(double (*corner)(double, double, double), double x0, double x1, double y0, double y1,
-                      double h) {
+double over_rectangle(double (*corner)(double, double, double), double x0, double x1, double y0, double y1, double h) {
   const auto g = [&](double x, double y) {
     return (x < 0 ? -1.0 : 1.0) * (y < 0 ? -1.0 : 1.0) * corner(std::fabs(x), std::fabs(y), h);
   };
@@ -143,7 +142,8 @@ TEST(SphereLight, IrradianceEqualsPointLightWhileAboveTheHorizon) {
   for (double tilt : {0.0, 0.5, 1.2}) {
     ASSERT_LT(tilt + theta_max, kPiD / 2);  // fully above the horizon
     const Vec3 n(float(std::sin(tilt)), 0.0f, float(std::cos(tilt)));
-    const Estimate e = monte_carlo(100000, [&](uint32_t i) { return irradiance_sample(light, Vec3(0.0f), n, rand2(i, 1)); });
+    const Estimate e =
+        monte_carlo(100000, [&](uint32_t i) { return irradiance_sample(light, Vec3(0.0f), n, rand2(i, 1)); });
     expect_converges(e, intensity * std::cos(tilt), "sphere light");
   }
 }
@@ -176,7 +176,8 @@ TEST(SphereLight, InsideTheSphereIrradianceIsPiL) {
   const Light light = PointLight::make(Vec3(0), 50.0f, Vec3(1.0f), 1.0f);
   const double radiance = std::get<PointLight>(light).radiance.x;
   const Vec3 n = glm::normalize(Vec3(0.3f, -1.0f, 0.2f));
-  const Estimate e = monte_carlo(100000, [&](uint32_t i) { return irradiance_sample(light, Vec3(0.2f, 0.1f, -0.3f), n, rand2(i, 3)); });
+  const Estimate e = monte_carlo(
+      100000, [&](uint32_t i) { return irradiance_sample(light, Vec3(0.2f, 0.1f, -0.3f), n, rand2(i, 3)); });
   expect_converges(e, kPiD * radiance, "inside a sphere light");
 }
 
@@ -202,7 +203,9 @@ TEST(AreaLight, SmallLightsMatchCyclesPixelsOfBlenderUnits) {
   for (auto [shape, measured] : {std::pair{AreaShape::Square, 7.950}, std::pair{AreaShape::Disk, 7.953}})
     for (AreaSampling sampling : {AreaSampling::Area, AreaSampling::SolidAngle}) {
       const Light light = ceiling_light(shape, 0.05f, 0.0f, 1.0f, 100.0f);
-      const Estimate e = monte_carlo(20000, [&](uint32_t i) { return irradiance_sample(light, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 4), sampling); });
+      const Estimate e = monte_carlo(20000, [&](uint32_t i) {
+        return irradiance_sample(light, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 4), sampling);
+      });
       EXPECT_NEAR(e.mean / kPiD, measured, 0.001 * measured);
     }
 }
@@ -217,7 +220,8 @@ TEST(AreaLight, BothEstimatorsConvergeToTheRectangleIrradiance) {
       const double height = h - p.z;
       const double exact = radiance * over_rectangle(corner_irradiance_over_radiance, -sx / 2 - p.x, sx / 2 - p.x,
                                                      -sy / 2 - p.y, sy / 2 - p.y, height);
-      const Estimate e = monte_carlo(100000, [&](uint32_t i) { return irradiance_sample(light, p, Vec3(0, 0, 1), rand2(i, 5), sampling); });
+      const Estimate e = monte_carlo(
+          100000, [&](uint32_t i) { return irradiance_sample(light, p, Vec3(0, 0, 1), rand2(i, 5), sampling); });
       expect_converges(e, exact, sampling == AreaSampling::Area ? "area sampling" : "solid-angle sampling");
     }
   }
@@ -325,7 +329,8 @@ TEST(AreaLight, SolidAngleSamplingHasLowerVarianceCloseToALargeLight) {
   double variance[2];
   for (AreaSampling sampling : {AreaSampling::Area, AreaSampling::SolidAngle}) {
     const Light light = ceiling_light(AreaShape::Square, 4.0f, 0.0f, 1.0f, 100.0f);
-    const Estimate e = monte_carlo(20000, [&](uint32_t i) { return irradiance_sample(light, p, n, rand2(i, 10), sampling); });
+    const Estimate e =
+        monte_carlo(20000, [&](uint32_t i) { return irradiance_sample(light, p, n, rand2(i, 10), sampling); });
     variance[int(sampling)] = e.standard_error * e.standard_error;
   }
   std::printf("variance ratio area / solid angle: %.1f\n", variance[0] / variance[1]);
@@ -337,7 +342,8 @@ TEST(AreaLight, DiskAndEllipseIrradianceOnTheAxis) {
   // Disk of radius R: E = pi L R^2 / (h^2 + R^2).
   const Light disk = ceiling_light(AreaShape::Disk, 1.2f, 0.0f, h, power);
   const double l_disk = std::get<AreaLight>(disk).radiance.x, r = 0.6;
-  const Estimate e_disk = monte_carlo(100000, [&](uint32_t i) { return irradiance_sample(disk, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 11)); });
+  const Estimate e_disk =
+      monte_carlo(100000, [&](uint32_t i) { return irradiance_sample(disk, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 11)); });
   expect_converges(e_disk, kPiD * l_disk * r * r / (h * h + r * r), "disk");
   // Ellipse with semi-axes a, b: in polar coordinates the radial integral of L h^2 rho / (h^2 +
   // rho^2)^2 is closed, leaving E = L integral over phi of rho_max^2 / (2 (h^2 + rho_max^2)),
@@ -352,7 +358,8 @@ TEST(AreaLight, DiskAndEllipseIrradianceOnTheAxis) {
     const double rho2 = 1.0 / (std::pow(std::cos(phi) / a, 2) + std::pow(std::sin(phi) / b, 2));
     integral += rho2 / (2.0 * (h * h + rho2)) * (2.0 * kPiD / kSteps);
   }
-  const Estimate e_ellipse = monte_carlo(100000, [&](uint32_t i) { return irradiance_sample(ellipse, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 12)); });
+  const Estimate e_ellipse = monte_carlo(
+      100000, [&](uint32_t i) { return irradiance_sample(ellipse, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 12)); });
   expect_converges(e_ellipse, l_ellipse * integral, "ellipse");
 }
 
@@ -391,7 +398,7 @@ TEST(LightSelector, ProbabilitiesSumToOneAndFollowTheImportance) {
       PointLight::make(Vec3(0, 0, 2), 100.0f, Vec3(1.0f)),
       PointLight::make(Vec3(3, 0, 1), 40.0f, Vec3(1.0f, 0.0f, 0.0f), 0.2f),
       ceiling_light(AreaShape::Rectangle, 1.0f, 2.0f, 3.0f, 200.0f),
-      PointLight::make(Vec3(0, 0, -2), 100.0f, Vec3(1.0f)),  // below the receiver: cannot contribute
+      PointLight::make(Vec3(0, 0, -2), 100.0f, Vec3(1.0f)),       // below the receiver: cannot contribute
       ceiling_light(AreaShape::Disk, 1.0f, 0.0f, -1.0f, 100.0f),  // faces away
   };
   const LightSelector selector(lights);
@@ -457,7 +464,8 @@ TEST(LightSelector, ImportanceIsPositiveWhereverALightContributes) {
     const Vec3 n = glm::normalize(Vec3(rand2(j, 15), random_float(j, 0, 2, 15)) - Vec3(0.5f));
     for (const Light& light : lights) {
       bool contributes = false;
-      for (uint32_t i = 0; i < 16 && !contributes; ++i) contributes = irradiance_sample(light, p, n, rand2(i, 16 + j)) > 0.0;
+      for (uint32_t i = 0; i < 16 && !contributes; ++i)
+        contributes = irradiance_sample(light, p, n, rand2(i, 16 + j)) > 0.0;
       if (contributes) {
         ++contributing;
         EXPECT_GT(light_importance(light, p, n), 0.0f);

@@ -2,8 +2,8 @@
 // sampling, and the area-light estimator as a setting of the render rather than of the scene.
 #include "render/renderer.h"
 
-#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include <stdexcept>
 

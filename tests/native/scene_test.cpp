@@ -4,8 +4,8 @@
 #include "oracle_compare.h"
 #include "test_scenes.h"
 
-#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include <random>
 
@@ -175,7 +175,7 @@ TEST(Scene, RejectsBadTransformsAndIndices) {
   Scene scene;
   EXPECT_THROW(scene.add_instance(0, Mat4(1.0f)), std::invalid_argument);  // no mesh yet
   const uint32_t id = scene.add_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
-  EXPECT_THROW(scene.add_instance(id, Mat4(0.0f)), std::invalid_argument);                  // not affine
+  EXPECT_THROW(scene.add_instance(id, Mat4(0.0f)), std::invalid_argument);                             // not affine
   EXPECT_THROW(scene.add_instance(id, glm::scale(Mat4(1.0f), Vec3(1, 0, 1))), std::invalid_argument);  // singular
   Mat4 nan(1.0f);
   nan[3][0] = std::nanf("");
