@@ -5,9 +5,25 @@
 #include <gtest/gtest.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <atomic>
+#include <cstdlib>
+#include <new>
 #include <stdexcept>
 
+#include "test_scenes.h"
+
 using namespace toyrt;
+
+// Bytes allocated through operator new in this binary: ReadsTheSceneInPlace checks that a render
+// allocates nothing the size of the scene's shading (a per-render copy of it did, tens of MB).
+static std::atomic<size_t> g_new_bytes{0};
+void* operator new(size_t n) {
+  g_new_bytes.fetch_add(n, std::memory_order_relaxed);
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, size_t) noexcept { std::free(p); }
 
 namespace {
 
@@ -119,4 +135,31 @@ TEST(RenderSettings, NamesParseAndPrintBack) {
   EXPECT_THROW(parse_light_sampling("some"), std::invalid_argument);
   EXPECT_THROW(parse_area_sampling("fast"), std::invalid_argument);
   EXPECT_THROW(parse_builder("fast"), std::invalid_argument);
+}
+
+TEST(Render, ReadsTheSceneInPlace) {
+  // A mesh whose shading is ~12 MB; a one-pixel render must allocate far less than that.
+  const toyrt::testing::MeshData m = toyrt::testing::uv_sphere(316, 316);
+  const size_t corners = 3 * m.triangles.size();
+  MeshShading sh;
+  sh.corner_normals.assign(corners, Vec3(0.0f, 0.0f, 1.0f));
+  sh.corner_uvs.assign(corners, Vec2(0.5f));
+  sh.material_ids.assign(m.triangles.size(), 0);
+  const size_t shading_bytes = corners * (sizeof(Vec3) + sizeof(Vec2)) + m.triangles.size() * sizeof(int32_t);
+  ASSERT_GT(shading_bytes, size_t(10) << 20);
+  Scene scene;
+  scene.add_instance(scene.add_mesh(m.vertices, m.triangles, std::move(sh)), Mat4(1.0f));
+  scene.add_material(Lambert{});
+  scene.add_light(PointLight::make(Vec3(0.0f, 0.0f, 3.0f), 10.0f, Vec3(1.0f)));
+  scene.commit();
+  CameraParams p;
+  p.resolution_x = p.resolution_y = 1;
+  p.matrix_world = glm::translate(Mat4(1.0f), Vec3(0.0f, 0.0f, 4.0f));
+  const Camera cam = Camera::make(p);
+  render(scene, cam, few_samples(1));  // warm-up: the thread arena's own allocations
+  const size_t before = g_new_bytes.load();
+  const RenderResult r = render(scene, cam, few_samples(1));
+  const size_t allocated = g_new_bytes.load() - before;
+  EXPECT_LT(allocated, size_t(1) << 20) << "a render allocated " << allocated << " bytes";
+  EXPECT_GT(r.rgba[0], 0.0f);  // it did see the lit sphere
 }
