@@ -10,6 +10,7 @@ import argparse
 import ctypes
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -61,13 +62,17 @@ def child(sizes):
                     return int(line.split()[1])
         return 0
 
+    def cpu_s():  # user + system time of every thread of the process: less sensitive to a busy machine
+        r = resource.getrusage(resource.RUSAGE_SELF)
+        return r.ru_utime + r.ru_stime
+
     s.render(camera(32, 24), samples=1, threads=2)  # warm-up: thread pool, page faults of the tree
     libc = ctypes.CDLL("libc.so.6")
     out = {}
     for w, h in sizes:
-        start = time.perf_counter()
+        cpu0, start = cpu_s(), time.perf_counter()
         s.render(camera(w, h), samples=1, threads=2)
-        ms = 1000.0 * (time.perf_counter() - start)
+        ms, cpu_ms = 1000.0 * (time.perf_counter() - start), 1000.0 * (cpu_s() - cpu0)
         # Memory, by a second render: first give freed heap pages back to the system (otherwise a
         # copy reuses pages already counted in RSS and shows no growth), then reset the peak
         # (Linux: clear_refs 5), so the peak after the render is the render's own.
@@ -76,7 +81,7 @@ def child(sizes):
             f.write("5")
         before = rss_kb("VmRSS")
         s.render(camera(w, h), samples=1, threads=2)
-        out[f"{w}x{h}"] = dict(ms=ms, peak_growth_mb=(rss_kb("VmHWM") - before) / 1024.0)
+        out[f"{w}x{h}"] = dict(ms=ms, cpu_ms=cpu_ms, peak_growth_mb=(rss_kb("VmHWM") - before) / 1024.0)
     print(json.dumps(out))
 
 
@@ -100,14 +105,16 @@ def main():
                 sys.exit(f"{name}: {done.stderr[-2000:]}")
             runs[name].append(json.loads(done.stdout.strip().splitlines()[-1]))
             print(f"repeat {r + 1}/{args.repeats} {name}: {runs[name][-1]}", file=sys.stderr)
-    print(f"median of {args.repeats} (render() wall time, its minimum on a shared machine; peak RSS growth during a"
-          " render), 1 sample, threads=2")
+    print(f"median of {args.repeats}: render() wall time (its minimum, and the process's CPU time, on a shared"
+          " machine); peak RSS growth during a render. 1 sample, threads=2")
     for name, _ in modules:
         for w, h in SIZES:
             key = f"{w}x{h}"
             times = [x[key]["ms"] for x in runs[name]]
+            cpu = statistics.median(x[key]["cpu_ms"] for x in runs[name])
             mb = statistics.median(x[key]["peak_growth_mb"] for x in runs[name])
-            print(f"  {name:>8} {key:>8}: {statistics.median(times):8.1f} ms (min {min(times):6.1f})   {mb:7.1f} MB")
+            print(f"  {name:>8} {key:>8}: {statistics.median(times):8.1f} ms (min {min(times):6.1f}, CPU {cpu:7.1f})"
+                  f"   {mb:7.1f} MB")
 
 
 if __name__ == "__main__":
