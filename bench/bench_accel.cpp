@@ -6,7 +6,7 @@
 //
 //   bench_accel --csv FILE.csv [--dump DIR] [--runs N] [--quick]
 #include "accel/binned_sah_builder.h"
-#include "accel/builder_choice.h"
+#include "accel/builder.h"
 #include "accel/lbvh_builder.h"
 #include "bench_util.h"
 #include "embree_oracle.h"
@@ -26,17 +26,13 @@
 
 using namespace toyrt;
 using namespace toyrt::testing;
-using toyrt::bench::best_ms;
+using namespace toyrt::bench;
 
 namespace {
 
 template <class Tracer>
 double mrays(const std::vector<Ray>& rays, int runs, const Tracer& tracer) {
-  const double ms = best_ms(runs, [&] {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i != r.end(); ++i) tracer(rays[i]);
-    });
-  });
+  const double ms = best_ms(runs, [&] { for_each_ray(rays, tracer); });
   return rays.size() / ms / 1e3;
 }
 
@@ -55,52 +51,30 @@ void dump_rays(const std::string& path, const std::vector<Ray>& rays) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string csv_path, dump_dir;
-  int runs = 2;
-  bool quick = false;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--csv") && i + 1 < argc) csv_path = argv[++i];
-    else if (!std::strcmp(argv[i], "--dump") && i + 1 < argc) dump_dir = argv[++i];
-    else if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--quick")) quick = true;
-    else {
-      std::fprintf(stderr, "usage: %s --csv FILE.csv [--dump DIR] [--runs N] [--quick]\n", argv[0]);
-      return 2;
-    }
-  }
-  // 2 r^2 triangles: 10K, 100K, 1M, 4M.
-  const std::vector<int> rings = quick ? std::vector<int>{71, 224} : std::vector<int>{71, 224, 708, 1415};
-  const int width = quick ? 192 : 384, height = quick ? 144 : 288;
+  const std::optional<Args> args = parse_args(argc, argv, "--csv FILE.csv [--dump DIR] [--runs N] [--quick]", 2);
+  if (!args) return 2;
+  const int width = args->quick ? 192 : 384, height = args->quick ? 144 : 288;
 
   {  // Compile the LBVH kernels once, outside every timing.
-    const MeshData warm = uv_sphere(10, 10);
-    Scene s;
-    s.add_instance(s.add_mesh(warm.vertices, warm.triangles), Mat4(1.0f));
-    CommitOptions o;
-    o.builder = BuilderKind::Lbvh;
-    s.commit(o);
-    if (!s.commit_stats().warning.empty()) std::fprintf(stderr, "%s\n", s.commit_stats().warning.c_str());
+    const CommitStats warm = compile_lbvh_kernels();
+    if (!warm.warning.empty()) std::fprintf(stderr, "%s\n", warm.warning.c_str());
   }
 
-  std::ofstream csv(csv_path);
+  std::ofstream csv(args->csv);
   csv << "triangles,builder,build_ms,sah_cost,primary_mrays,diffuse_mrays,shadow_mrays,rays_primary,rays_diffuse,"
          "rays_shadow,auto_preview,auto_final,device\n";
   const BuilderCostModel model;
   // Workloads as bench_lbvh counts them: one primary, one shadow and one bounce ray per sample.
   const double preview_rays = 640.0 * 360 * 3, final_rays = 1920.0 * 1080 * 64 * 3;
-  for (int r : rings) {
+  for (int r : sphere_rings(args->quick)) {
     const MeshData m = uv_sphere(r, r, 1.0f, 0.15f);
     const size_t n = m.triangles.size();
     std::fprintf(stderr, "bench_accel: %zu triangles\n", n);
     const EmbreeScene embree(m.vertices, m.triangles);
-    const std::vector<Ray> primary = primary_rays(bounds_of(m), width, height);
-    std::vector<Hit> hits;
-    for (const Ray& ray : primary) hits.push_back(embree.intersect(ray));
-    const BBox box = bounds_of(m);
-    const Vec3 light = box.center() + glm::length(box.extent()) * Vec3(-0.4f, -0.9f, 1.3f);
-    const std::vector<Ray> diffuse = diffuse_rays(m, primary, hits, 3), shadow = shadow_rays(m, primary, hits, light);
-    if (!dump_dir.empty()) {
-      const std::string base = dump_dir + "/accel-" + std::to_string(n);
+    const RaySets sets = ray_sets(m, embree, width, height);
+    const std::vector<Ray>&primary = sets.primary, &diffuse = sets.diffuse, &shadow = sets.shadow;
+    if (!args->dump.empty()) {
+      const std::string base = args->dump + "/accel-" + std::to_string(n);
       dump(base + ".verts.bin", m.vertices.data(), m.vertices.size() * sizeof(Vec3));
       dump(base + ".tris.bin", m.triangles.data(), m.triangles.size() * sizeof(Triangle));
       dump_rays(base + ".primary.bin", primary);
@@ -112,31 +86,29 @@ int main(int argc, char** argv) {
     const char* pick_final = model.choose(n, final_rays) == BuilderKind::Lbvh ? "lbvh" : "sah";
     auto row = [&](const char* name, double build, double cost, double p, double d, double s) {
       char line[512];
-      std::snprintf(line, sizeof line, "%zu,%s,%.3f,%.3f,%.4f,%.4f,%.4f,%zu,%zu,%zu,%s,%s,%s\n", n, name, build, cost, p, d,
-                    s, primary.size(), diffuse.size(), shadow.size(), pick_preview, pick_final,
+      std::snprintf(line, sizeof line, "%zu,%s,%.3f,%.3f,%.4f,%.4f,%.4f,%zu,%zu,%zu,%s,%s,%s\n", n, name, build, cost,
+                    p, d, s, primary.size(), diffuse.size(), shadow.size(), pick_preview, pick_final,
                     opencl::device().name.c_str());
       csv << line;
       std::fprintf(stderr, "%s", line);
     };
     for (BuilderKind kind : {BuilderKind::Sah, BuilderKind::Lbvh}) {
       Bvh tree;
-      const double build = kind == BuilderKind::Sah
-          ? best_ms(runs, [&] { tree = build_binned_sah(prims.boxes.data(), prims.centers.data(), n); })
-          : best_ms(runs, [&] { tree = build_lbvh(prims.boxes.data(), prims.centers.data(), n, {}); });
-      Scene s;
-      s.add_instance(s.add_mesh(m.vertices, m.triangles), Mat4(1.0f));
-      CommitOptions o;
-      o.builder = kind;
-      s.commit(o);
-      auto hit = [&](const Ray& ray) { s.intersect(ray); };
-      auto occ = [&](const Ray& ray) { s.occluded(ray); };
-      row(kind == BuilderKind::Sah ? "sah" : "lbvh", build, tree.sah_cost(), mrays(primary, runs, hit),
-          mrays(diffuse, runs, hit), mrays(shadow, runs, occ));
+      const double build =
+          kind == BuilderKind::Sah
+              ? best_ms(args->runs, [&] { tree = build_binned_sah(prims.boxes.data(), prims.centers.data(), n); })
+              : best_ms(args->runs, [&] { tree = build_lbvh(prims.boxes.data(), prims.centers.data(), n, {}); });
+      const auto s = scene_of(m, kind);
+      auto hit = [&](const Ray& ray) { s->intersect(ray); };
+      auto occ = [&](const Ray& ray) { s->occluded(ray); };
+      row(kind == BuilderKind::Sah ? "sah" : "lbvh", build, tree.sah_cost(), mrays(primary, args->runs, hit),
+          mrays(diffuse, args->runs, hit), mrays(shadow, args->runs, occ));
     }
-    const double build = best_ms(runs, [&] { EmbreeScene e(m.vertices, m.triangles); });
+    const double build = best_ms(args->runs, [&] { EmbreeScene e(m.vertices, m.triangles); });
     auto hit = [&](const Ray& ray) { embree.intersect(ray); };
     auto occ = [&](const Ray& ray) { embree.occluded(ray); };
-    row("embree", build, 0.0, mrays(primary, runs, hit), mrays(diffuse, runs, hit), mrays(shadow, runs, occ));
+    row("embree", build, 0.0, mrays(primary, args->runs, hit), mrays(diffuse, args->runs, hit),
+        mrays(shadow, args->runs, occ));
   }
   return 0;
 }

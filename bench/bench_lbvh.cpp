@@ -5,10 +5,10 @@
 //
 //   bench_lbvh [--out FILE.md] [--csv FILE.csv] [--runs N] [--quick]
 #include "accel/lbvh_builder.h"
-#include "opencl/device.h"
 #include "bench_util.h"
 #include "core/parallel.h"
 #include "embree_oracle.h"
+#include "opencl/device.h"
 #include "scene/scene.h"
 #include "test_scenes.h"
 
@@ -30,43 +30,22 @@
 
 using namespace toyrt;
 using namespace toyrt::testing;
-using toyrt::bench::best_ms;
-using toyrt::bench::cpu_model;
+using namespace toyrt::bench;
 
 namespace {
 
-double ms_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-}
-
-
-// Mixed ray set: primary rays, and a diffuse bounce and a shadow ray from each primary hit.
-std::vector<Ray> mixed_rays(const MeshData& m, int width, int height) {
-  const EmbreeScene embree(m.vertices, m.triangles);
-  std::vector<Ray> rays = primary_rays(bounds_of(m), width, height);
-  std::vector<Hit> hits;
-  for (const Ray& r : rays) hits.push_back(embree.intersect(r));
-  const BBox box = bounds_of(m);
-  const Vec3 light = box.center() + glm::length(box.extent()) * Vec3(-0.4f, -0.9f, 1.3f);
-  const std::vector<Ray> d = diffuse_rays(m, rays, hits, 3), s = shadow_rays(m, rays, hits, light);
-  const size_t primary = rays.size();
-  rays.insert(rays.end(), d.begin(), d.end());
-  rays.insert(rays.end(), s.begin(), s.end());
-  (void)primary;
-  return rays;
-}
-
-double trace_ms(const Scene& scene, const std::vector<Ray>& rays, int runs) {
+// A mixed set: shadow rays (finite tfar) ask occluded(), the others intersect().
+template <class Tracer>
+double trace_ms(const Tracer& tracer, const std::vector<Ray>& rays, int runs) {
   return best_ms(runs, [&] {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i != r.end(); ++i) {
-        if (rays[i].tfar < kInfinity) scene.occluded(rays[i]);
-        else scene.intersect(rays[i]);
-      }
+    for_each_ray(rays, [&](const Ray& ray) {
+      if (ray.tfar < kInfinity)
+        tracer.occluded(ray);
+      else
+        tracer.intersect(ray);
     });
   });
 }
-
 
 struct Row {
   size_t triangles;
@@ -78,35 +57,18 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string md_path, csv_path;
-  int runs = 3;
-  bool quick = false;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) md_path = argv[++i];
-    else if (!std::strcmp(argv[i], "--csv") && i + 1 < argc) csv_path = argv[++i];
-    else if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--quick")) quick = true;
-    else {
-      std::fprintf(stderr, "usage: %s [--out FILE.md] [--csv FILE.csv] [--runs N] [--quick]\n", argv[0]);
-      return 2;
-    }
-  }
-  const std::vector<int> rings = quick ? std::vector<int>{71, 224} : std::vector<int>{71, 224, 708, 1415};
-  const int width = quick ? 256 : 512, height = quick ? 192 : 384;
+  const std::optional<Args> args = parse_args(argc, argv, "[--out FILE.md] [--csv FILE.csv] [--runs N] [--quick]", 3);
+  if (!args) return 2;
+  const int width = args->quick ? 256 : 512, height = args->quick ? 192 : 384;
 
   // First use: kernel compilation, reported apart (and out of every build time below).
   double compile_ms = 0.0;
   std::string device;
   {
-    const MeshData warm = uv_sphere(10, 10);
-    Scene s;
-    s.add_instance(s.add_mesh(warm.vertices, warm.triangles), Mat4(1.0f));
-    CommitOptions o;
-    o.builder = BuilderKind::Lbvh;
-    s.commit(o);
-    compile_ms = s.commit_stats().lbvh_compile_ms;
-    if (!s.commit_stats().warning.empty()) {
-      std::fprintf(stderr, "%s\n", s.commit_stats().warning.c_str());
+    const CommitStats warm = compile_lbvh_kernels();
+    compile_ms = warm.lbvh_compile_ms;
+    if (!warm.warning.empty()) {
+      std::fprintf(stderr, "%s\n", warm.warning.c_str());
       return 1;
     }
     device = opencl::device().name;
@@ -114,7 +76,7 @@ int main(int argc, char** argv) {
 
   std::vector<Row> rows;
   std::vector<std::vector<std::pair<std::string, double>>> stages;
-  for (int r : rings) {
+  for (int r : sphere_rings(args->quick)) {
     const MeshData m = uv_sphere(r, r, 1.0f, 0.15f);
     std::fprintf(stderr, "%zu triangles\n", m.triangles.size());
     Row row{};
@@ -125,49 +87,36 @@ int main(int argc, char** argv) {
     // Builder alone (what differs between them); the collapse to the wide traversal layout that
     // both then share is not included.
     Bvh sah, lbvh, lbvh63;
-    row.sah_ms = best_ms(runs, [&] { sah = build_binned_sah(boxes.data(), centers.data(), boxes.size()); });
+    row.sah_ms = best_ms(args->runs, [&] { sah = build_binned_sah(boxes.data(), centers.data(), boxes.size()); });
     LbvhStats st;
-    row.lbvh_ms = best_ms(runs, [&] { lbvh = build_lbvh(boxes.data(), centers.data(), boxes.size(), {}, &st); });
+    row.lbvh_ms = best_ms(args->runs, [&] { lbvh = build_lbvh(boxes.data(), centers.data(), boxes.size(), {}, &st); });
     stages.push_back(st.stages);
-    row.lbvh63_ms = best_ms(runs, [&] {
+    row.lbvh63_ms = best_ms(args->runs, [&] {
       lbvh63 = build_lbvh(boxes.data(), centers.data(), boxes.size(), LbvhConfig{MortonBits::k63});
     });
-    row.embree_ms = best_ms(runs, [&] { EmbreeScene e(m.vertices, m.triangles); });
+    row.embree_ms = best_ms(args->runs, [&] { EmbreeScene e(m.vertices, m.triangles); });
     row.sah_cost = sah.sah_cost();
     row.lbvh_cost = lbvh.sah_cost();
     row.lbvh63_cost = lbvh63.sah_cost();
 
-    const std::vector<Ray> rays = mixed_rays(m, width, height);
-    auto scene_with = [&](BuilderKind kind, MortonBits bits) {
-      auto s = std::make_unique<Scene>();
-      s->add_instance(s->add_mesh(m.vertices, m.triangles), Mat4(1.0f));
-      CommitOptions o;
-      o.builder = kind;
-      o.lbvh.bits = bits;
-      s->commit(o);
-      return s;
-    };
-    const auto s_sah = scene_with(BuilderKind::Sah, MortonBits::k30);
-    const auto s_lbvh = scene_with(BuilderKind::Lbvh, MortonBits::k30);
-    const auto s_lbvh63 = scene_with(BuilderKind::Lbvh, MortonBits::k63);
-    row.sah_mrays = rays.size() / trace_ms(*s_sah, rays, runs) / 1e3;
-    row.lbvh_mrays = rays.size() / trace_ms(*s_lbvh, rays, runs) / 1e3;
-    row.lbvh63_mrays = rays.size() / trace_ms(*s_lbvh63, rays, runs) / 1e3;
     const EmbreeScene embree(m.vertices, m.triangles);
-    row.embree_mrays = rays.size() / best_ms(runs, [&] {
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 256), [&](const tbb::blocked_range<size_t>& rr) {
-        for (size_t i = rr.begin(); i != rr.end(); ++i) {
-          if (rays[i].tfar < kInfinity) embree.occluded(rays[i]);
-          else embree.intersect(rays[i]);
-        }
-      });
-    }) / 1e3;
+    const std::vector<Ray> rays = ray_sets(m, embree, width, height).mixed();
+    const auto s_sah = scene_of(m, BuilderKind::Sah, MortonBits::k30);
+    const auto s_lbvh = scene_of(m, BuilderKind::Lbvh, MortonBits::k30);
+    const auto s_lbvh63 = scene_of(m, BuilderKind::Lbvh, MortonBits::k63);
+    row.sah_mrays = rays.size() / trace_ms(*s_sah, rays, args->runs) / 1e3;
+    row.lbvh_mrays = rays.size() / trace_ms(*s_lbvh, rays, args->runs) / 1e3;
+    row.lbvh63_mrays = rays.size() / trace_ms(*s_lbvh63, rays, args->runs) / 1e3;
+    row.embree_mrays = rays.size() / trace_ms(embree, rays, args->runs) / 1e3;
     rows.push_back(row);
   }
 
   // What auto picks, against the better total, for two workloads (rays per pixel: one primary,
   // one shadow, one bounce per sample).
-  struct Workload { const char* name; double rays; };
+  struct Workload {
+    const char* name;
+    double rays;
+  };
   const Workload workloads[] = {{"preview, 640x360, 1 sample", 640.0 * 360 * 3},
                                 {"final, 1920x1080, 64 samples", 1920.0 * 1080 * 64 * 3}};
   const BuilderCostModel model;
@@ -178,12 +127,13 @@ int main(int argc, char** argv) {
   std::ostringstream md;
   md << "# Builders: LBVH on OpenCL against SAH and Embree\n\n"
      << "Written by `make bench-lbvh` (`build/bench/bench_lbvh`) on " << date << ": " << cpu_model() << ", "
-     << std::thread::hardware_concurrency() << " hardware threads; OpenCL device: " << device << ". Best of " << runs
+     << std::thread::hardware_concurrency() << " hardware threads; OpenCL device: " << device << ". Best of "
+     << args->runs
      << " runs. Meshes: bumpy UV spheres. Build times are the builders alone (SAH with TBB on all cores, LBVH "
      << "kernels on PoCL on the same cores, Embree's default build with its own TBB), without the collapse to the "
      << "8-wide traversal layout that TOYRT's builders then share. SAH cost: expected node visits plus triangle tests "
-     << "of a random ray (traversal and intersection cost 1) of the binary tree. Trace speed: a mixed set of "
-     << width << "x" << height << " primary rays, one diffuse bounce and one shadow ray per primary hit, on all threads.\n\n"
+     << "of a random ray (traversal and intersection cost 1) of the binary tree. Trace speed: a mixed set of " << width
+     << "x" << height << " primary rays, one diffuse bounce and one shadow ray per primary hit, on all threads.\n\n"
      << "Kernel compilation on first use (once per process, not in any build time below): **" << compile_ms
      << " ms**.\n\n"
      << "| triangles | SAH build ms | LBVH build ms | LBVH-63 build ms | Embree build ms | SAH / LBVH build time | "
@@ -191,11 +141,11 @@ int main(int argc, char** argv) {
      << "|---|---|---|---|---|---|---|---|---|\n";
   char line[1024];
   for (const Row& r : rows) {
-    std::snprintf(line, sizeof line,
-                  "| %zu | %.1f | %.1f | %.1f | %.1f | **%.2fx** | %.1f / %.1f / %.1f | %.2f / %.2f / %.2f / %.2f | %.0f %% |\n",
-                  r.triangles, r.sah_ms, r.lbvh_ms, r.lbvh63_ms, r.embree_ms, r.sah_ms / r.lbvh_ms, r.sah_cost,
-                  r.lbvh_cost, r.lbvh63_cost, r.sah_mrays, r.lbvh_mrays, r.lbvh63_mrays, r.embree_mrays,
-                  100.0 * r.lbvh_mrays / r.sah_mrays);
+    std::snprintf(
+        line, sizeof line,
+        "| %zu | %.1f | %.1f | %.1f | %.1f | **%.2fx** | %.1f / %.1f / %.1f | %.2f / %.2f / %.2f / %.2f | %.0f %% |\n",
+        r.triangles, r.sah_ms, r.lbvh_ms, r.lbvh63_ms, r.embree_ms, r.sah_ms / r.lbvh_ms, r.sah_cost, r.lbvh_cost,
+        r.lbvh63_cost, r.sah_mrays, r.lbvh_mrays, r.lbvh63_mrays, r.embree_mrays, 100.0 * r.lbvh_mrays / r.sah_mrays);
     md << line;
   }
   md << "\nLBVH stages at the largest size (ms): ";
@@ -204,7 +154,7 @@ int main(int argc, char** argv) {
     md << line;
   }
   md << "\n\n## What `auto` picks\n\nTotal time = build + rays / measured trace speed, per mesh and workload; "
-        "`auto` decides from its cost model (native/accel/builder_choice.h) before building anything.\n\n"
+        "`auto` decides from its cost model (native/accel/builder.h) before building anything.\n\n"
      << "| triangles | workload | rays | SAH total s | LBVH total s | auto picks | auto's total vs the better |\n"
      << "|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows)
@@ -213,20 +163,22 @@ int main(int argc, char** argv) {
       const double lbvh = r.lbvh_ms / 1e3 + w.rays / (r.lbvh_mrays * 1e6);
       const BuilderKind pick = model.choose(r.triangles, w.rays);
       const double picked = pick == BuilderKind::Lbvh ? lbvh : sah;
-      std::snprintf(line, sizeof line, "| %zu | %s | %.3g | %.3f | %.3f | %s | %+.1f %% |\n", r.triangles, w.name, w.rays,
-                    sah, lbvh, pick == BuilderKind::Lbvh ? "LBVH" : "SAH", 100.0 * (picked / std::min(sah, lbvh) - 1.0));
+      std::snprintf(line, sizeof line, "| %zu | %s | %.3g | %.3f | %.3f | %s | %+.1f %% |\n", r.triangles, w.name,
+                    w.rays, sah, lbvh, pick == BuilderKind::Lbvh ? "LBVH" : "SAH",
+                    100.0 * (picked / std::min(sah, lbvh) - 1.0));
       md << line;
     }
   md << "\n![build time and trace speed against triangle count](lbvh.png)\n";
   std::cout << md.str();
-  if (!md_path.empty()) std::ofstream(md_path) << md.str();
-  if (!csv_path.empty()) {
-    std::ofstream csv(csv_path);
-    csv << "triangles,sah_ms,lbvh_ms,lbvh63_ms,embree_ms,sah_cost,lbvh_cost,lbvh63_cost,sah_mrays,lbvh_mrays,lbvh63_mrays,embree_mrays\n";
+  if (!args->out.empty()) std::ofstream(args->out) << md.str();
+  if (!args->csv.empty()) {
+    std::ofstream csv(args->csv);
+    csv << "triangles,sah_ms,lbvh_ms,lbvh63_ms,embree_ms,sah_cost,lbvh_cost,lbvh63_cost,sah_mrays,lbvh_mrays,lbvh63_"
+           "mrays,embree_mrays\n";
     for (const Row& r : rows)
       csv << r.triangles << ',' << r.sah_ms << ',' << r.lbvh_ms << ',' << r.lbvh63_ms << ',' << r.embree_ms << ','
-          << r.sah_cost << ',' << r.lbvh_cost << ',' << r.lbvh63_cost << ',' << r.sah_mrays << ',' << r.lbvh_mrays << ','
-          << r.lbvh63_mrays << ',' << r.embree_mrays << '\n';
+          << r.sah_cost << ',' << r.lbvh_cost << ',' << r.lbvh63_cost << ',' << r.sah_mrays << ',' << r.lbvh_mrays
+          << ',' << r.lbvh63_mrays << ',' << r.embree_mrays << '\n';
   }
   return 0;
 }

@@ -45,7 +45,7 @@
 
 using namespace toyrt;
 using namespace toyrt::testing;
-using toyrt::bench::best_ms;
+using namespace toyrt::bench;
 
 namespace {
 
@@ -74,17 +74,6 @@ bool mt_hits_any(const MeshData& m, const Ray& r) {
   for (const Triangle& tri : m.triangles)
     if (moller_trumbore(r, m.vertices[tri[0]], m.vertices[tri[1]], m.vertices[tri[2]], t)) return true;
   return false;
-}
-
-std::unique_ptr<Scene> scene_of(const MeshData& m, BuilderKind kind = BuilderKind::Sah,
-                                MortonBits bits = MortonBits::k30) {
-  auto s = std::make_unique<Scene>();
-  s->add_instance(s->add_mesh(m.vertices, m.triangles), Mat4(1.0f));
-  CommitOptions o;
-  o.builder = kind;
-  o.lbvh.bits = bits;
-  s->commit(o);
-  return s;
 }
 
 template <class F>
@@ -132,7 +121,7 @@ AcneCase acne(const std::string& name, const MeshData& base, float scale, float 
   const BBox box = bounds_of(m);
   const auto scene = scene_of(m);
   const std::vector<Ray> cams = primary_rays(box, res, res);
-  const Vec3 light = box.center() + glm::length(box.extent()) * Vec3(-0.4f, -0.9f, 1.3f);
+  const Vec3 light = light_for(box);
   AcneCase c{name, scale, distance};
   std::vector<std::array<Ray, 3>> shadow;
   for (const Ray& r : cams) {
@@ -171,12 +160,12 @@ struct EstimatorCase {
 // One-sample irradiance estimates E = L cos / pdf at p (normal n) from a 1 m x 1 m light at the
 // origin emitting down (-Z); mean and relative standard deviation over `n` independent samples.
 std::pair<double, double> estimate(AreaSampling sampling, const Vec3& p, const Vec3& n, int count) {
-  const AreaLight light = AreaLight::make(AreaShape::Square, 1.0f, 1.0f, Mat4(1.0f), 4.0f, Vec3(1.0f), sampling);
+  const AreaLight light = AreaLight::make(AreaShape::Square, 1.0f, 1.0f, Mat4(1.0f), 4.0f, Vec3(1.0f));
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   double sum = 0.0, sum2 = 0.0;
   for (int i = 0; i < count; ++i) {
-    const LightSample s = sample(light, p, Vec2(unit(rng), unit(rng)));
+    const LightSample s = sample(light, p, Vec2(unit(rng), unit(rng)), sampling);
     double e = 0.0;
     if (s.valid()) e = double(s.radiance.x) * std::max(0.0f, glm::dot(n, s.wi)) / double(s.pdf);
     sum += e;
@@ -207,17 +196,10 @@ double fresnel_exact(double cos_i, double eta) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string out_path;
-  bool quick = false, smoke = false;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out_path = argv[++i];
-    else if (!std::strcmp(argv[i], "--quick")) quick = true;
-    else if (!std::strcmp(argv[i], "--smoke")) smoke = true;
-    else {
-      std::fprintf(stderr, "usage: %s [--out FILE.json] [--quick] [--smoke]\n", argv[0]);
-      return 2;
-    }
-  }
+  const std::optional<Args> args = parse_args(argc, argv, "[--out FILE.json] [--quick] [--smoke]");
+  if (!args) return 2;
+  const std::string& out_path = args->out;
+  const bool quick = args->quick, smoke = args->smoke;
 
   if (smoke) {
     // A fan of 64 triangles around each apex of a double cone: rays at the apexes and edges.
@@ -233,7 +215,11 @@ int main(int argc, char** argv) {
   js << "{\n";
 
   // ---- leaks ----
-  struct Placement { const char* name; float scale; Vec3 offset; };
+  struct Placement {
+    const char* name;
+    float scale;
+    Vec3 offset;
+  };
   std::vector<Placement> placements = {{"origin", 1.0f, Vec3(0.0f)},
                                        {"offset 1e3", 1.0f, Vec3(1e3f, -7e2f, 4e2f)},
                                        {"offset 1e4", 1.0f, Vec3(1e4f, -7e3f, 4e3f)},
@@ -245,8 +231,8 @@ int main(int argc, char** argv) {
   const MeshData sphere = uv_sphere(24, 48), fan = bicone_fan(256);
   js << " \"leaks\": [\n";
   bool first = true;
-  for (const auto& [mesh_name, mesh] : {std::pair<std::string, const MeshData*>{"uv_sphere", &sphere},
-                                        {"bicone_fan", &fan}})
+  for (const auto& [mesh_name, mesh] :
+       {std::pair<std::string, const MeshData*>{"uv_sphere", &sphere}, {"bicone_fan", &fan}})
     for (const Placement& p : placements) {
       const LeakCase c = leaks(mesh_name, *mesh, p.name, p.scale, p.offset, per_edge);
       std::fprintf(stderr, "leaks %s %s: %zu rays, watertight %zu, MT %zu, Embree %zu / robust %zu\n", c.mesh.c_str(),
@@ -324,7 +310,8 @@ int main(int argc, char** argv) {
     const PrimitiveBounds prims = triangle_bounds(room);
     const Bvh sah = build_binned_sah(prims.boxes.data(), prims.centers.data(), prims.boxes.size());
     const Bvh l30 = build_lbvh(prims.boxes.data(), prims.centers.data(), prims.boxes.size(), {});
-    const Bvh l63 = build_lbvh(prims.boxes.data(), prims.centers.data(), prims.boxes.size(), LbvhConfig{MortonBits::k63});
+    const Bvh l63 =
+        build_lbvh(prims.boxes.data(), prims.centers.data(), prims.boxes.size(), LbvhConfig{MortonBits::k63});
     // Rays at the object (camera outside its box, inside the room), then diffuse bounces from the hits.
     MeshData object_only;
     object_only.vertices.assign(room.vertices.begin(), room.vertices.begin() + b);
@@ -339,21 +326,18 @@ int main(int argc, char** argv) {
     }
     auto speed = [&](BuilderKind kind, MortonBits bits) {
       const auto scene = scene_of(room, kind, bits);
-      const double ms = best_ms(3, [&] {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-          for (size_t i = r.begin(); i != r.end(); ++i) scene->intersect(rays[i]);
-        });
-      });
+      const double ms = best_ms(3, [&] { for_each_ray(rays, [&](const Ray& ray) { scene->intersect(ray); }); });
       return rays.size() / ms / 1e3;
     };
     const double v_sah = speed(BuilderKind::Sah, MortonBits::k30), v30 = speed(BuilderKind::Lbvh, MortonBits::k30),
                  v63 = speed(BuilderKind::Lbvh, MortonBits::k63);
-    std::fprintf(stderr, "room: SAH cost %.1f / %.1f / %.1f, Mrays/s %.2f / %.2f / %.2f\n", sah.sah_cost(), l30.sah_cost(),
-                 l63.sah_cost(), v_sah, v30, v63);
+    std::fprintf(stderr, "room: SAH cost %.1f / %.1f / %.1f, Mrays/s %.2f / %.2f / %.2f\n", sah.sah_cost(),
+                 l30.sah_cost(), l63.sah_cost(), v_sah, v30, v63);
     js << " \"lbvh_room\": {\"triangles\": " << room.triangles.size() << ", \"object_triangles\": " << object_tris
-       << ", \"room_size_m\": " << 2 * s << ", \"rays\": " << rays.size() << ", \"sah_cost\": {\"sah\": " << sah.sah_cost()
-       << ", \"lbvh30\": " << l30.sah_cost() << ", \"lbvh63\": " << l63.sah_cost() << "}, \"mrays\": {\"sah\": " << v_sah
-       << ", \"lbvh30\": " << v30 << ", \"lbvh63\": " << v63 << "}},\n";
+       << ", \"room_size_m\": " << 2 * s << ", \"rays\": " << rays.size()
+       << ", \"sah_cost\": {\"sah\": " << sah.sah_cost() << ", \"lbvh30\": " << l30.sah_cost()
+       << ", \"lbvh63\": " << l63.sah_cost() << "}, \"mrays\": {\"sah\": " << v_sah << ", \"lbvh30\": " << v30
+       << ", \"lbvh63\": " << v63 << "}},\n";
   }
 
   // ---- total internal reflection: glass seen from inside ----
@@ -375,13 +359,15 @@ int main(int argc, char** argv) {
       const SpecularSample pr = sample(refr, wo, ng, ng);
       const double expected = 1.0 - fresnel_exact(std::cos(th), 1.0 / ior);  // eta = n_t / n_i = 1 / 1.5
       js << (deg ? ",\n" : "") << "  {\"deg\": " << deg << ", \"transmitted\": " << double(transmitted) / n
-         << ", \"expected\": " << expected << ", \"refraction_tir\": " << (pr.total_internal_reflection ? "true" : "false")
-         << "}";
+         << ", \"expected\": " << expected
+         << ", \"refraction_tir\": " << (pr.total_internal_reflection ? "true" : "false") << "}";
     }
     js << "\n ]}\n";
   }
   js << "}\n";
-  if (!out_path.empty()) std::ofstream(out_path) << js.str();
-  else std::cout << js.str();
+  if (!out_path.empty())
+    std::ofstream(out_path) << js.str();
+  else
+    std::cout << js.str();
   return 0;
 }

@@ -29,11 +29,9 @@
 
 using namespace toyrt;
 using namespace toyrt::testing;
-using toyrt::bench::best_ms;
-using toyrt::bench::cpu_model;
+using namespace toyrt::bench;
 
 namespace {
-
 
 struct Flat {  // a ray set as the batch API takes it
   std::vector<float> org, dir, tfar;
@@ -51,7 +49,6 @@ Flat flatten(const std::vector<Ray>& rays) {
   return f;
 }
 
-
 struct Row {
   std::string mesh, rays, threads;
   size_t count;
@@ -61,22 +58,18 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string out_path;
-  int runs = 5;
-  bool quick = false;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out_path = argv[++i];
-    else if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--quick")) quick = true;
-    else {
-      std::fprintf(stderr, "usage: %s [--out FILE] [--runs N] [--quick]\n", argv[0]);
-      return 2;
-    }
-  }
+  const std::optional<Args> args = parse_args(argc, argv, "[--out FILE] [--runs N] [--quick]", 5);
+  if (!args) return 2;
+  const std::string& out_path = args->out;
+  const int runs = args->runs;
+  const bool quick = args->quick;
   const int all = int(std::thread::hardware_concurrency());
   const int width = quick ? 320 : 1024, height = quick ? 240 : 768;
 
-  struct Case { std::string name; MeshData mesh; };
+  struct Case {
+    std::string name;
+    MeshData mesh;
+  };
   std::vector<Case> cases;
   cases.push_back({"bumpy sphere, 1.0M triangles", uv_sphere(708, 708, 1.0f, 0.15f)});
   cases.push_back({"triangle soup, 200K triangles", triangle_soup(200000, 0.02f, 1)});
@@ -96,7 +89,8 @@ int main(int argc, char** argv) {
         opt.threads = threads;
         s.commit(opt);
       });
-      const double theirs = best_ms(std::max(1, runs / 2), [&] { EmbreeScene e(c.mesh.vertices, c.mesh.triangles, false, threads); });
+      const double theirs =
+          best_ms(std::max(1, runs / 2), [&] { EmbreeScene e(c.mesh.vertices, c.mesh.triangles, false, threads); });
       char line[256];
       std::snprintf(line, sizeof line, "| %s | %d | %.0f | %.0f | %.2f |\n", c.name.c_str(), threads, mine, theirs,
                     mine / theirs);
@@ -113,7 +107,8 @@ int main(int argc, char** argv) {
     const BBox box = bounds_of(c.mesh);
     const Vec3 light = box.center() + glm::length(box.extent()) * Vec3(-0.4f, -0.9f, 1.3f);
     const std::vector<std::pair<std::string, std::vector<Ray>>> sets = {
-        {"primary", primary}, {"diffuse", diffuse_rays(c.mesh, primary, hits, 17)},
+        {"primary", primary},
+        {"diffuse", diffuse_rays(c.mesh, primary, hits, 17)},
         {"shadow", shadow_rays(c.mesh, primary, hits, light)}};
 
     for (const auto& [kind, rays] : sets) {
@@ -126,18 +121,23 @@ int main(int argc, char** argv) {
       std::vector<uint8_t> blocked(f.count);
       for (int threads : {1, all}) {
         const double mine = best_ms(runs, [&] {
-          if (shadow) scene.occluded(batch, blocked.data(), threads);
-          else scene.intersect(batch, {t.data(), u.data(), v.data(), prim.data(), inst.data()}, threads);
+          if (shadow)
+            scene.occluded(batch, blocked.data(), threads);
+          else
+            scene.intersect(batch, {t.data(), u.data(), v.data(), prim.data(), inst.data()}, threads);
         });
         // Embree through the same harness: TBB tasks of 256 rays, single-ray queries.
         const double theirs = best_ms(runs, [&] {
           run_with_threads(threads, [&] {
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-              for (size_t i = r.begin(); i != r.end(); ++i) {
-                if (shadow) blocked[i] = embree.occluded(rays[i]);
-                else t[i] = embree.intersect(rays[i]).t;
-              }
-            });
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 256),
+                              [&](const tbb::blocked_range<size_t>& r) {
+                                for (size_t i = r.begin(); i != r.end(); ++i) {
+                                  if (shadow)
+                                    blocked[i] = embree.occluded(rays[i]);
+                                  else
+                                    t[i] = embree.intersect(rays[i]).t;
+                                }
+                              });
           });
         });
         rows.push_back({c.name, kind, std::to_string(threads), rays.size(), mine, theirs});
@@ -151,18 +151,18 @@ int main(int argc, char** argv) {
   const std::time_t now = std::time(nullptr);
   std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
   md << "# Trace benchmark: TOYRT against Embree " << RTC_VERSION_STRING << "\n\n"
-     << "Written by `make bench-trace` (`build/bench/bench_trace`) on " << date << ": " << cpu_model() << ", "
-     << all << " hardware threads. Best of " << runs << " runs for tracing, each engine in the same process on the "
+     << "Written by `make bench-trace` (`build/bench/bench_trace`) on " << date << ": " << cpu_model() << ", " << all
+     << " hardware threads. Best of " << runs << " runs for tracing, each engine in the same process on the "
      << "same rays; Embree 3 with its default scene flags and build quality, single-ray queries "
-     << "(`rtcIntersect1`/`rtcOccluded1`) through the same TBB harness as TOYRT's batch API. Rays: a "
-     << width << "x" << height << " pinhole camera (primary), one cosine-distributed bounce from each primary hit "
+     << "(`rtcIntersect1`/`rtcOccluded1`) through the same TBB harness as TOYRT's batch API. Rays: a " << width << "x"
+     << height << " pinhole camera (primary), one cosine-distributed bounce from each primary hit "
      << "(diffuse), and one ray from each primary hit to a point light (shadow, any-hit query).\n\n"
      << "## Tracing\n\n| mesh | rays | threads | count | TOYRT Mrays/s | Embree Mrays/s | TOYRT / Embree |\n"
      << "|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
     char line[512];
-    std::snprintf(line, sizeof line, "| %s | %s | %s | %zu | %.2f | %.2f | **%.2f** |\n", r.mesh.c_str(), r.rays.c_str(),
-                  r.threads.c_str(), r.count, r.count / r.toyrt_ms / 1e3, r.count / r.embree_ms / 1e3,
+    std::snprintf(line, sizeof line, "| %s | %s | %s | %zu | %.2f | %.2f | **%.2f** |\n", r.mesh.c_str(),
+                  r.rays.c_str(), r.threads.c_str(), r.count, r.count / r.toyrt_ms / 1e3, r.count / r.embree_ms / 1e3,
                   r.embree_ms / r.toyrt_ms);
     md << line;
   }
@@ -174,7 +174,11 @@ int main(int argc, char** argv) {
   md << "\n## Watertightness\n\nRays from inside a closed mesh aimed exactly at its vertices and edges; "
      << "every one should hit.\n\n| mesh | rays | TOYRT misses | Embree default misses | Embree robust misses |\n"
      << "|---|---|---|---|---|\n";
-  struct Closed { std::string name; MeshData mesh; Vec3 inside; };
+  struct Closed {
+    std::string name;
+    MeshData mesh;
+    Vec3 inside;
+  };
   const Vec3 far_offset(1e5f, -5e4f, 2.5e4f);
   const std::vector<Closed> closed = {
       {"UV sphere, 39,600 triangles", uv_sphere(100, 200), Vec3(0.0f)},
@@ -196,14 +200,18 @@ int main(int argc, char** argv) {
       robust_misses += !robust.intersect(r).found();
     }
     char line[512];
-    std::snprintf(line, sizeof line, "| %s | %zu | **%zu** | %zu (%.2f %%) | %zu (%.3f %%) |\n", c.name.c_str(), rays.size(),
-                  mine, fast_misses, 100.0 * fast_misses / rays.size(), robust_misses, 100.0 * robust_misses / rays.size());
+    std::snprintf(line, sizeof line, "| %s | %zu | **%zu** | %zu (%.2f %%) | %zu (%.3f %%) |\n", c.name.c_str(),
+                  rays.size(), mine, fast_misses, 100.0 * fast_misses / rays.size(), robust_misses,
+                  100.0 * robust_misses / rays.size());
     md << line;
   }
   // Accuracy against a double-precision evaluation on the same float geometry and rays
   // (tests/support/oracle_compare.h classifies every disagreement).
-  md << "\n## Accuracy\n\nPrimary rays (" << width << "x" << height << ") against the double-precision answer on the same float "
-     << "geometry: the largest error of t relative to the hit distance (or to 1 % of the coordinates' magnitude where that is larger, since float positions carry that much absolute error), hits Embree missed although the ray crosses a nearer triangle "
+  md << "\n## Accuracy\n\nPrimary rays (" << width << "x" << height
+     << ") against the double-precision answer on the same float "
+     << "geometry: the largest error of t relative to the hit distance (or to 1 % of the coordinates' magnitude where "
+        "that is larger, since float positions carry that much absolute error), hits Embree missed although the ray "
+        "crosses a nearer triangle "
      << "(leaks), and hits reported where the ray crosses nothing (false hits). TOYRT's own misses and false hits are "
      << "asserted to be zero by `tests/native/embree_oracle_test.cpp`.\n\n"
      << "| mesh | TOYRT max t error | Embree max t error | Embree leaks | Embree false hits | TOYRT errors |\n"

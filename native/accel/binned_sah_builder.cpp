@@ -22,14 +22,20 @@ constexpr int kMedianSplitDepth = kMaxBvhDepth - 34;
 struct RangeBounds {
   BBox box;      // of the primitives
   BBox centers;  // of their centroids
-  void extend(const RangeBounds& o) { box.extend(o.box); centers.extend(o.centers); }
+  void extend(const RangeBounds& o) {
+    box.extend(o.box);
+    centers.extend(o.centers);
+  }
 };
 
 struct Bins {
   std::array<BBox, 3 * kMaxBins> box;
   std::array<uint32_t, 3 * kMaxBins> count{};
   void merge(const Bins& o, int bins) {
-    for (int i = 0; i < 3 * bins; ++i) { box[i].extend(o.box[i]); count[i] += o.count[i]; }
+    for (int i = 0; i < 3 * bins; ++i) {
+      box[i].extend(o.box[i]);
+      count[i] += o.count[i];
+    }
   }
 };
 
@@ -59,9 +65,11 @@ class Builder {
       return acc;
     };
     if (end - begin < cfg_.parallel_threshold) return accumulate({begin, end}, RangeBounds{});
-    return tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(begin, end, 4096), RangeBounds{}, accumulate,
-        [](RangeBounds a, const RangeBounds& b) { a.extend(b); return a; });
+    return tbb::parallel_reduce(tbb::blocked_range<size_t>(begin, end, 4096), RangeBounds{}, accumulate,
+                                [](RangeBounds a, const RangeBounds& b) {
+                                  a.extend(b);
+                                  return a;
+                                });
   }
 
   int bin_of(const Vec3& c, int axis, const BBox& centers, const Vec3& scale) const {
@@ -92,9 +100,11 @@ class Builder {
       return bins;
     };
     if (end - begin < cfg_.parallel_threshold) return accumulate({begin, end}, Bins{});
-    return tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(begin, end, 4096), Bins{}, accumulate,
-        [&](Bins a, const Bins& b) { a.merge(b, kMaxBins); return a; });
+    return tbb::parallel_reduce(tbb::blocked_range<size_t>(begin, end, 4096), Bins{}, accumulate,
+                                [&](Bins a, const Bins& b) {
+                                  a.merge(b, kMaxBins);
+                                  return a;
+                                });
   }
 
   struct Split {
@@ -215,8 +225,7 @@ class Builder {
 
 }  // namespace
 
-Bvh build_binned_sah(const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
-                     const BinnedSahConfig& config) {
+Bvh build_binned_sah(const BBox* prim_bounds, const Vec3* prim_centers, size_t count, const BinnedSahConfig& config) {
   if (count == 0) return {};
   return Builder(prim_bounds, prim_centers, count, config).run();
 }

@@ -49,31 +49,61 @@ std::string Bvh::validate(const BBox* prim_bounds, size_t prim_count) const {
   while (!stack.empty()) {
     auto [i, d] = stack.back();
     stack.pop_back();
-    if (i >= nodes.size()) { err << "child index " << i << " out of range"; return err.str(); }
-    if (reached[i]++) { err << "node " << i << " reached twice"; return err.str(); }
-    if (d > kMaxBvhDepth) { err << "depth " << d << " exceeds " << kMaxBvhDepth; return err.str(); }
+    if (i >= nodes.size()) {
+      err << "child index " << i << " out of range";
+      return err.str();
+    }
+    if (reached[i]++) {
+      err << "node " << i << " reached twice";
+      return err.str();
+    }
+    if (d > kMaxBvhDepth) {
+      err << "depth " << d << " exceeds " << kMaxBvhDepth;
+      return err.str();
+    }
     const Node& n = nodes[i];
     const BBox box = n.bbox();
     if (n.is_leaf()) {
-      if (size_t(n.first) + n.count > prim_ids.size()) { err << "leaf " << i << " out of range"; return err.str(); }
+      if (size_t(n.first) + n.count > prim_ids.size()) {
+        err << "leaf " << i << " out of range";
+        return err.str();
+      }
       for (uint32_t k = n.first; k < n.first + n.count; ++k) {
         const uint32_t p = prim_ids[k];
-        if (p >= prim_count) { err << "primitive id " << p << " out of range"; return err.str(); }
+        if (p >= prim_count) {
+          err << "primitive id " << p << " out of range";
+          return err.str();
+        }
         ++seen[p];
-        if (!box.contains(prim_bounds[p])) { err << "primitive " << p << " outside leaf " << i; return err.str(); }
+        if (!box.contains(prim_bounds[p])) {
+          err << "primitive " << p << " outside leaf " << i;
+          return err.str();
+        }
       }
     } else {
       for (uint32_t c : {n.first, n.first + 1}) {
-        if (c >= nodes.size()) { err << "child index " << c << " out of range"; return err.str(); }
-        if (!box.contains(nodes[c].bbox())) { err << "child " << c << " outside parent " << i; return err.str(); }
+        if (c >= nodes.size()) {
+          err << "child index " << c << " out of range";
+          return err.str();
+        }
+        if (!box.contains(nodes[c].bbox())) {
+          err << "child " << c << " outside parent " << i;
+          return err.str();
+        }
         stack.push_back({c, d + 1});
       }
     }
   }
   for (size_t i = 0; i < nodes.size(); ++i)
-    if (!reached[i]) { err << "node " << i << " unreachable"; return err.str(); }
+    if (!reached[i]) {
+      err << "node " << i << " unreachable";
+      return err.str();
+    }
   for (size_t p = 0; p < prim_count; ++p)
-    if (seen[p] != 1) { err << "primitive " << p << " in " << seen[p] << " leaves"; return err.str(); }
+    if (seen[p] != 1) {
+      err << "primitive " << p << " in " << seen[p] << " leaves";
+      return err.str();
+    }
   return "";
 }
 

@@ -5,8 +5,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <numeric>
 
 namespace toyrt {
@@ -141,8 +141,8 @@ namespace {
 
 // Runs the kernels. Fills `hierarchy` (Karras nodes and parents, and the keys when asked) and/or
 // `bvh` (the flat nodes written on the device), whichever is non-null.
-void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config,
-                LbvhStats* stats, LbvhHierarchy* hierarchy, bool with_keys, Bvh* bvh) {
+void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config, LbvhStats* stats,
+                LbvhHierarchy* hierarchy, bool with_keys, Bvh* bvh) {
   using namespace opencl;
   if (count >= size_t(INT32_MAX) / 2) throw OpenClError("LBVH: more than 2^30 primitives");
   const Device& dev = device();
@@ -195,10 +195,17 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
   Buffer keys[2] = {Buffer(count * sizeof(uint64_t)), Buffer(count * sizeof(uint64_t))};
   Buffer values[2] = {Buffer(count * sizeof(uint32_t)), Buffer(count * sizeof(uint32_t))};
   Kernel(prog.program, "morton_codes")
-      .arg(0, centers_buf.get()).arg(1, n)
-      .arg(2, frame.lo.x).arg(3, frame.lo.y).arg(4, frame.lo.z)
-      .arg(5, frame.scale.x).arg(6, frame.scale.y).arg(7, frame.scale.z)
-      .arg(8, cl_uint(frame.bits)).arg(9, keys[0].get()).arg(10, values[0].get())
+      .arg(0, centers_buf.get())
+      .arg(1, n)
+      .arg(2, frame.lo.x)
+      .arg(3, frame.lo.y)
+      .arg(4, frame.lo.z)
+      .arg(5, frame.scale.x)
+      .arg(6, frame.scale.y)
+      .arg(7, frame.scale.z)
+      .arg(8, cl_uint(frame.bits))
+      .arg(9, keys[0].get())
+      .arg(10, values[0].get())
       .run(count);
   stage("morton codes");
 
@@ -213,8 +220,14 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
   for (cl_uint shift = 0; shift < key_bits; shift += 8, in ^= 1) {
     histogram.arg(0, keys[in].get()).arg(1, n).arg(2, shift).arg(3, block).arg(4, hist.get()).run(blocks);
     scan.arg(0, hist.get()).arg(1, cl_uint(256 * blocks)).run(1);
-    scatter.arg(0, keys[in].get()).arg(1, values[in].get()).arg(2, n).arg(3, shift).arg(4, block)
-        .arg(5, hist.get()).arg(6, keys[in ^ 1].get()).arg(7, values[in ^ 1].get())
+    scatter.arg(0, keys[in].get())
+        .arg(1, values[in].get())
+        .arg(2, n)
+        .arg(3, shift)
+        .arg(4, block)
+        .arg(5, hist.get())
+        .arg(6, keys[in ^ 1].get())
+        .arg(7, values[in ^ 1].get())
         .run(blocks);
   }
   stage("radix sort");
@@ -234,7 +247,11 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
   Buffer nodes(internal * sizeof(LbvhNode)), internal_parent(internal * sizeof(cl_int)),
       leaf_parent(count * sizeof(cl_int)), flags(internal * sizeof(cl_int));
   Kernel(prog.program, "emit_hierarchy")
-      .arg(0, keys[in].get()).arg(1, n).arg(2, nodes.get()).arg(3, internal_parent.get()).arg(4, leaf_parent.get())
+      .arg(0, keys[in].get())
+      .arg(1, n)
+      .arg(2, nodes.get())
+      .arg(3, internal_parent.get())
+      .arg(4, leaf_parent.get())
       .run(internal);
   stage("hierarchy");
 
@@ -243,12 +260,19 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
   Buffer bounds_buf(count * sizeof(BBox), CL_MEM_READ_ONLY, prim_bounds);
   Buffer sorted_bounds(count * sizeof(BBox));
   Kernel(prog.program, "gather_bounds")
-      .arg(0, bounds_buf.get()).arg(1, values[in].get()).arg(2, n).arg(3, sorted_bounds.get())
+      .arg(0, bounds_buf.get())
+      .arg(1, values[in].get())
+      .arg(2, n)
+      .arg(3, sorted_bounds.get())
       .run(count);
   flags.fill_zero(internal * sizeof(cl_int));
   Kernel(prog.program, "propagate_bounds")
-      .arg(0, sorted_bounds.get()).arg(1, n).arg(2, nodes.get())
-      .arg(3, internal_parent.get()).arg(4, leaf_parent.get()).arg(5, flags.get())
+      .arg(0, sorted_bounds.get())
+      .arg(1, n)
+      .arg(2, nodes.get())
+      .arg(3, internal_parent.get())
+      .arg(4, leaf_parent.get())
+      .arg(5, flags.get())
       .run(count);
   stage("bounds");
 
@@ -257,8 +281,12 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
     const size_t bytes = bvh->nodes.size() * sizeof(Node);
     Buffer flat(bytes, CL_MEM_WRITE_ONLY, bvh->nodes.data());  // written in place where the device can
     Kernel(prog.program, "write_bvh_nodes")
-        .arg(0, nodes.get()).arg(1, internal_parent.get()).arg(2, leaf_parent.get()).arg(3, sorted_bounds.get())
-        .arg(4, n).arg(5, flat.get())
+        .arg(0, nodes.get())
+        .arg(1, internal_parent.get())
+        .arg(2, leaf_parent.get())
+        .arg(3, sorted_bounds.get())
+        .arg(4, n)
+        .arg(5, flat.get())
         .run(2 * count - 1);
     flat.sync_to_host(bytes);
     bvh->prim_ids = order;
@@ -298,7 +326,10 @@ Bvh to_bvh(const LbvhHierarchy& h, const BBox* prim_bounds) {
     return bvh;
   }
   // The same placement as the write_bvh_nodes kernel.
-  auto split_of = [&](int32_t p) { const int32_t l = h.nodes[size_t(p)].left; return uint32_t(l >= 0 ? l : ~l); };
+  auto split_of = [&](int32_t p) {
+    const int32_t l = h.nodes[size_t(p)].left;
+    return uint32_t(l >= 0 ? l : ~l);
+  };
   auto slot = [&](int32_t p, int32_t child) {
     return 1u + 2u * split_of(p) + (h.nodes[size_t(p)].right == child ? 1u : 0u);
   };
@@ -318,8 +349,7 @@ Bvh to_bvh(const LbvhHierarchy& h, const BBox* prim_bounds) {
   return bvh;
 }
 
-Bvh build_lbvh(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config,
-               LbvhStats* stats) {
+Bvh build_lbvh(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config, LbvhStats* stats) {
   const auto start = std::chrono::steady_clock::now();
   Bvh bvh;
   run_opencl(prim_bounds, centers, count, config, stats, nullptr, false, &bvh);

@@ -40,8 +40,7 @@ struct LbvhHierarchy {
 // OpenCL build; throws opencl::OpenClError when there is no device or the kernels fail to build.
 // The sorted keys are read back only when with_keys (tests compare them with the reference).
 LbvhHierarchy build_lbvh_hierarchy_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count,
-                                          const LbvhConfig& config, LbvhStats* stats = nullptr,
-                                          bool with_keys = false);
+                                          const LbvhConfig& config, LbvhStats* stats = nullptr, bool with_keys = false);
 // The same construction on the CPU, single-threaded: the reference the kernels are checked by.
 LbvhHierarchy build_lbvh_hierarchy_reference(const BBox* prim_bounds, const Vec3* centers, size_t count,
                                              const LbvhConfig& config);

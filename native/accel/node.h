@@ -19,8 +19,12 @@ struct Node {
   bool is_leaf() const { return count != 0; }
   BBox bbox() const { return {{bounds[0], bounds[1], bounds[2]}, {bounds[3], bounds[4], bounds[5]}}; }
   void set_bbox(const BBox& b) {
-    bounds[0] = b.lo.x; bounds[1] = b.lo.y; bounds[2] = b.lo.z;
-    bounds[3] = b.hi.x; bounds[4] = b.hi.y; bounds[5] = b.hi.z;
+    bounds[0] = b.lo.x;
+    bounds[1] = b.lo.y;
+    bounds[2] = b.lo.z;
+    bounds[3] = b.hi.x;
+    bounds[4] = b.hi.y;
+    bounds[5] = b.hi.z;
   }
 };
 static_assert(sizeof(Node) == 32, "Node must stay 32 bytes: two per cache line");

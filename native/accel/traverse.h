@@ -17,7 +17,10 @@ inline bool traverse(const Bvh& bvh, const RayBoxData& ray, float tnear, float& 
   const Node* nodes = bvh.nodes.data();
   if (intersect_box(ray, nodes[0].bounds, tnear, tfar) == kInfinity) return false;
 
-  struct Entry { uint32_t node; float tentry; };
+  struct Entry {
+    uint32_t node;
+    float tentry;
+  };
   Entry stack[kMaxBvhDepth];
   int sp = 0;
   uint32_t current = 0;

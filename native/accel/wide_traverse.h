@@ -55,7 +55,10 @@ inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear
   const vfloat widen = splat(1.0f + 2.0f * gamma(3)), shrink = splat(1.0f - 2.0f * gamma(3));
   const bool negative_start = tnear < 0.0f;
 
-  struct Entry { uint32_t child, count; float tentry; };
+  struct Entry {
+    uint32_t child, count;
+    float tentry;
+  };
   Entry stack[(kWidth - 1) * kMaxBvhDepth + 1];
   int sp = 0;
   Entry current{0, 0, tnear};

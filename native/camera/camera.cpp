@@ -32,8 +32,7 @@ Camera Camera::make(const CameraParams& p) {
     require(finite_positive(p.ortho_scale), "ortho_scale must be positive and finite");
   }
   require(std::isfinite(p.shift_x) && std::isfinite(p.shift_y), "shift_x and shift_y must be finite");
-  require(std::isfinite(p.clip_start) && std::isfinite(p.clip_end) && p.clip_start >= 0.0f &&
-              p.clip_end > p.clip_start,
+  require(std::isfinite(p.clip_start) && std::isfinite(p.clip_end) && p.clip_start >= 0.0f && p.clip_end > p.clip_start,
           "clipping needs 0 <= clip_start < clip_end, both finite");
   for (int c = 0; c < 4; ++c)
     for (int r = 0; r < 4; ++r) require(std::isfinite(p.matrix_world[c][r]), "matrix_world is not finite");

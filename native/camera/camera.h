@@ -5,9 +5,9 @@
 //
 // Pixel coordinates: continuous (px, py) with px in [0, width) from the left and py in
 // [0, height) from the TOP row, the order images are stored in memory here; pixel (i, j) covers
-// [i, i + 1) x [j, j + 1), so its centre is (i + 0.5, j + 0.5). Blender's RenderResult (and
-// Image.pixels) store rows bottom-up: the integrator writes row j of this camera to Blender's
-// row height - 1 - j.
+// [i, i + 1) x [j, j + 1), so its centre is (i + 0.5, j + 0.5). render() returns rows in this
+// order too; Blender's RenderResult (and Image.pixels) store rows bottom-up, so the add-on flips
+// them (addon/render_toyrt/engine.py and viewport.py, pixels[::-1]) when it hands them over.
 #pragma once
 
 #include "core/math.h"
@@ -29,9 +29,9 @@ struct CameraParams {
   float sensor_width = 36.0f;   // mm
   float sensor_height = 24.0f;  // mm (used by VERTICAL fit only)
   SensorFit sensor_fit = SensorFit::Auto;
-  float shift_x = 0.0f, shift_y = 0.0f;  // fractions of the fitted (AUTO: larger) image dimension
+  float shift_x = 0.0f, shift_y = 0.0f;        // fractions of the fitted (AUTO: larger) image dimension
   float clip_start = 0.1f, clip_end = 100.0f;  // distances along the view axis, m
-  float ortho_scale = 6.0f;     // extent of the fitted dimension, m (orthographic)
+  float ortho_scale = 6.0f;                    // extent of the fitted dimension, m (orthographic)
   int resolution_x = 1920, resolution_y = 1080, resolution_percentage = 100;
   float pixel_aspect_x = 1.0f, pixel_aspect_y = 1.0f;
   bool use_border = false;  // render only the border region (Blender's border_min/max, y from the bottom)

@@ -11,8 +11,14 @@ struct BBox {
   Vec3 lo{kInfinity};
   Vec3 hi{-kInfinity};
 
-  void extend(const Vec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
-  void extend(const BBox& b) { lo = glm::min(lo, b.lo); hi = glm::max(hi, b.hi); }
+  void extend(const Vec3& p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  void extend(const BBox& b) {
+    lo = glm::min(lo, b.lo);
+    hi = glm::max(hi, b.hi);
+  }
   bool empty() const { return lo.x > hi.x || lo.y > hi.y || lo.z > hi.z; }
   // Halved before the sum, so boxes near +-FLT_MAX have a finite centre (halving is exact).
   Vec3 center() const { return 0.5f * lo + 0.5f * hi; }
@@ -24,17 +30,16 @@ struct BBox {
     return e.x * e.y + e.y * e.z + e.z * e.x;
   }
   bool contains(const BBox& b) const {
-    return b.lo.x >= lo.x && b.lo.y >= lo.y && b.lo.z >= lo.z &&
-           b.hi.x <= hi.x && b.hi.y <= hi.y && b.hi.z <= hi.z;
+    return b.lo.x >= lo.x && b.lo.y >= lo.y && b.lo.z >= lo.z && b.hi.x <= hi.x && b.hi.y <= hi.y && b.hi.z <= hi.z;
   }
 };
 
 // Per-ray data precomputed once for all box tests of a traversal.
 struct RayBoxData {
   Vec3 org;
-  Vec3 inv_dir;   // 1/dir; +-inf where a component is +-0 (IEEE division keeps the sign of zero)
-  int near[3];    // index of the near plane per axis in a {lo.x, lo.y, lo.z, hi.x, hi.y, hi.z} array
-  int far[3];     // index of the far plane: near[a] +- 3
+  Vec3 inv_dir;  // 1/dir; +-inf where a component is +-0 (IEEE division keeps the sign of zero)
+  int near[3];   // index of the near plane per axis in a {lo.x, lo.y, lo.z, hi.x, hi.y, hi.z} array
+  int far[3];    // index of the far plane: near[a] +- 3
 };
 
 inline RayBoxData make_ray_box_data(const Vec3& org, const Vec3& dir) {

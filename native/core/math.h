@@ -29,12 +29,8 @@ inline constexpr float gamma(int n) {
 inline float safe_max(float value, float candidate) { return candidate > value ? candidate : value; }
 inline float safe_min(float value, float candidate) { return candidate < value ? candidate : value; }
 
-inline int max_dimension(const Vec3& v) {
-  return v.x > v.y ? (v.x > v.z ? 0 : 2) : (v.y > v.z ? 1 : 2);
-}
+inline int max_dimension(const Vec3& v) { return v.x > v.y ? (v.x > v.z ? 0 : 2) : (v.y > v.z ? 1 : 2); }
 
-inline bool is_finite(const Vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
+inline bool is_finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 }  // namespace toyrt

@@ -19,8 +19,7 @@ bool is_degenerate(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
 
 Mesh::Mesh(std::vector<Vec3> vertices, std::vector<Triangle> triangles)
     : vertices_(std::move(vertices)), triangles_(std::move(triangles)) {
-  if (triangles_.size() >= size_t(INT32_MAX))
-    throw std::invalid_argument("a mesh holds at most 2^31 - 1 triangles");
+  if (triangles_.size() >= size_t(INT32_MAX)) throw std::invalid_argument("a mesh holds at most 2^31 - 1 triangles");
   for (size_t i = 0; i < vertices_.size(); ++i) {
     if (!is_finite(vertices_[i]))
       throw std::invalid_argument("vertex " + std::to_string(i) + " is not finite (NaN or inf)");
@@ -57,20 +56,12 @@ void Mesh::prepare(std::vector<BBox>& boxes, std::vector<Vec3>& centers, std::ve
   }
 }
 
-void Mesh::build(const BinnedSahConfig& config) {
+void Mesh::build(BuilderKind kind, const BuildConfig& config, BuildStats* stats) {
   std::vector<BBox> boxes;
   std::vector<Vec3> centers;
   std::vector<uint32_t> valid;
   prepare(boxes, centers, valid);
-  finish(build_binned_sah(boxes.data(), centers.data(), boxes.size(), config), valid);
-}
-
-void Mesh::build_lbvh(const LbvhConfig& config, LbvhStats* stats) {
-  std::vector<BBox> boxes;
-  std::vector<Vec3> centers;
-  std::vector<uint32_t> valid;
-  prepare(boxes, centers, valid);
-  finish(toyrt::build_lbvh(boxes.data(), centers.data(), boxes.size(), config, stats), valid);
+  finish(build_bvh(kind, boxes.data(), centers.data(), boxes.size(), config, stats), valid);
 }
 
 void Mesh::finish(Bvh bvh, const std::vector<uint32_t>& valid) {
@@ -104,8 +95,7 @@ void Mesh::finish(Bvh bvh, const std::vector<uint32_t>& valid) {
 }
 
 template <bool AnyHit>
-bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v,
-                 int32_t& prim) const {
+bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim) const {
   // A valid world ray can overflow in an instance's object space (a huge inverse scale): with a
   // NaN in every inverse direction component, each slab test keeps its NaN-free bounds, so even
   // the empty slots of a wide node "hit" and send the walk back to the root until its stack
@@ -117,25 +107,27 @@ bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, flo
   const TriangleBlock* blocks = blocks_.data();
   uint32_t found_block = 0;
   int found_lane = 0;
-  const bool found = traverse_wide<AnyHit>(wide_, box_ray, tnear, tfar, [&](uint32_t first, uint32_t count, float& t_max) {
-    bool hit = false;
-    const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
-    for (uint32_t k = first; k < end; ++k) {
-      hit |= intersect_block<AnyHit>(tri_ray, blocks[k], tnear, t_max, [&](int lane, float t) {
-        if (t < t_max) {
-          t_max = t;
-          found_block = k;
-          found_lane = lane;
+  const bool found =
+      traverse_wide<AnyHit>(wide_, box_ray, tnear, tfar, [&](uint32_t first, uint32_t count, float& t_max) {
+        bool hit = false;
+        const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
+        for (uint32_t k = first; k < end; ++k) {
+          hit |= intersect_block<AnyHit>(tri_ray, blocks[k], tnear, t_max, [&](int lane, float t) {
+            if (t < t_max) {
+              t_max = t;
+              found_block = k;
+              found_lane = lane;
+            }
+          });
+          if (AnyHit && hit) return true;
         }
+        return hit;
       });
-      if (AnyHit && hit) return true;
-    }
-    return hit;
-  });
   if constexpr (!AnyHit) {
     if (found) {
       const TriangleBlock& b = blocks[found_block];
-      refine_hit(org, dir, b.vertex(found_lane, 0), b.vertex(found_lane, 1), b.vertex(found_lane, 2), tnear, tfar, u, v);
+      refine_hit(org, dir, b.vertex(found_lane, 0), b.vertex(found_lane, 1), b.vertex(found_lane, 2), tnear, tfar, u,
+                 v);
       // The float test put the hit before the segment's end, but its double-precision distance
       // can round onto it (t = tfar = 0 in the fuzzer's case): keep the promise t < tfar. A hit
       // implies tnear < segment_end, so the result stays >= tnear.

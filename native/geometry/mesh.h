@@ -1,8 +1,7 @@
 // A triangle mesh stored once in object space, with its own BVH; instances refer to it by id.
 #pragma once
 
-#include "accel/binned_sah_builder.h"
-#include "accel/lbvh_builder.h"
+#include "accel/builder.h"
 #include "accel/wide_bvh.h"
 #include "geometry/triangle_block.h"
 
@@ -20,16 +19,14 @@ class Mesh {
   // a triangle of zero area.
   Mesh(std::vector<Vec3> vertices, std::vector<Triangle> triangles);
 
-  // Builds (or rebuilds) the BVH with the SAH builder; runs on the caller's TBB arena.
-  void build(const BinnedSahConfig& config = {});
-  // Builds with the LBVH kernels (OpenCL); throws opencl::OpenClError if they cannot run, leaving
-  // the mesh unbuilt.
-  void build_lbvh(const LbvhConfig& config, LbvhStats* stats = nullptr);
+  // Builds (or rebuilds) the BVH over the triangles that can be hit with build_bvh() (the one
+  // builder entry point: Auto, the LBVH fallback and the cancel flag behave as there); runs on
+  // the caller's TBB arena. A cancelled build throws BuildCancelled and leaves the mesh unbuilt.
+  void build(BuilderKind kind = BuilderKind::Sah, const BuildConfig& config = {}, BuildStats* stats = nullptr);
   bool built() const { return built_; }
 
   // Closest hit within [tnear, tfar): shrinks tfar and writes u, v, prim on a hit.
-  bool intersect(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v,
-                 int32_t& prim) const;
+  bool intersect(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim) const;
   // Any hit within [tnear, tfar).
   bool occluded(const Vec3& org, const Vec3& dir, float tnear, float tfar) const;
 
@@ -37,7 +34,6 @@ class Mesh {
   const std::vector<Triangle>& triangles() const { return triangles_; }
   const Bvh& bvh() const { return bvh_; }
   const BBox& bounds() const { return bounds_; }
-  size_t degenerate_count() const { return triangles_.size() - bvh_.prim_ids.size(); }
   // Bytes held by this mesh (input arrays, BVH and leaf triangles).
   size_t memory_bytes() const;
 
@@ -48,8 +44,7 @@ class Mesh {
   void finish(Bvh bvh, const std::vector<uint32_t>& valid);
 
   template <bool AnyHit>
-  bool trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v,
-             int32_t& prim) const;
+  bool trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim) const;
 
   std::vector<Vec3> vertices_;
   std::vector<Triangle> triangles_;

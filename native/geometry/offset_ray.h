@@ -15,9 +15,9 @@ namespace toyrt {
 // leaves into (flip it for rays going through the surface). n need not be normalised but should
 // be of unit order.
 inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& n) {
-  constexpr float kOrigin = 1.0f / 32.0f;      // below this |coordinate|, offset by distance
+  constexpr float kOrigin = 1.0f / 32.0f;  // below this |coordinate|, offset by distance
   constexpr float kFloatScale = 1.0f / 65536.0f;
-  constexpr float kIntScale = 256.0f;          // ulps per unit of normal
+  constexpr float kIntScale = 256.0f;  // ulps per unit of normal
   Vec3 out;
   for (int a = 0; a < 3; ++a) {
     // A non-finite or huge normal would overflow the conversion (undefined behaviour): no step.

@@ -16,8 +16,8 @@ namespace toyrt {
 // Per-ray constants of the shear transform, computed once per traversal.
 struct WatertightRay {
   Vec3 org, dir;
-  int kx, ky, kz;      // axis permutation: kz is the dominant direction axis
-  float sx, sy, sz;    // shear and scale that map the direction to (0, 0, 1)
+  int kx, ky, kz;    // axis permutation: kz is the dominant direction axis
+  float sx, sy, sz;  // shear and scale that map the direction to (0, 0, 1)
 };
 
 inline WatertightRay make_watertight_ray(const Vec3& org, const Vec3& dir) {
@@ -40,8 +40,8 @@ inline WatertightRay make_watertight_ray(const Vec3& org, const Vec3& dir) {
 // section 6.8.4: errors of the translated and sheared coordinates, then of the edge functions,
 // then of their weighted sum). A hit whose T is within this bound of tnear may really be behind
 // the ray's start; those few are decided in double.
-inline float near_start_error(float ax, float ay, float bx, float by, float cx, float cy, float az, float bz,
-                              float cz, float eu, float ev, float ew) {
+inline float near_start_error(float ax, float ay, float bx, float by, float cx, float cy, float az, float bz, float cz,
+                              float eu, float ev, float ew) {
   const float max_z = std::max({std::fabs(az), std::fabs(bz), std::fabs(cz)});
   const float max_x = std::max({std::fabs(ax), std::fabs(bx), std::fabs(cx)});
   const float max_y = std::max({std::fabs(ay), std::fabs(by), std::fabs(cy)});
@@ -55,8 +55,9 @@ inline float near_start_error(float ax, float ay, float bx, float by, float cx, 
 // The hit test for a candidate whose float distance is too close to tnear to trust: the plane
 // crossing in double precision (Moller-Trumbore on the same float inputs). The float test has
 // already placed the ray inside the triangle, so only the distance is decided here.
-[[gnu::noinline, gnu::cold]] inline bool near_start_in_double(const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2, float tnear,
-                                 float tfar, float& t, float& u, float& v) {
+[[gnu::noinline, gnu::cold]] inline bool near_start_in_double(const WatertightRay& r, const Vec3& p0, const Vec3& p1,
+                                                              const Vec3& p2, float tnear, float tfar, float& t,
+                                                              float& u, float& v) {
   const DVec3 o(r.org), d(r.dir), a(p0);
   const DVec3 e1 = DVec3(p1) - a, e2 = DVec3(p2) - a;
   const DVec3 pv = glm::cross(d, e2);
@@ -76,7 +77,7 @@ inline float near_start_error(float ax, float ay, float bx, float by, float cx, 
 // zero only when the products are equal), so these signs are the true ones. Returns whether the
 // signs agree (the ray passes inside or on the boundary), and writes the values back.
 [[gnu::noinline, gnu::cold]] inline bool edge_signs_in_double(float ax, float ay, float bx, float by, float cx,
-                                                                float cy, float& eu, float& ev, float& ew) {
+                                                              float cy, float& eu, float& ev, float& ew) {
   const double du = double(cx) * double(by) - double(cy) * double(bx);
   const double dv = double(ax) * double(cy) - double(ay) * double(cx);
   const double dw = double(bx) * double(ay) - double(by) * double(ax);
@@ -90,8 +91,9 @@ inline float near_start_error(float ax, float ay, float bx, float by, float cx, 
 // Tests the triangle against the ray segment [tnear, tfar). On a hit, writes t and the
 // barycentrics u, v with p = (1 - u - v) p0 + u p1 + v p2, and returns true. Both faces count.
 // A degenerate (zero-area) triangle never hits: its determinant is zero.
-[[gnu::always_inline]] inline bool intersect_triangle(const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2,
-                               float tnear, float tfar, float& t, float& u, float& v) {
+[[gnu::always_inline]] inline bool intersect_triangle(const WatertightRay& r, const Vec3& p0, const Vec3& p1,
+                                                      const Vec3& p2, float tnear, float tfar, float& t, float& u,
+                                                      float& v) {
   const Vec3 a = p0 - r.org, b = p1 - r.org, c = p2 - r.org;
   const float ax = a[r.kx] - r.sx * a[r.kz], ay = a[r.ky] - r.sy * a[r.kz];
   const float bx = b[r.kx] - r.sx * b[r.kz], by = b[r.ky] - r.sy * b[r.kz];
@@ -138,8 +140,8 @@ inline float near_start_error(float ax, float ay, float bx, float by, float cx, 
 // hit that rounding let in they may lie outside [0, 1] by as much as the point lies outside the
 // triangle (a distance of rounding size, though on a sliver that is a visible fraction of its
 // narrow barycentric range); clamping them would move the point along the sliver instead.
-inline void refine_hit(const Vec3& org, const Vec3& dir, const Vec3& p0, const Vec3& p1, const Vec3& p2,
-                       float tnear, float& t, float& u, float& v) {
+inline void refine_hit(const Vec3& org, const Vec3& dir, const Vec3& p0, const Vec3& p1, const Vec3& p2, float tnear,
+                       float& t, float& u, float& v) {
   const DVec3 o(org), d(dir), a(p0);
   const DVec3 e1 = DVec3(p1) - a, e2 = DVec3(p2) - a;
   const DVec3 pv = glm::cross(d, e2);

@@ -47,7 +47,8 @@ using simd::mask_of;
 // (nearest lanes are not sorted; the caller keeps the minimum); with AnyHit the first ends it.
 // Returns whether any lane was hit.
 template <bool AnyHit, class OnHit>
-[[gnu::always_inline]] inline bool intersect_block(const WatertightRay& r, const TriangleBlock& b, float tnear, float tfar, OnHit&& hit) {
+[[gnu::always_inline]] inline bool intersect_block(const WatertightRay& r, const TriangleBlock& b, float tnear,
+                                                   float tfar, OnHit&& hit) {
   using namespace simd4;
   const vfloat ox = splat(r.org[r.kx]), oy = splat(r.org[r.ky]), oz = splat(r.org[r.kz]);
   const vfloat sx = splat(r.sx), sy = splat(r.sy), sz = splat(r.sz);
@@ -84,7 +85,8 @@ template <bool AnyHit, class OnHit>
   const vfloat max_e = max(max(abs(eu), abs(ev)), abs(ew));
   const vfloat delta_x = splat(gamma(5)) * (max_x + max_z), delta_y = splat(gamma(5)) * (max_y + max_z);
   const vfloat delta_e = splat(2.0f) * (splat(gamma(2)) * max_x * max_y + delta_y * max_x + delta_x * max_y);
-  const vfloat error = splat(3.0f) * (splat(gamma(3)) * max_e * max_z + delta_e * max_z + splat(gamma(3)) * max_z * max_e);
+  const vfloat error =
+      splat(3.0f) * (splat(gamma(3)) * max_e * max_z + delta_e * max_z + splat(gamma(3)) * max_z * max_e);
   const vint clear_of_start = signed_t - splat(tnear) * abs_det > error;
 
   // Lanes the vector test decides, and lanes that need the scalar test's double precision.

@@ -13,8 +13,8 @@ void require(bool ok, const char* message) {
   if (!ok) throw std::invalid_argument(std::string("area light: ") + message);
 }
 
-bool use_solid_angle(const AreaLight& light) {
-  return light.sampling == AreaSampling::SolidAngle && light.is_rectangle();
+bool use_solid_angle(const AreaLight& light, AreaSampling sampling) {
+  return sampling == AreaSampling::SolidAngle && light.is_rectangle();
 }
 
 // Density of area sampling, converted to solid angle.
@@ -24,8 +24,7 @@ float area_pdf(const AreaLight& light, float distance, float cos_light) {
 
 }  // namespace
 
-AreaLight AreaLight::make(AreaShape shape, float size, float size_y, const Mat4& m, float power, const Vec3& color,
-                          AreaSampling sampling) {
+AreaLight AreaLight::make(AreaShape shape, float size, float size_y, const Mat4& m, float power, const Vec3& color) {
   const bool square = shape == AreaShape::Square || shape == AreaShape::Disk;
   const float sx = size, sy = square ? size : size_y;
   require(std::isfinite(sx) && std::isfinite(sy) && sx > 0.0f && sy > 0.0f, "size must be positive and finite");
@@ -45,7 +44,6 @@ AreaLight AreaLight::make(AreaShape shape, float size, float size_y, const Mat4&
 
   AreaLight light;
   light.shape = shape;
-  light.sampling = sampling;
   light.center = Vec3(m[3]);
   light.edge_x = sx * ax;
   light.edge_y = sy * ay;
@@ -56,13 +54,13 @@ AreaLight AreaLight::make(AreaShape shape, float size, float size_y, const Mat4&
   return light;
 }
 
-LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u) {
+LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u, AreaSampling sampling) {
   LightSample s;
   if (!(glm::dot(p - light.center, light.normal) > 0.0f)) return s;  // one-sided
   float pdf = 0.0f;
   Vec3 q;
   bool by_area = true;
-  if (use_solid_angle(light)) {
+  if (use_solid_angle(light, sampling)) {
     const SphericalRectangle rect = SphericalRectangle::make(p, light.corner(), light.edge_x, light.edge_y);
     if (rect.solid_angle >= SphericalRectangle::kMinSolidAngle) {
       q = rect.sample(u);
@@ -88,7 +86,7 @@ LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u) {
   return s;
 }
 
-LightEval evaluate(const AreaLight& light, const Vec3& p, const Vec3& wi) {
+LightEval evaluate(const AreaLight& light, const Vec3& p, const Vec3& wi, AreaSampling sampling) {
   LightEval e;
   const float height = glm::dot(p - light.center, light.normal);
   const float cos_light = -glm::dot(wi, light.normal);
@@ -102,7 +100,7 @@ LightEval evaluate(const AreaLight& light, const Vec3& p, const Vec3& wi) {
   e.radiance = light.radiance;
   e.distance = t;
   e.pdf = area_pdf(light, t, cos_light);
-  if (use_solid_angle(light)) {
+  if (use_solid_angle(light, sampling)) {
     const double omega = SphericalRectangle::make(p, light.corner(), light.edge_x, light.edge_y).solid_angle;
     if (omega >= SphericalRectangle::kMinSolidAngle) e.pdf = float(1.0 / omega);
   }
@@ -135,6 +133,39 @@ float importance(const AreaLight& light, const Vec3& p, const Vec3& n) {
   }
   const float mean_intensity = (light.radiance.x + light.radiance.y + light.radiance.z) / 3.0f * light.area;
   return mean_intensity * cos_emit * cos_receive / std::max(d2, r2);
+}
+
+AreaShape parse_area_shape(const std::string& name) {
+  if (name == "RECTANGLE") return AreaShape::Rectangle;
+  if (name == "SQUARE") return AreaShape::Square;
+  if (name == "DISK") return AreaShape::Disk;
+  if (name == "ELLIPSE") return AreaShape::Ellipse;
+  throw std::invalid_argument("area light shape must be 'RECTANGLE', 'SQUARE', 'DISK' or 'ELLIPSE', got '" + name +
+                              "'");
+}
+
+const char* area_shape_name(AreaShape shape) {
+  switch (shape) {
+    case AreaShape::Rectangle:
+      return "RECTANGLE";
+    case AreaShape::Square:
+      return "SQUARE";
+    case AreaShape::Disk:
+      return "DISK";
+    case AreaShape::Ellipse:
+      return "ELLIPSE";
+  }
+  return "?";
+}
+
+AreaSampling parse_area_sampling(const std::string& name) {
+  if (name == "solid_angle") return AreaSampling::SolidAngle;
+  if (name == "area") return AreaSampling::Area;
+  throw std::invalid_argument("area_light_sampling must be 'solid_angle' or 'area', got '" + name + "'");
+}
+
+const char* area_sampling_name(AreaSampling sampling) {
+  return sampling == AreaSampling::SolidAngle ? "solid_angle" : "area";
 }
 
 }  // namespace toyrt

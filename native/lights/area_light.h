@@ -8,10 +8,14 @@
 // light up dims its radiance.
 //
 // Sampling: rectangles and squares by either estimator (AreaSampling), disks and ellipses by area.
+// The estimator is a render setting (IntegratorSettings::area_sampling), passed to sample() and
+// evaluate(), not part of the light: one scene renders with either without being copied.
 #pragma once
 
 #include "lights/light_sample.h"
 #include "sampling/warp.h"
+
+#include <string>
 
 namespace toyrt {
 
@@ -22,29 +26,45 @@ enum class AreaSampling { Area, SolidAngle };
 
 struct AreaLight {
   AreaShape shape = AreaShape::Rectangle;
-  AreaSampling sampling = AreaSampling::SolidAngle;
   Vec3 center{0.0f};
   Vec3 edge_x{1.0f, 0.0f, 0.0f}, edge_y{0.0f, 1.0f, 0.0f};  // full extents along local x and y (orthogonal)
-  Vec3 normal{0.0f, 0.0f, -1.0f};  // unit, the emitting side
-  float area = 1.0f;               // m^2 (pi/4 |edge_x| |edge_y| for disks and ellipses)
-  Vec3 radiance{0.0f};             // L = P colour / (4 area), W / (m^2 sr)
+  Vec3 normal{0.0f, 0.0f, -1.0f};                           // unit, the emitting side
+  float area = 1.0f;                                        // m^2 (pi/4 |edge_x| |edge_y| for disks and ellipses)
+  Vec3 radiance{0.0f};                                      // L = P colour / (4 area), W / (m^2 sr)
 
   // Blender's settings: shape; size (and size_y for RECTANGLE and ELLIPSE; SQUARE and DISK use
   // size for both, a disk's size being its diameter); the object's world matrix; power (W);
   // colour. Throws std::invalid_argument for non-positive sizes, negative power or colour, a
   // non-finite or non-affine matrix, a zero or sheared scale (the light must stay a rectangle).
   static AreaLight make(AreaShape shape, float size, float size_y, const Mat4& matrix_world, float power,
-                        const Vec3& color, AreaSampling sampling = AreaSampling::SolidAngle);
+                        const Vec3& color);
 
   bool is_rectangle() const { return shape == AreaShape::Rectangle || shape == AreaShape::Square; }
   Vec3 corner() const { return center - 0.5f * edge_x - 0.5f * edge_y; }
 };
 
+// What an area light is when the caller does not say (the Python binding's argument defaults):
+// Blender's new area light, a 1 m square of 10 W, white.
+struct AreaLightDefaults {
+  AreaShape shape = AreaShape::Square;
+  float size = 1.0f;    // m
+  float power = 10.0f;  // W
+  Vec3 color{1.0f};
+};
+
 // A point on the light seen from shading point p (u: two uniform numbers). No sample when p is
 // behind or in the light's plane.
-LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u);
+// `sampling` applies to rectangles and squares; other shapes are always sampled by area.
+LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u, AreaSampling sampling);
 // The light along direction wi from p, with the density `sample` would have given wi.
-LightEval evaluate(const AreaLight& light, const Vec3& p, const Vec3& wi);
+LightEval evaluate(const AreaLight& light, const Vec3& p, const Vec3& wi, AreaSampling sampling);
+
+// Blender's shape names: "RECTANGLE", "SQUARE", "DISK", "ELLIPSE"; throws std::invalid_argument.
+AreaShape parse_area_shape(const std::string& name);
+const char* area_shape_name(AreaShape shape);
+// "solid_angle" and "area"; throws std::invalid_argument.
+AreaSampling parse_area_sampling(const std::string& name);
+const char* area_sampling_name(AreaSampling sampling);
 // The light's expected contribution at p with normal n (n = 0: no receiver cosine), for light
 // selection: mean (L area) over distance^2, times bounds of the emitter's and the receiver's
 // cosines over the light's bounding sphere. Zero exactly when p is not in front of the light or

@@ -11,15 +11,15 @@
 namespace toyrt {
 
 struct LightSample {
-  Vec3 point{0.0f};     // the sampled point on the light
-  Vec3 wi{0.0f};        // unit direction from the shading point to `point`
+  Vec3 point{0.0f};  // the sampled point on the light
+  Vec3 wi{0.0f};     // unit direction from the shading point to `point`
   float distance = 0.0f;
   // Radiance arriving along -wi, W / (m^2 sr) per channel. For a delta light (a point light of
   // radius 0) there is no radiance: this holds its irradiance at normal incidence, I / d^2
   // (W / m^2), and pdf is 1, so the estimate above keeps the same form.
   Vec3 radiance{0.0f};
-  float pdf = 0.0f;     // solid-angle density of wi (1 / sr); 0: no sample (the light cannot reach p)
-  bool delta = false;   // cannot be hit by a ray, so it takes no part in MIS
+  float pdf = 0.0f;    // solid-angle density of wi (1 / sr); 0: no sample (the light cannot reach p)
+  bool delta = false;  // cannot be hit by a ray, so it takes no part in MIS
   bool valid() const { return pdf > 0.0f; }
 };
 
@@ -27,7 +27,7 @@ struct LightSample {
 struct LightEval {
   Vec3 radiance{0.0f};  // W / (m^2 sr); 0 if the ray misses the light or sees its back
   float distance = kInfinity;
-  float pdf = 0.0f;     // the light sampler's solid-angle density for this direction
+  float pdf = 0.0f;  // the light sampler's solid-angle density for this direction
   bool hit() const { return pdf > 0.0f; }
 };
 

@@ -10,10 +10,12 @@ namespace toyrt {
 
 PointLight PointLight::make(const Vec3& position, float power, const Vec3& color, float radius) {
   if (!is_finite(position)) throw std::invalid_argument("point light: position is not finite");
-  if (!std::isfinite(power) || power < 0.0f) throw std::invalid_argument("point light: power must be finite and >= 0 W");
+  if (!std::isfinite(power) || power < 0.0f)
+    throw std::invalid_argument("point light: power must be finite and >= 0 W");
   if (!is_finite(color) || glm::any(glm::lessThan(color, Vec3(0.0f))))
     throw std::invalid_argument("point light: colour must be finite and >= 0");
-  if (!std::isfinite(radius) || radius < 0.0f) throw std::invalid_argument("point light: radius must be finite and >= 0 m");
+  if (!std::isfinite(radius) || radius < 0.0f)
+    throw std::invalid_argument("point light: radius must be finite and >= 0 m");
   PointLight light;
   light.position = position;
   light.radius = radius;

@@ -21,13 +21,20 @@ namespace toyrt {
 
 struct PointLight {
   Vec3 position{0.0f};
-  float radius = 0.0f;      // m; 0: a delta light
-  Vec3 intensity{0.0f};     // I = P colour / (4 pi), W/sr
-  Vec3 radiance{0.0f};      // of the sphere's surface, I / (pi R^2); 0 when radius is 0
+  float radius = 0.0f;   // m; 0: a delta light
+  Vec3 intensity{0.0f};  // I = P colour / (4 pi), W/sr
+  Vec3 radiance{0.0f};   // of the sphere's surface, I / (pi R^2); 0 when radius is 0
 
   // Blender's settings: location, power (W), colour (linear RGB), radius (shadow_soft_size, m).
   // Throws std::invalid_argument for non-finite values, negative power, colour or radius.
   static PointLight make(const Vec3& position, float power, const Vec3& color, float radius = 0.0f);
+};
+
+// What a point light is when the caller does not say (the Python binding's argument defaults):
+// white, radius 0 (a delta light, hard shadows).
+struct PointLightDefaults {
+  Vec3 color{1.0f};
+  float radius = 0.0f;
 };
 
 // A direction towards the light from shading point p (u: two uniform numbers, used for R > 0).

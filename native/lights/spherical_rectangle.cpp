@@ -15,8 +15,7 @@ double interior_angle(const DVec3& a, const DVec3& b) {
 
 }  // namespace
 
-SphericalRectangle SphericalRectangle::make(const Vec3& p, const Vec3& corner, const Vec3& edge_x,
-                                            const Vec3& edge_y) {
+SphericalRectangle SphericalRectangle::make(const Vec3& p, const Vec3& corner, const Vec3& edge_x, const Vec3& edge_y) {
   SphericalRectangle r;
   const DVec3 ex(edge_x), ey(edge_y);
   const double length_x = glm::length(ex), length_y = glm::length(ey);

@@ -32,8 +32,8 @@ struct FresnelDielectric {
 };
 
 struct SpecularSample {
-  Vec3 wi{0.0f};             // unit direction leaving the surface
-  bool reflected = false;    // mirror direction (always, under total internal reflection)
+  Vec3 wi{0.0f};           // unit direction leaving the surface
+  bool reflected = false;  // mirror direction (always, under total internal reflection)
   bool total_internal_reflection = false;
   bool entering = false;     // wo was on the geometric normal's side
   float probability = 1.0f;  // of this branch: 1, or F / 1 - F for FresnelDielectric; f / pdf is 1

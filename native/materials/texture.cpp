@@ -11,8 +11,9 @@ void check_shape(int width, int height, int channels, size_t size) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("texture: width and height must be positive");
   if (channels != 3 && channels != 4) throw std::invalid_argument("texture: channels must be 3 (RGB) or 4 (RGBA)");
   if (size != size_t(width) * size_t(height) * size_t(channels))
-    throw std::invalid_argument("texture: expected width * height * channels = " +
-                                std::to_string(size_t(width) * height * channels) + " values, got " + std::to_string(size));
+    throw std::invalid_argument(
+        "texture: expected width * height * channels = " + std::to_string(size_t(width) * height * channels) +
+        " values, got " + std::to_string(size));
 }
 
 template <class T, class ToUnit>
@@ -42,12 +43,16 @@ int wrap(int i, int n) {
 
 }  // namespace
 
-Texture Texture::from_floats(int width, int height, int channels, const std::vector<float>& data, ColorEncoding encoding) {
-  return make(width, height, channels, data, encoding, [](float v) { return v; }, false);
+Texture Texture::from_floats(int width, int height, int channels, const std::vector<float>& data,
+                             ColorEncoding encoding) {
+  return make(
+      width, height, channels, data, encoding, [](float v) { return v; }, false);
 }
 
-Texture Texture::from_bytes(int width, int height, int channels, const std::vector<uint8_t>& data, ColorEncoding encoding) {
-  return make(width, height, channels, data, encoding, [](uint8_t v) { return float(v) / 255.0f; }, true);
+Texture Texture::from_bytes(int width, int height, int channels, const std::vector<uint8_t>& data,
+                            ColorEncoding encoding) {
+  return make(
+      width, height, channels, data, encoding, [](uint8_t v) { return float(v) / 255.0f; }, true);
 }
 
 namespace {

@@ -31,8 +31,10 @@ struct Texture {
 
   // Throw std::invalid_argument for non-positive sizes, channels other than 3 or 4, a data size
   // that does not match, or non-finite floats.
-  static Texture from_floats(int width, int height, int channels, const std::vector<float>& data, ColorEncoding encoding);
-  static Texture from_bytes(int width, int height, int channels, const std::vector<uint8_t>& data, ColorEncoding encoding);
+  static Texture from_floats(int width, int height, int channels, const std::vector<float>& data,
+                             ColorEncoding encoding);
+  static Texture from_bytes(int width, int height, int channels, const std::vector<uint8_t>& data,
+                            ColorEncoding encoding);
 
   glm::vec4 texel(int x, int y) const;  // column x, row y from the bottom, linear; alpha 1 for RGB
   glm::vec4 lookup(const Vec2& uv) const;

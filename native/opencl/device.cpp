@@ -11,7 +11,8 @@
 namespace toyrt::opencl {
 
 void check(cl_int status, const char* what) {
-  if (status != CL_SUCCESS) throw OpenClError(std::string("OpenCL: ") + what + " failed (error " + std::to_string(status) + ")");
+  if (status != CL_SUCCESS)
+    throw OpenClError(std::string("OpenCL: ") + what + " failed (error " + std::to_string(status) + ")");
 }
 
 namespace {
@@ -145,7 +146,8 @@ Buffer::~Buffer() {
 }
 
 void Buffer::write(const void* data, size_t bytes) const {
-  check(clEnqueueWriteBuffer(device().queue, mem_, CL_TRUE, 0, bytes, data, 0, nullptr, nullptr), "clEnqueueWriteBuffer");
+  check(clEnqueueWriteBuffer(device().queue, mem_, CL_TRUE, 0, bytes, data, 0, nullptr, nullptr),
+        "clEnqueueWriteBuffer");
 }
 
 void Buffer::read(void* data, size_t bytes) const {
@@ -161,7 +163,8 @@ void Buffer::sync_to_host(size_t bytes) const {
 
 void Buffer::fill_zero(size_t bytes) const {
   const cl_int zero = 0;
-  check(clEnqueueFillBuffer(device().queue, mem_, &zero, sizeof zero, 0, bytes, 0, nullptr, nullptr), "clEnqueueFillBuffer");
+  check(clEnqueueFillBuffer(device().queue, mem_, &zero, sizeof zero, 0, bytes, 0, nullptr, nullptr),
+        "clEnqueueFillBuffer");
 }
 
 }  // namespace toyrt::opencl

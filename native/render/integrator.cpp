@@ -1,5 +1,6 @@
 #include "render/integrator.h"
 
+#include "core/overloaded.h"
 #include "geometry/offset_ray.h"
 #include "lights/light_selector.h"
 #include "sampling/frame.h"
@@ -14,15 +15,14 @@ constexpr uint32_t kDimsPerVertex = 64;
 uint32_t vertex_dimension(int depth, uint32_t k) { return 1 + uint32_t(depth) * kDimsPerVertex + k; }
 
 struct SurfaceHit {
-  Vec3 p;       // world position, from the barycentrics (more accurate than org + t dir)
-  Vec3 ng;      // unit geometric normal, world space
-  Vec3 ns;      // unit shading normal, world space
+  Vec3 p;   // world position, from the barycentrics (more accurate than org + t dir)
+  Vec3 ng;  // unit geometric normal, world space
+  Vec3 ns;  // unit shading normal, world space
   Vec2 uv{0.0f};
   int32_t material = -1;
 };
 
-SurfaceHit surface_at(const RenderScene& rs, const Hit& hit) {
-  const Scene& scene = *rs.geometry;
+SurfaceHit surface_at(const Scene& scene, const Hit& hit) {
   const Instance& inst = scene.instance(uint32_t(hit.instance));
   const Mesh& mesh = scene.mesh(inst.mesh);
   const Triangle& tri = mesh.triangles()[size_t(hit.prim)];
@@ -35,62 +35,65 @@ SurfaceHit surface_at(const RenderScene& rs, const Hit& hit) {
   s.p = inst.identity ? local : Vec3(inst.to_world * glm::vec4(local, 1.0f));
   s.ng = glm::normalize(normal_matrix * glm::cross(p1 - p0, p2 - p0));
   s.ns = s.ng;
-  if (inst.mesh < rs.shading.size()) {
-    const MeshShading& sh = rs.shading[inst.mesh];
-    const size_t c = 3 * size_t(hit.prim);
-    if (!sh.corner_normals.empty()) {
-      const Vec3 n = w * sh.corner_normals[c] + hit.u * sh.corner_normals[c + 1] + hit.v * sh.corner_normals[c + 2];
-      const Vec3 world = normal_matrix * n;
-      if (glm::dot(world, world) > 0.0f && is_finite(world)) s.ns = glm::normalize(world);
-    }
-    if (!sh.corner_uvs.empty()) s.uv = w * sh.corner_uvs[c] + hit.u * sh.corner_uvs[c + 1] + hit.v * sh.corner_uvs[c + 2];
-    if (!sh.material_ids.empty()) s.material = sh.material_ids[size_t(hit.prim)];
+  const MeshShading& sh = scene.shading(inst.mesh);
+  const size_t c = 3 * size_t(hit.prim);
+  if (!sh.corner_normals.empty()) {
+    const Vec3 n = w * sh.corner_normals[c] + hit.u * sh.corner_normals[c + 1] + hit.v * sh.corner_normals[c + 2];
+    const Vec3 world = normal_matrix * n;
+    if (glm::dot(world, world) > 0.0f && is_finite(world)) s.ns = glm::normalize(world);
   }
+  if (!sh.corner_uvs.empty()) s.uv = w * sh.corner_uvs[c] + hit.u * sh.corner_uvs[c + 1] + hit.v * sh.corner_uvs[c + 2];
+  if (!sh.material_ids.empty()) s.material = sh.material_ids[size_t(hit.prim)];
   return s;
 }
 
 // Light arriving at a diffuse point: one sample per light, or one light chosen by contribution.
-Vec3 direct_lighting(const RenderScene& rs, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f,
-                     int depth, uint32_t pixel, uint32_t sample, const IntegratorSettings& settings) {
+Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f, int depth,
+                     uint32_t pixel, uint32_t sample, const IntegratorSettings& settings) {
+  const World& world = scene.world();
   const Vec3 origin = offset_ray_origin(s.p, ng);
   Vec3 sum(0.0f);
   auto add = [&](const Light& light, float select_probability, uint32_t dim) {
-    const LightSample ls = sample_light(light, s.p, sobol_owen_2d(pixel, sample, vertex_dimension(depth, dim), settings.seed));
+    const LightSample ls = sample_light(
+        light, s.p, sobol_owen_2d(pixel, sample, vertex_dimension(depth, dim), settings.seed), settings.area_sampling);
     if (!ls.valid()) return;
     const float cos_s = glm::dot(ns, ls.wi);
     if (cos_s <= 0.0f || glm::dot(ng, ls.wi) <= 0.0f) return;  // below the shading or the true surface
     // The shadow ray ends where the light sample is: t = 1 with an unnormalised direction.
     const Ray shadow{origin, 0.0f, ls.point - origin, 1.0f};
-    if (rs.geometry->occluded(shadow)) return;
+    if (scene.occluded(shadow)) return;
     sum += f * ls.radiance * (cos_s / (ls.pdf * select_probability));
   };
   // The world as a light: a constant background seen over the hemisphere. A cosine-distributed
   // direction makes the estimate f L cos / pdf = albedo L when nothing blocks it.
-  if (rs.background_lights_surfaces && rs.background != Vec3(0.0f)) {
-    const Vec3 local = sample_cosine_hemisphere(sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 1), settings.seed));
+  if (world.background_lights_surfaces && world.background != Vec3(0.0f)) {
+    const Vec3 local = sample_cosine_hemisphere(
+        sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 1), settings.seed));
     const Vec3 wi = Frame::from_normal(ns).to_world(local);
-    if (glm::dot(ng, wi) > 0.0f && !rs.geometry->occluded(Ray{origin, 0.0f, wi, kInfinity}))
-      sum += f * rs.background * kPi;  // f = albedo / pi
+    if (glm::dot(ng, wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, wi, kInfinity}))
+      sum += f * world.background * kPi;  // f = albedo / pi
   }
-  if (settings.light_sampling == LightSampling::All || rs.lights.size() == 1) {
-    for (size_t j = 0; j < rs.lights.size(); ++j) add(rs.lights[j], 1.0f, 1 + uint32_t(j));
+  const std::vector<Light>& lights = world.lights;
+  if (settings.light_sampling != LightSampling::One || lights.size() == 1) {
+    for (size_t j = 0; j < lights.size(); ++j) add(lights[j], 1.0f, 1 + uint32_t(j));
   } else {
-    const LightSelector selector(rs.lights);
-    const LightSelection pick = selector.select(s.p, ns, sobol_owen_1d(pixel, sample, vertex_dimension(depth, 0), settings.seed));
-    if (pick.found()) add(rs.lights[size_t(pick.index)], pick.probability, 1);
+    const LightSelector selector(lights);
+    const LightSelection pick =
+        selector.select(s.p, ns, sobol_owen_1d(pixel, sample, vertex_dimension(depth, 0), settings.seed));
+    if (pick.found()) add(lights[size_t(pick.index)], pick.probability, 1);
   }
   return sum;
 }
 
 // The nearest light a camera (depth 0) or specular ray sees before distance `limit` (in units of
 // the unit direction), if it is visible to that kind of ray: its radiance, or nothing.
-bool visible_light(const RenderScene& rs, const Vec3& org, const Vec3& unit_dir, float from, float limit, bool camera,
-                   Vec3& radiance) {
+bool visible_light(const World& world, const Vec3& org, const Vec3& unit_dir, float from, float limit, bool camera,
+                   AreaSampling area_sampling, Vec3& radiance) {
   bool seen = false;
-  for (size_t j = 0; j < rs.lights.size(); ++j) {
-    const RenderScene::LightVisibility v = j < rs.light_visibility.size() ? rs.light_visibility[j] : RenderScene::LightVisibility{};
+  for (size_t j = 0; j < world.lights.size(); ++j) {
+    const LightVisibility v = world.light_visibility[j];
     if (!(camera ? v.camera : v.specular)) continue;
-    const LightEval e = evaluate_light(rs.lights[j], org, unit_dir);
+    const LightEval e = evaluate_light(world.lights[j], org, unit_dir, area_sampling);
     if (!e.hit() || !(e.distance >= from) || !(e.distance < limit)) continue;
     limit = e.distance;
     radiance = e.radiance;
@@ -101,69 +104,84 @@ bool visible_light(const RenderScene& rs, const Vec3& org, const Vec3& unit_dir,
 
 // The radiance arriving along `ray`, whose first vertex is path vertex `depth` (0: the camera
 // ray). Recursive only where a Fresnel surface is split, so at most split_depth levels deep.
-Vec3 trace_from(const RenderScene& rs, Ray ray, int first_depth, uint32_t pixel, uint32_t sample,
+Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, uint32_t sample,
                 const IntegratorSettings& settings) {
   static const Material kDefault = Lambert{};
+  const World& world = scene.world();
+  const std::vector<Material>& materials = scene.materials();
   Vec3 throughput(1.0f), radiance(0.0f);
   for (int depth = first_depth;; ++depth) {
-    const Hit hit = rs.geometry->intersect(ray);
-    if (!rs.lights.empty()) {
+    const Hit hit = scene.intersect(ray);
+    if (!world.lights.empty()) {
       // A light nearer than the surface (or than nothing): the ray sees the light and ends there.
       const float length = glm::length(ray.dir);
       Vec3 seen(0.0f);
-      if (visible_light(rs, ray.org, ray.dir / length, ray.tnear * length, std::min(hit.t, ray.tfar) * length, depth == 0,
-                        seen)) {
+      if (visible_light(world, ray.org, ray.dir / length, ray.tnear * length, std::min(hit.t, ray.tfar) * length,
+                        depth == 0, settings.area_sampling, seen)) {
         radiance += throughput * seen;
         break;
       }
     }
     if (!hit.found()) {
-      radiance += throughput * rs.background;
+      radiance += throughput * world.background;
       break;
     }
-    const SurfaceHit s = surface_at(rs, hit);
+    const SurfaceHit s = surface_at(scene, hit);
     const Vec3 wo = -glm::normalize(ray.dir);
     // The geometric normal decides the side; the shading normal is turned to that side.
     const bool front = glm::dot(s.ng, wo) > 0.0f;
     const Vec3 ng = front ? s.ng : -s.ng;
     const Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;
-    const Material& m = s.material >= 0 && size_t(s.material) < rs.materials.size() ? rs.materials[size_t(s.material)]
-                                                                                      : kDefault;
-    if (const Lambert* lambert = std::get_if<Lambert>(&m)) {
-      const Vec3 f = lambert_f(lambert_albedo(*lambert, rs.textures, s.uv));
-      radiance += throughput * direct_lighting(rs, s, ng, ns, f, depth, pixel, sample, settings);
-      break;
-    }
-    // A specular surface: continue the path, if the depth allows.
-    if (depth >= settings.max_specular_depth) break;
-    SpecularSample next;
-    if (const PerfectRefraction* r = std::get_if<PerfectRefraction>(&m)) {
-      next = toyrt::sample(*r, wo, s.ng, s.ns);
-    } else if (depth < settings.split_depth) {
-      // Splitting: both branches, each weighted by its Fresnel term, instead of choosing one with
-      // that probability. A light seen in a reflection with F = 0.04 is otherwise an all-or-nothing
-      // sample in 4 % of the paths, the largest variance in a glass scene (docs/render.md).
-      SpecularSample branches[2];
-      const int n = split(std::get<FresnelDielectric>(m), wo, s.ng, s.ns, branches);
-      for (int b = 0; b < n; ++b) {
-        const Ray branch{offset_ray_origin(s.p, branches[b].offset_normal), 0.0f, branches[b].wi, kInfinity};
-        radiance += throughput * branches[b].probability * trace_from(rs, branch, depth + 1, pixel, sample, settings);
-      }
-      break;
-    } else {
-      const float u = sobol_owen_1d(pixel, sample, vertex_dimension(depth, 0), settings.seed);
-      next = toyrt::sample(std::get<FresnelDielectric>(m), wo, s.ng, s.ns, u);
-    }
-    ray = Ray{offset_ray_origin(s.p, next.offset_normal), 0.0f, next.wi, kInfinity};
+    const Material& m =
+        s.material >= 0 && size_t(s.material) < materials.size() ? materials[size_t(s.material)] : kDefault;
+    // One dispatch per hit, one case per material type: a type added to Material without its
+    // case here does not compile. Each case either ends the path (returns false) or sets the
+    // next ray of the chain (returns true).
+    const bool go_on = std::visit(
+        Overloaded{
+            [&](const Lambert& lambert) {
+              const Vec3 f = lambert_f(lambert_albedo(lambert, scene.textures(), s.uv));
+              radiance += throughput * direct_lighting(scene, s, ng, ns, f, depth, pixel, sample, settings);
+              return false;
+            },
+            [&](const PerfectRefraction& refraction) {
+              if (depth >= settings.max_specular_depth) return false;
+              const SpecularSample next = toyrt::sample(refraction, wo, s.ng, s.ns);
+              ray = Ray{offset_ray_origin(s.p, next.offset_normal), 0.0f, next.wi, kInfinity};
+              return true;
+            },
+            [&](const FresnelDielectric& glass) {
+              if (depth >= settings.max_specular_depth) return false;
+              if (depth < settings.split_depth) {
+                // Splitting: both branches, each weighted by its Fresnel term, instead of choosing
+                // one with that probability. A light seen in a reflection with F = 0.04 is
+                // otherwise an all-or-nothing sample in 4 % of the paths, the largest variance in
+                // a glass scene (docs/render.md).
+                SpecularSample branches[2];
+                const int n = split(glass, wo, s.ng, s.ns, branches);
+                for (int b = 0; b < n; ++b) {
+                  const Ray branch{offset_ray_origin(s.p, branches[b].offset_normal), 0.0f, branches[b].wi, kInfinity};
+                  radiance += throughput * branches[b].probability *
+                              trace_from(scene, branch, depth + 1, pixel, sample, settings);
+                }
+                return false;
+              }
+              const float u = sobol_owen_1d(pixel, sample, vertex_dimension(depth, 0), settings.seed);
+              const SpecularSample next = toyrt::sample(glass, wo, s.ng, s.ns, u);
+              ray = Ray{offset_ray_origin(s.p, next.offset_normal), 0.0f, next.wi, kInfinity};
+              return true;
+            }},
+        m);
+    if (!go_on) break;
   }
   return radiance;
 }
 
 }  // namespace
 
-Vec3 trace_path(const RenderScene& rs, const Ray& camera_ray, uint32_t pixel, uint32_t sample,
+Vec3 trace_path(const Scene& scene, const Ray& camera_ray, uint32_t pixel, uint32_t sample,
                 const IntegratorSettings& settings) {
-  const Vec3 radiance = trace_from(rs, camera_ray, 0, pixel, sample, settings);
+  const Vec3 radiance = trace_from(scene, camera_ray, 0, pixel, sample, settings);
   // A numerical failure anywhere (it should not happen) must not poison the pixel.
   if (!is_finite(radiance)) return Vec3(0.0f);
   return glm::max(radiance, Vec3(0.0f));

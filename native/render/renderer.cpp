@@ -10,11 +10,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <limits>
 #include <condition_variable>
+#include <cstdio>
 #include <deque>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -25,9 +25,12 @@ namespace {
 std::string format_bytes(size_t bytes) {
   char buf[32];
   const double b = double(bytes);
-  if (b >= 1e12) std::snprintf(buf, sizeof buf, "%.1f TB", b / 1e12);
-  else if (b >= 1e9) std::snprintf(buf, sizeof buf, "%.1f GB", b / 1e9);
-  else std::snprintf(buf, sizeof buf, "%.1f MB", b / 1e6);
+  if (b >= 1e12)
+    std::snprintf(buf, sizeof buf, "%.1f TB", b / 1e12);
+  else if (b >= 1e9)
+    std::snprintf(buf, sizeof buf, "%.1f GB", b / 1e9);
+  else
+    std::snprintf(buf, sizeof buf, "%.1f MB", b / 1e6);
   return buf;
 }
 }  // namespace
@@ -58,15 +61,15 @@ size_t available_memory_bytes() {
   return pages > 0 && page > 0 ? size_t(pages) * size_t(page) : SIZE_MAX;
 }
 
-RenderResult render(const RenderScene& scene, const Camera& camera, const RenderSettings& settings,
-                    const TileSink& on_tile, const CancelPoll& should_cancel) {
-  if (!scene.geometry || !scene.geometry->committed())
-    throw std::logic_error("render: the scene changed since the last commit(): call commit() first");
-  if (settings.samples < 1) throw std::invalid_argument("samples must be at least 1");
-  if (settings.first_sample < 0) throw std::invalid_argument("first_sample must be >= 0");
-  if (settings.samples > std::numeric_limits<int>::max() - settings.first_sample)
-    throw std::invalid_argument("first_sample + samples must stay below 2^31");
-  if (settings.tile_size < 1) throw std::invalid_argument("tile_size must be at least 1");
+RenderResult render(const Scene& scene, const Camera& camera, const RenderSettings& requested, const TileSink& on_tile,
+                    const CancelPoll& should_cancel) {
+  requested.check();
+  scene.check_renderable();
+  // The settings with "auto" light sampling resolved for this scene: a copy of a few ints, the
+  // scene itself is read in place.
+  RenderSettings settings = requested;
+  settings.integrator.light_sampling =
+      resolve_light_sampling(requested.integrator.light_sampling, scene.world().lights.size());
   const auto start = std::chrono::steady_clock::now();
   const PixelWindow win = camera.window;
   const size_t needed = render_memory_estimate(camera, settings), available = available_memory_bytes();
@@ -75,13 +78,15 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
                          " image needs " + format_bytes(needed) + " but only " + format_bytes(available) +
                          " of memory is available; lower the resolution or the resolution percentage");
   RenderResult result;
+  result.light_sampling = settings.integrator.light_sampling;
   result.width = win.width();
   result.height = win.height();
   result.rgba.assign(size_t(result.width) * size_t(result.height) * 4, 0.0f);
   std::vector<Tile> tiles;
   for (int y = 0; y < result.height; y += settings.tile_size)
     for (int x = 0; x < result.width; x += settings.tile_size)
-      tiles.push_back({x, y, std::min(settings.tile_size, result.width - x), std::min(settings.tile_size, result.height - y)});
+      tiles.push_back(
+          {x, y, std::min(settings.tile_size, result.width - x), std::min(settings.tile_size, result.height - y)});
   result.tiles_total = tiles.size();
 
   std::atomic<bool> cancel{false};
@@ -174,7 +179,8 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
   if (failure) std::rethrow_exception(failure);
   result.cancelled = cancel;
   if (result.cancelled)
-    result.cancel_latency_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cancelled_at).count();
+    result.cancel_latency_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cancelled_at).count();
   result.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

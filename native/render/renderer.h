@@ -4,7 +4,9 @@
 #pragma once
 
 #include "camera/camera.h"
+#include "core/cancel_poll.h"
 #include "render/integrator.h"
+#include "render/render_settings.h"
 
 #include <atomic>
 #include <functional>
@@ -12,17 +14,6 @@
 #include <vector>
 
 namespace toyrt {
-
-struct RenderSettings {
-  int samples = 16;        // per pixel, on a Sobol-Owen pattern, box filter of one pixel
-  // The first sample index: a pass renders samples [first_sample, first_sample + samples) of the
-  // same sequence, so passes of n1 and n2 samples averaged with weights n1 and n2 equal one
-  // render of n1 + n2 samples (the viewport accumulates this way).
-  int first_sample = 0;
-  int tile_size = 32;      // pixels
-  int threads = 0;         // 0: all cores
-  IntegratorSettings integrator;
-};
 
 // A rectangle of the window, in window pixels (rows from the top).
 struct Tile {
@@ -36,6 +27,7 @@ struct RenderResult {
   size_t tiles_done = 0, tiles_total = 0;
   double render_ms = 0.0;
   double cancel_latency_ms = 0.0;  // from the cancel request to every worker stopped (when cancelled)
+  LightSampling light_sampling = LightSampling::All;  // the estimator used ("auto" resolved)
 };
 
 // A render refused before allocating: its image would not fit in memory (Python: MemoryError).
@@ -57,9 +49,11 @@ size_t available_memory_bytes();
 constexpr int kCancelCheckSamples = 8;
 
 using TileSink = std::function<void(const Tile&, const RenderResult&)>;
-using CancelPoll = std::function<bool()>;
 
-RenderResult render(const RenderScene& scene, const Camera& camera, const RenderSettings& settings,
+// Renders the committed scene in place (no copy of it: the caller keeps it unchanged until this
+// returns). Throws std::invalid_argument for settings out of bounds or a material id without its
+// material, std::logic_error for an uncommitted scene, RenderTooLarge before allocating.
+RenderResult render(const Scene& scene, const Camera& camera, const RenderSettings& settings,
                     const TileSink& on_tile = {}, const CancelPoll& should_cancel = {});
 
 }  // namespace toyrt

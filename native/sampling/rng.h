@@ -21,9 +21,7 @@ inline uint32_t pcg_hash(uint32_t v) {
 // for multi-dimensional inputs.
 inline uint32_t hash_keys(uint32_t a, uint32_t b) { return pcg_hash(b ^ pcg_hash(a)); }
 inline uint32_t hash_keys(uint32_t a, uint32_t b, uint32_t c) { return pcg_hash(c ^ hash_keys(a, b)); }
-inline uint32_t hash_keys(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
-  return pcg_hash(d ^ hash_keys(a, b, c));
-}
+inline uint32_t hash_keys(uint32_t a, uint32_t b, uint32_t c, uint32_t d) { return pcg_hash(d ^ hash_keys(a, b, c)); }
 
 // The top 24 bits as a float in [0, 1): every value is exact, and 1 is never returned.
 inline float bits_to_unit_float(uint32_t bits) { return float(bits >> 8) * 0x1p-24f; }

@@ -2,26 +2,30 @@
 
 #include "accel/traverse.h"
 #include "core/parallel.h"
-#include "opencl/device.h"
 
-#include <glm/gtc/matrix_inverse.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <glm/gtc/matrix_inverse.hpp>
 
 #include <chrono>
+#include <future>
 #include <stdexcept>
+#include <thread>
 
 namespace toyrt {
 
-BuilderKind parse_builder(const std::string& name) {
-  if (name == "auto") return BuilderKind::Auto;
-  if (name == "sah") return BuilderKind::Sah;
-  if (name == "lbvh") return BuilderKind::Lbvh;
-  throw std::invalid_argument("unknown builder '" + name + "': expected 'auto', 'sah' or 'lbvh'");
+void Scene::check_mesh_id(int64_t mesh) const {
+  if (mesh < 0 || size_t(mesh) >= meshes_.size())
+    throw std::invalid_argument("unknown mesh id " + std::to_string(mesh) + " (the scene has " +
+                                std::to_string(meshes_.size()) + " meshes)");
 }
 
-uint32_t Scene::add_mesh(std::vector<Vec3> vertices, std::vector<Triangle> triangles) {
-  meshes_.push_back(std::make_unique<Mesh>(std::move(vertices), std::move(triangles)));
+uint32_t Scene::add_mesh(std::vector<Vec3> vertices, std::vector<Triangle> triangles, MeshShading shading) {
+  const int32_t max_material = shading.check(triangles.size());
+  auto mesh = std::make_unique<Mesh>(std::move(vertices), std::move(triangles));  // validates
+  meshes_.push_back(std::move(mesh));
+  shading_.push_back(std::move(shading));
+  max_material_id_.push_back(max_material);
   committed_ = false;
   return uint32_t(meshes_.size() - 1);
 }
@@ -42,13 +46,11 @@ Mat4 Scene::checked_inverse(const Mat4& to_world) {
   return to_object;
 }
 
-uint32_t Scene::add_instance(uint32_t mesh, const Mat4& to_world) {
-  if (mesh >= meshes_.size())
-    throw std::invalid_argument("unknown mesh id " + std::to_string(mesh) + " (the scene has " +
-                                std::to_string(meshes_.size()) + " meshes)");
+uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world) {
+  check_mesh_id(mesh);
   const Mat4 to_object = checked_inverse(to_world);
   Instance inst;
-  inst.mesh = mesh;
+  inst.mesh = uint32_t(mesh);
   inst.to_world = to_world;
   inst.to_object = to_object;
   inst.identity = to_world == Mat4(1.0f);
@@ -57,22 +59,24 @@ uint32_t Scene::add_instance(uint32_t mesh, const Mat4& to_world) {
   return uint32_t(instances_.size() - 1);
 }
 
-void Scene::replace_mesh(uint32_t mesh, std::vector<Vec3> vertices, std::vector<Triangle> triangles) {
-  if (mesh >= meshes_.size())
-    throw std::invalid_argument("unknown mesh id " + std::to_string(mesh) + " (the scene has " +
-                                std::to_string(meshes_.size()) + " meshes)");
-  // Built before the swap, so a refused mesh leaves the old one in place.
+void Scene::replace_mesh(int64_t mesh, std::vector<Vec3> vertices, std::vector<Triangle> triangles,
+                         MeshShading shading) {
+  check_mesh_id(mesh);
+  // Checked and built before the swap, so a refused mesh leaves the old one in place.
+  const int32_t max_material = shading.check(triangles.size());
   auto replacement = std::make_unique<Mesh>(std::move(vertices), std::move(triangles));
-  meshes_[mesh] = std::move(replacement);
+  meshes_[size_t(mesh)] = std::move(replacement);
+  shading_[size_t(mesh)] = std::move(shading);
+  max_material_id_[size_t(mesh)] = max_material;
   committed_ = false;
 }
 
-void Scene::set_instance_transform(uint32_t instance, const Mat4& to_world) {
-  if (instance >= instances_.size())
+void Scene::set_instance_transform(int64_t instance, const Mat4& to_world) {
+  if (instance < 0 || size_t(instance) >= instances_.size())
     throw std::invalid_argument("unknown instance id " + std::to_string(instance) + " (the scene has " +
                                 std::to_string(instances_.size()) + " instances)");
   const Mat4 to_object = checked_inverse(to_world);
-  Instance& inst = instances_[instance];
+  Instance& inst = instances_[size_t(instance)];
   inst.to_world = to_world;
   inst.to_object = to_object;
   inst.identity = to_world == Mat4(1.0f);
@@ -84,39 +88,134 @@ void Scene::clear_instances() {
   committed_ = false;
 }
 
-void Scene::commit(const CommitOptions& options) {
+namespace {
+void check_texture_id(const Material& m, size_t textures) {
+  const int32_t texture = texture_of(m);
+  if (texture < -1 || texture >= int64_t(textures))
+    throw std::invalid_argument("unknown texture id " + std::to_string(texture) + " (the scene has " +
+                                std::to_string(textures) + " textures)");
+}
+}  // namespace
+
+uint32_t Scene::add_material(const Material& material) {
+  check_texture_id(material, textures_.size());
+  materials_.push_back(material);
+  return uint32_t(materials_.size() - 1);
+}
+
+void Scene::set_material(int64_t material, const Material& replacement) {
+  if (material < 0 || size_t(material) >= materials_.size())
+    throw std::invalid_argument("unknown material id " + std::to_string(material));
+  check_texture_id(replacement, textures_.size());
+  materials_[size_t(material)] = replacement;
+}
+
+uint32_t Scene::add_texture(Texture texture) {
+  textures_.push_back(std::move(texture));
+  return uint32_t(textures_.size() - 1);
+}
+
+void Scene::set_texture(int64_t texture, Texture replacement) {
+  if (texture < 0 || size_t(texture) >= textures_.size())
+    throw std::invalid_argument("unknown texture id " + std::to_string(texture));
+  textures_[size_t(texture)] = std::move(replacement);
+}
+
+uint32_t Scene::add_light(const Light& light, LightVisibility visibility) {
+  world_.lights.push_back(light);
+  world_.light_visibility.push_back(visibility);
+  return uint32_t(world_.lights.size() - 1);
+}
+
+void Scene::clear_lights() {
+  world_.lights.clear();
+  world_.light_visibility.clear();
+}
+
+void Scene::set_background(const Vec3& radiance) {
+  if (!is_finite(radiance) || glm::any(glm::lessThan(radiance, Vec3(0.0f))))
+    throw std::invalid_argument("background must be finite and >= 0");
+  world_.background = radiance;
+}
+
+void Scene::check_committed() const {
+  if (!committed_)
+    throw std::logic_error(instances_.empty() && meshes_.empty()
+                               ? "query before commit(): add meshes, then call commit()"
+                               : "the scene changed since the last commit(): call commit() before queries");
+}
+
+void Scene::check_renderable() const {
+  check_committed();
+  const size_t count = materials_.size();
+  for (size_t mesh = 0; mesh < meshes_.size(); ++mesh) {
+    const int32_t id = max_material_id_[mesh];
+    if (id >= 0 && size_t(id) >= count && !(count == 0 && id == 0))
+      throw std::invalid_argument("mesh " + std::to_string(mesh) + " uses material id " + std::to_string(id) +
+                                  " but the scene has " + std::to_string(count) + " materials");
+  }
+}
+
+bool Scene::commit(const CommitOptions& options, const CancelPoll& should_cancel) {
+  check_threads(options.threads);
+  if (options.expected_rays && !(std::isfinite(*options.expected_rays) && *options.expected_rays >= 0.0))
+    throw std::invalid_argument("expected_rays must be a finite number >= 0 (or None when unknown)");
+  if (!should_cancel) {
+    build(options, nullptr);
+    return true;
+  }
+  // The build runs on its own thread while this one polls should_cancel every 10 ms; a true
+  // answer, or an exception from it, sets the flag the builders poll. The worker is joined
+  // before anything else happens, exceptions included.
+  std::atomic<bool> cancel{false};
+  std::packaged_task<void()> task([&] { build(options, &cancel); });
+  std::future<void> done = task.get_future();
+  std::thread worker(std::move(task));
+  std::exception_ptr poll_error;
+  while (done.wait_for(std::chrono::milliseconds(10)) != std::future_status::ready) {
+    if (cancel.load() || poll_error) continue;
+    try {
+      if (should_cancel()) cancel.store(true);
+    } catch (...) {
+      poll_error = std::current_exception();
+      cancel.store(true);
+    }
+  }
+  worker.join();
+  bool cancelled = false;
+  try {
+    done.get();
+  } catch (const BuildCancelled&) {
+    cancelled = true;
+  }
+  if (poll_error) std::rethrow_exception(poll_error);
+  return !cancelled;
+}
+
+void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel) {
   const auto start = std::chrono::steady_clock::now();
   stats_ = {};
   instances_.shrink_to_fit();  // many instances are added one by one: drop the growth slack
-  committed_ = false;  // until this commit completes (it may be cancelled)
-  BinnedSahConfig sah = options.sah;
-  sah.cancel = options.cancel;
+  committed_ = false;          // until this commit completes (it may be cancelled)
+  BuildConfig config;
+  config.sah = options.sah;
+  config.sah.cancel = cancel;
+  config.lbvh = options.lbvh;
+  config.cost_model = options.cost_model;
+  config.expected_rays = options.expected_rays.value_or(-1.0);
   auto check_cancel = [&] {
-    if (options.cancel && options.cancel->load(std::memory_order_relaxed)) throw BuildCancelled();
+    if (cancel && cancel->load(std::memory_order_relaxed)) throw BuildCancelled();
   };
   run_with_threads(options.threads, [&] {
     // Meshes first (each build is parallel inside), then the top level over their boxes.
     for (auto& mesh : meshes_) {
       if (mesh->built()) continue;
       check_cancel();
-      BuilderKind kind = options.builder;
-      if (kind == BuilderKind::Auto) kind = options.cost_model.choose(mesh->triangles().size(), options.expected_rays);
-      if (kind == BuilderKind::Lbvh) {
-        try {
-          LbvhStats lbvh_stats;
-          mesh->build_lbvh(options.lbvh, &lbvh_stats);
-          stats_.lbvh_compile_ms += lbvh_stats.compile_ms;
-          ++stats_.lbvh_meshes;
-        } catch (const opencl::OpenClError& e) {
-          if (stats_.warning.empty())
-            stats_.warning = std::string("LBVH builder unavailable, using the SAH builder instead: ") + e.what();
-          kind = BuilderKind::Sah;
-        }
-      }
-      if (kind == BuilderKind::Sah) {
-        mesh->build(sah);
-        ++stats_.sah_meshes;
-      }
+      BuildStats built;
+      mesh->build(options.builder, config, &built);
+      stats_.lbvh_compile_ms += built.lbvh_compile_ms;
+      if (stats_.warning.empty()) stats_.warning = built.warning;  // one message per commit
+      ++(built.used == BuilderKind::Lbvh ? stats_.lbvh_meshes : stats_.sah_meshes);
       ++stats_.meshes_built;
     }
     std::vector<uint32_t> placed;
@@ -142,9 +241,9 @@ void Scene::commit(const CommitOptions& options) {
       centers.push_back(inst.world_bounds.center());
     }
     check_cancel();
-    BinnedSahConfig top_config = sah;
-    top_config.max_leaf = 1;  // an instance test is a whole traversal: never group them
-    top_ = build_binned_sah(boxes.data(), centers.data(), boxes.size(), top_config);
+    BuildConfig top_config = config;
+    top_config.sah.max_leaf = 1;  // an instance test is a whole traversal: never group them
+    top_ = build_bvh(BuilderKind::Sah, boxes.data(), centers.data(), boxes.size(), top_config);
     for (uint32_t& id : top_.prim_ids) id = placed[id];
   });
   single_identity_ = instances_.size() == 1 && instances_[0].identity;
@@ -223,7 +322,8 @@ constexpr size_t kRayGrain = 256;
 }  // namespace
 
 void Scene::intersect(const RayBatch& rays, const HitBatch& hits, int threads) const {
-  if (!committed_) throw std::logic_error("the scene changed since the last commit(): call commit() before queries");
+  check_committed();
+  check_threads(threads);
   run_with_threads(threads, [&] {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.count, kRayGrain), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t i = r.begin(); i != r.end(); ++i) {
@@ -239,7 +339,8 @@ void Scene::intersect(const RayBatch& rays, const HitBatch& hits, int threads) c
 }
 
 void Scene::occluded(const RayBatch& rays, uint8_t* blocked, int threads) const {
-  if (!committed_) throw std::logic_error("the scene changed since the last commit(): call commit() before queries");
+  check_committed();
+  check_threads(threads);
   run_with_threads(threads, [&] {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.count, kRayGrain), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t i = r.begin(); i != r.end(); ++i) blocked[i] = occluded(ray_at(rays, i)) ? 1 : 0;
@@ -262,6 +363,9 @@ size_t Scene::instanced_triangle_count() const {
 size_t Scene::memory_bytes() const {
   size_t bytes = instances_.capacity() * sizeof(Instance) + top_.nodes.capacity() * sizeof(Node) +
                  top_.prim_ids.capacity() * sizeof(uint32_t);
+  for (const MeshShading& sh : shading_)
+    bytes += sh.corner_normals.capacity() * sizeof(Vec3) + sh.corner_uvs.capacity() * sizeof(Vec2) +
+             sh.material_ids.capacity() * sizeof(int32_t);
   for (const auto& m : meshes_) bytes += m->memory_bytes();
   return bytes;
 }

@@ -1,40 +1,41 @@
-// The two-level scene: meshes stored once, each with its own BVH, and instances placing them,
-// gathered by a top-level BVH over the instances' world boxes. Queries come one ray at a time
-// or as batches spread over threads.
+// The whole scene the core renders: the two-level geometry (meshes stored once, each with its
+// own BVH, and instances placing them, gathered by a top-level BVH over the instances' world
+// boxes), each mesh's shading attributes, the materials and textures, and the world (lights,
+// background). It owns the policy too: every edit validates its input (std::invalid_argument
+// names the bad value), commit() chooses builders and honours a cancel poll. Queries come one
+// ray at a time (the integrator's) or as batches spread over threads.
 //
-// Thread safety: queries on a committed scene are read-only and may run concurrently;
-// add_mesh / add_instance / commit must not overlap with anything else (the Python binding
-// holds a lock to guarantee that).
+// Thread safety: queries and renders of a committed scene are read-only and may run
+// concurrently; edits and commit must not overlap with anything else (the Python binding holds
+// a lock to guarantee that).
 #pragma once
 
+#include "accel/builder.h"
+#include "core/cancel_poll.h"
 #include "core/ray.h"
 #include "geometry/mesh.h"
-#include "accel/builder_choice.h"
-#include "accel/lbvh_builder.h"
+#include "materials/material.h"
+#include "materials/texture.h"
 #include "scene/instance.h"
+#include "scene/mesh_shading.h"
+#include "scene/world.h"
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace toyrt {
 
-// Parses "auto", "sah", "lbvh"; throws std::invalid_argument on anything else.
-BuilderKind parse_builder(const std::string& name);
-
 struct CommitOptions {
   BuilderKind builder = BuilderKind::Auto;
   int threads = 0;  // 0: all cores
-  // Rays the caller expects to trace (pixels x samples x rays per sample), for "auto"; < 0:
-  // unknown, and "auto" keeps the SAH builder.
-  double expected_rays = -1.0;
+  // Rays the caller expects to trace (pixels x samples x rays per sample), for "auto"; unset:
+  // unknown, and "auto" keeps the SAH builder. Must be finite and >= 0 when set.
+  std::optional<double> expected_rays;
   BinnedSahConfig sah;
   LbvhConfig lbvh;
   BuilderCostModel cost_model;
-  // Cancel flag (not owned; may be null): polled between meshes and inside every SAH build.
-  // A cancelled commit throws BuildCancelled and leaves the scene uncommitted; meshes built
-  // before the cancel keep their BVHs, so the next commit builds only the rest.
-  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct CommitStats {
@@ -70,24 +71,45 @@ struct HitBatch {
 
 class Scene {
  public:
-  // Adds a mesh (no instance) and returns its id. Validation as in Mesh's constructor.
-  uint32_t add_mesh(std::vector<Vec3> vertices, std::vector<Triangle> triangles);
+  // ---- geometry and shading. Ids are int64_t so that a caller's negative id is refused by
+  // name ("unknown mesh id -1") instead of wrapping around.
+  // Adds a mesh (no instance) and returns its id. Validation as in Mesh's constructor and
+  // MeshShading::check; a refused mesh leaves the scene unchanged.
+  uint32_t add_mesh(std::vector<Vec3> vertices, std::vector<Triangle> triangles, MeshShading shading = {});
   // Places mesh `mesh` with the affine object-to-world matrix `to_world`; returns the instance
   // id. Throws std::invalid_argument for an unknown mesh, a non-finite, non-affine (last row not
   // 0 0 0 1) or singular matrix.
-  uint32_t add_instance(uint32_t mesh, const Mat4& to_world);
+  uint32_t add_instance(int64_t mesh, const Mat4& to_world);
   // Edits for interactive updates (the viewport), each leaving the scene uncommitted; ids stay
-  // valid. replace_mesh swaps a mesh's geometry (its BVH is rebuilt by the next commit, the
-  // instances placing it stay); set_instance_transform moves one instance (the next commit
-  // rebuilds only the top level); clear_instances removes every instance (meshes stay).
-  void replace_mesh(uint32_t mesh, std::vector<Vec3> vertices, std::vector<Triangle> triangles);
-  void set_instance_transform(uint32_t instance, const Mat4& to_world);
+  // valid. replace_mesh swaps a mesh's geometry and shading (its BVH is rebuilt by the next
+  // commit, the instances placing it stay); set_instance_transform moves one instance (the next
+  // commit rebuilds only the top level); clear_instances removes every instance (meshes stay).
+  void replace_mesh(int64_t mesh, std::vector<Vec3> vertices, std::vector<Triangle> triangles,
+                    MeshShading shading = {});
+  void set_instance_transform(int64_t instance, const Mat4& to_world);
   void clear_instances();
   // The transform checks of add_instance alone; returns the inverse.
   static Mat4 checked_inverse(const Mat4& to_world);
 
-  // Builds what changed since the last commit: new meshes' BVHs and the top level.
-  void commit(const CommitOptions& options = {});
+  // ---- materials, textures, world. Edits in place, so meshes keep their material ids; they
+  // do not touch the geometry (no commit needed).
+  // A Lambert texture id must name one of the scene's textures (or be -1).
+  uint32_t add_material(const Material& material);
+  void set_material(int64_t material, const Material& replacement);
+  uint32_t add_texture(Texture texture);
+  void set_texture(int64_t texture, Texture replacement);
+  uint32_t add_light(const Light& light, LightVisibility visibility = {});
+  void clear_lights();                        // lights are re-sent as a whole on an edit: they are few and cheap
+  void set_background(const Vec3& radiance);  // finite and >= 0
+  void set_background_lighting(bool on) { world_.background_lights_surfaces = on; }
+
+  // Builds what changed since the last commit: new meshes' BVHs (each with the builder
+  // options.builder names, "auto" deciding per mesh) and the top level. With should_cancel, the
+  // build runs on a worker thread while this one polls it every 10 ms (core/cancel_poll.h);
+  // returns false when it answered true: the scene stays uncommitted, and meshes built before the
+  // cancel keep their BVHs, so the next commit builds only the rest. Throws std::invalid_argument
+  // for bad options, and what should_cancel throws once the worker has stopped.
+  bool commit(const CommitOptions& options = {}, const CancelPoll& should_cancel = {});
   bool committed() const { return committed_; }
   const CommitStats& commit_stats() const { return stats_; }
 
@@ -96,6 +118,12 @@ class Scene {
   // non-finite origin, or tnear > tfar finds nothing.
   Hit intersect(const Ray& ray) const;
   bool occluded(const Ray& ray) const;
+
+  // Throws std::logic_error (naming commit()) unless the scene is committed.
+  void check_committed() const;
+  // What a render needs beyond check_committed: every material id a mesh uses names a material
+  // (with no materials at all, id 0 is the default grey). Costs one check per mesh.
+  void check_renderable() const;
 
   // Batch queries over `threads` threads (0: all cores). Throw std::logic_error before commit.
   void intersect(const RayBatch& rays, const HitBatch& hits, int threads = 0) const;
@@ -106,6 +134,10 @@ class Scene {
   const Mesh& mesh(uint32_t id) const { return *meshes_.at(id); }
   const Instance& instance(uint32_t id) const { return instances_.at(id); }
   const Bvh& top_level() const { return top_; }
+  const MeshShading& shading(uint32_t mesh) const { return shading_[mesh]; }  // one per mesh, always
+  const std::vector<Material>& materials() const { return materials_; }       // empty: all default grey
+  const std::vector<Texture>& textures() const { return textures_; }
+  const World& world() const { return world_; }
   // Triangles stored (each mesh counted once) and placed (each instance counting its mesh).
   size_t stored_triangle_count() const;
   size_t instanced_triangle_count() const;
@@ -114,8 +146,16 @@ class Scene {
  private:
   template <bool AnyHit>
   bool trace(const Ray& ray, Hit& hit) const;
+  // commit()'s work; throws BuildCancelled when *cancel turns true.
+  void build(const CommitOptions& options, const std::atomic<bool>* cancel);
+  void check_mesh_id(int64_t mesh) const;
 
   std::vector<std::unique_ptr<Mesh>> meshes_;
+  std::vector<MeshShading> shading_;      // parallel to meshes_
+  std::vector<int32_t> max_material_id_;  // parallel to meshes_: MeshShading::check's answer
+  std::vector<Material> materials_;
+  std::vector<Texture> textures_;
+  World world_;
   std::vector<Instance> instances_;
   Bvh top_;                       // over instances with a non-empty world box
   bool single_identity_ = false;  // one untransformed instance: skip the top level

@@ -7,7 +7,8 @@
 //   - on moderately sized inputs the scene finds a hit exactly when a brute-force loop over every
 //     triangle of every instance does (the BVH's boxes are conservative);
 //   - batch queries equal single-ray queries;
-//   - every builder's tree passes Bvh::validate.
+//   - every builder's tree passes Bvh::validate;
+//   - a whole scene (shading, materials, lights, world) renders to finite, non-negative pixels.
 // First input byte (from the end, FuzzedDataProvider's integer order) picks the part.
 #include "accel/binned_sah_builder.h"
 #include "accel/lbvh_builder.h"
@@ -17,6 +18,7 @@
 #include "lights/area_light.h"
 #include "lights/point_light.h"
 #include "materials/texture.h"
+#include "render/renderer.h"
 #include "scene/scene.h"
 
 #include <fuzzer/FuzzedDataProvider.h>
@@ -44,12 +46,15 @@ using namespace toyrt;
 // Floats that reach the interesting cases: a coarse grid (shared vertices and edges, rays along
 // axes and through vertices), special values, small reals, and arbitrary bit patterns.
 float fuzz_float(FuzzedDataProvider& in) {
-  static const float special[] = {0.0f, -0.0f, NAN, INFINITY, -INFINITY, FLT_MAX, -FLT_MAX,
-                                  FLT_MIN, 1e-40f, 1e30f, -1e30f, 1e-30f, 1e6f};
+  static const float special[] = {0.0f,    -0.0f,  NAN,   INFINITY, -INFINITY, FLT_MAX, -FLT_MAX,
+                                  FLT_MIN, 1e-40f, 1e30f, -1e30f,   1e-30f,    1e6f};
   switch (in.ConsumeIntegralInRange<int>(0, 3)) {
-    case 0: return float(in.ConsumeIntegralInRange<int>(-8, 8)) * 0.5f;
-    case 1: return special[in.ConsumeIntegralInRange<size_t>(0, sizeof(special) / sizeof(float) - 1)];
-    case 2: return in.ConsumeFloatingPointInRange<float>(-4.0f, 4.0f);
+    case 0:
+      return float(in.ConsumeIntegralInRange<int>(-8, 8)) * 0.5f;
+    case 1:
+      return special[in.ConsumeIntegralInRange<size_t>(0, sizeof(special) / sizeof(float) - 1)];
+    case 2:
+      return in.ConsumeFloatingPointInRange<float>(-4.0f, 4.0f);
     default: {
       const uint32_t bits = in.ConsumeIntegral<uint32_t>();
       float f;
@@ -67,8 +72,9 @@ Vec3 fuzz_vec3(FuzzedDataProvider& in) {
 Mat4 fuzz_matrix(FuzzedDataProvider& in) {
   Mat4 m(1.0f);
   switch (in.ConsumeIntegralInRange<int>(0, 3)) {
-    case 0: break;  // identity
-    case 1:         // scale and translation
+    case 0:
+      break;  // identity
+    case 1:   // scale and translation
       for (int a = 0; a < 3; ++a) m[a][a] = fuzz_float(in);
       m[3] = glm::vec4(fuzz_vec3(in), 1.0f);
       break;
@@ -97,8 +103,8 @@ bool degenerate(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
 
 // The documented contract of Scene::intersect: these rays find nothing.
 bool valid_ray(const Ray& r) {
-  return is_finite(r.org) && is_finite(r.dir) && r.dir != Vec3(0.0f) && !std::isnan(r.tnear) &&
-         !std::isnan(r.tfar) && r.tnear <= r.tfar;
+  return is_finite(r.org) && is_finite(r.dir) && r.dir != Vec3(0.0f) && !std::isnan(r.tnear) && !std::isnan(r.tfar) &&
+         r.tnear <= r.tfar;
 }
 
 // Every triangle of every instance, with the scene's own object-space ray (scene.cpp).
@@ -223,7 +229,8 @@ void fuzz_scene(FuzzedDataProvider& in) {
     } else {
       FUZZ_CHECK(h.t == kInfinity && h.instance == kInvalidId);
     }
-    if (all_moderate && moderate(r.org) && moderate(r.dir) && moderate(r.tnear) && (moderate(r.tfar) || r.tfar == kInfinity)) {
+    if (all_moderate && moderate(r.org) && moderate(r.dir) && moderate(r.tnear) &&
+        (moderate(r.tfar) || r.tfar == kInfinity)) {
       const bool brute = brute_force_hits(scene, r);
       if (brute != h.found()) dump(scene, r, h);
       FUZZ_CHECK(h.found() == brute);
@@ -285,6 +292,79 @@ void fuzz_builders(FuzzedDataProvider& in) {
 }
 
 // Constructors refuse bad settings with std::invalid_argument; what they accept must be usable.
+// The whole scene rendered: fuzzed shading (refused exactly when MeshShading::check says so),
+// materials of every kind with fuzzed settings, a light, the background; a 2 x 2 render must
+// give finite, non-negative pixels or refuse a material id it does not have.
+void fuzz_render(FuzzedDataProvider& in) {
+  Scene scene;
+  std::vector<Vec3> vertices(in.ConsumeIntegralInRange<size_t>(0, 6));
+  for (Vec3& v : vertices) v = Vec3(fuzz_float(in) * 0.25f, fuzz_float(in) * 0.25f, fuzz_float(in) * 0.1f);
+  std::vector<Triangle> triangles(in.ConsumeIntegralInRange<size_t>(0, 4));
+  for (Triangle& t : triangles)
+    for (int k = 0; k < 3; ++k)
+      t[k] = in.ConsumeIntegralInRange<uint32_t>(0, uint32_t(std::max<size_t>(vertices.size(), 1) - 1));
+  MeshShading sh;
+  const size_t corners = 3 * triangles.size() + (in.ConsumeIntegralInRange<int>(0, 7) == 0 ? 1 : 0);  // rarely wrong
+  if (in.ConsumeBool()) sh.corner_normals.resize(corners);
+  for (Vec3& n : sh.corner_normals) n = fuzz_vec3(in);
+  if (in.ConsumeBool()) sh.corner_uvs.resize(corners);
+  for (Vec2& uv : sh.corner_uvs) uv = Vec2(fuzz_float(in), fuzz_float(in));
+  if (in.ConsumeBool()) sh.material_ids.resize(triangles.size());
+  for (int32_t& id : sh.material_ids) id = in.ConsumeIntegralInRange<int32_t>(-1, 4);
+  bool shading_ok = true;
+  try {
+    (void)sh.check(triangles.size());
+  } catch (const std::invalid_argument&) {
+    shading_ok = false;
+  }
+  try {
+    scene.add_instance(scene.add_mesh(vertices, triangles, sh), Mat4(1.0f));
+    FUZZ_CHECK(shading_ok);
+  } catch (const std::invalid_argument&) {
+    FUZZ_CHECK(scene.mesh_count() == 0);  // refused shading or vertices: nothing added
+  }
+  if (in.ConsumeBool())
+    scene.add_texture(Texture::from_floats(2, 1, 3, {0, 0.5f, 1, 1, 0.5f, 0}, ColorEncoding::Linear));
+  for (int m = in.ConsumeIntegralInRange<int>(0, 4); m > 0; --m) {
+    static const char* kinds[] = {"diffuse", "refraction", "glass", "metal"};
+    try {
+      scene.add_material(make_material(kinds[in.ConsumeIntegralInRange<int>(0, 3)], fuzz_vec3(in),
+                                       in.ConsumeIntegralInRange<int64_t>(-2, 1), fuzz_float(in)));
+    } catch (const std::invalid_argument&) {
+    }
+  }
+  try {
+    scene.add_light(PointLight::make(fuzz_vec3(in), fuzz_float(in), Vec3(1.0f), fuzz_float(in)),
+                    {in.ConsumeBool(), in.ConsumeBool()});
+  } catch (const std::invalid_argument&) {
+  }
+  try {
+    scene.set_background(fuzz_vec3(in));
+  } catch (const std::invalid_argument&) {
+  }
+  scene.set_background_lighting(in.ConsumeBool());
+  CommitOptions options;
+  options.threads = 1;
+  scene.commit(options);
+  CameraParams p;
+  p.type = CameraType::Orthographic;
+  p.ortho_scale = 2.0f;
+  p.resolution_x = p.resolution_y = 2;
+  p.matrix_world[3] = glm::vec4(0.0f, 0.0f, 3.0f, 1.0f);
+  RenderSettings settings;
+  settings.samples = 1;
+  settings.threads = 1;
+  settings.integrator.max_specular_depth = in.ConsumeIntegralInRange<int>(0, 4);
+  settings.integrator.split_depth = in.ConsumeIntegralInRange<int>(0, 2);
+  settings.integrator.light_sampling = LightSampling(in.ConsumeIntegralInRange<int>(0, 2));
+  try {
+    const RenderResult r = render(scene, Camera::make(p), settings);
+    for (float x : r.rgba) FUZZ_CHECK(std::isfinite(x) && x >= 0.0f);
+  } catch (const std::invalid_argument& e) {
+    FUZZ_CHECK(std::strstr(e.what(), "uses material id") != nullptr);  // the only refusal left
+  }
+}
+
 void fuzz_transport(FuzzedDataProvider& in) {
   CameraParams p;
   p.type = in.ConsumeBool() ? CameraType::Perspective : CameraType::Orthographic;
@@ -324,10 +404,10 @@ void fuzz_transport(FuzzedDataProvider& in) {
   }
   try {
     const AreaLight light = AreaLight::make(AreaShape(in.ConsumeIntegralInRange<int>(0, 3)), fuzz_float(in),
-                                            fuzz_float(in), fuzz_matrix(in), fuzz_float(in), fuzz_vec3(in),
-                                            in.ConsumeBool() ? AreaSampling::Area : AreaSampling::SolidAngle);
-    (void)sample(light, shading_point, u);
-    (void)evaluate(light, shading_point, normal);
+                                            fuzz_float(in), fuzz_matrix(in), fuzz_float(in), fuzz_vec3(in));
+    const AreaSampling sampling = in.ConsumeBool() ? AreaSampling::Area : AreaSampling::SolidAngle;
+    (void)sample(light, shading_point, u, sampling);
+    (void)evaluate(light, shading_point, normal, sampling);
     (void)importance(light, shading_point, normal);
   } catch (const std::invalid_argument&) {
   }
@@ -336,10 +416,12 @@ void fuzz_transport(FuzzedDataProvider& in) {
     const int c = in.ConsumeIntegralInRange<int>(0, 5);
     std::vector<float> texels(in.ConsumeIntegralInRange<size_t>(0, 100));
     for (float& x : texels) x = fuzz_float(in);
-    const Texture tex = Texture::from_floats(w, h, c, texels, in.ConsumeBool() ? ColorEncoding::Srgb : ColorEncoding::Linear);
+    const Texture tex =
+        Texture::from_floats(w, h, c, texels, in.ConsumeBool() ? ColorEncoding::Srgb : ColorEncoding::Linear);
     (void)tex.lookup(Vec2(fuzz_float(in), fuzz_float(in)));
   } catch (const std::invalid_argument&) {
   }
+  fuzz_render(in);  // last, so the inputs above read the bytes they read before it existed
 }
 
 }  // namespace
@@ -347,9 +429,15 @@ void fuzz_transport(FuzzedDataProvider& in) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzedDataProvider in(data, size);
   switch (in.ConsumeIntegralInRange<int>(0, 2)) {
-    case 0: fuzz_scene(in); break;
-    case 1: fuzz_builders(in); break;
-    default: fuzz_transport(in); break;
+    case 0:
+      fuzz_scene(in);
+      break;
+    case 1:
+      fuzz_builders(in);
+      break;
+    default:
+      fuzz_transport(in);
+      break;
   }
   return 0;
 }

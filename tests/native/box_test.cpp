@@ -33,9 +33,9 @@ TEST(BoxTest, AxisParallelRayOutsideASlabMisses) {
 }
 
 TEST(BoxTest, RespectsTheSegment) {
-  EXPECT_EQ(entry({0.5f, 0.5f, 3.0f}, {0, 0, -1}, 0.0f, 1.5f), kInfinity);   // ends before the box
-  EXPECT_EQ(entry({0.5f, 0.5f, 3.0f}, {0, 0, 1}), kInfinity);                // box behind
-  EXPECT_NE(entry({0.5f, 0.5f, 3.0f}, {0, 0, -1}, 0.0f, 2.0f), kInfinity);   // touches at tfar
+  EXPECT_EQ(entry({0.5f, 0.5f, 3.0f}, {0, 0, -1}, 0.0f, 1.5f), kInfinity);  // ends before the box
+  EXPECT_EQ(entry({0.5f, 0.5f, 3.0f}, {0, 0, 1}), kInfinity);               // box behind
+  EXPECT_NE(entry({0.5f, 0.5f, 3.0f}, {0, 0, -1}, 0.0f, 2.0f), kInfinity);  // touches at tfar
 }
 
 TEST(BoxTest, GrazingACornerStillEnters) {

@@ -105,9 +105,9 @@ TEST(Camera, ShiftMovesImageCentreByShiftTimesLargerDimension) {
     const Ray b = plain.generate(w / 2.0f + 0.1f * larger, h / 2.0f + 0.25f * larger);
     EXPECT_NEAR(glm::length(a.dir - b.dir), 0.0f, 1e-6f) << w << "x" << h;
     // Shift translates the image: every pixel moves by the same amount.
-    EXPECT_NEAR(glm::length(shifted.generate(3.0f, 7.0f).dir -
-                            plain.generate(3.0f + 0.1f * larger, 7.0f + 0.25f * larger).dir),
-                0.0f, 1e-6f);
+    EXPECT_NEAR(
+        glm::length(shifted.generate(3.0f, 7.0f).dir - plain.generate(3.0f + 0.1f * larger, 7.0f + 0.25f * larger).dir),
+        0.0f, 1e-6f);
   }
 }
 
@@ -262,18 +262,32 @@ TEST(Camera, RejectsInvalidSettings) {
   bad([](CameraParams& p) { p.resolution_x = 0; });
   bad([](CameraParams& p) { p.resolution_y = -5; });
   bad([](CameraParams& p) { p.resolution_percentage = 0; });
-  bad([](CameraParams& p) { p.resolution_x = 1; p.resolution_percentage = 50; });  // 0 pixels
+  bad([](CameraParams& p) {
+    p.resolution_x = 1;
+    p.resolution_percentage = 50;
+  });  // 0 pixels
   bad([](CameraParams& p) { p.lens = 0.0f; });
   bad([](CameraParams& p) { p.lens = -35.0f; });
   bad([](CameraParams& p) { p.sensor_width = 0.0f; });
-  bad([](CameraParams& p) { p.type = CameraType::Orthographic; p.ortho_scale = 0.0f; });
+  bad([](CameraParams& p) {
+    p.type = CameraType::Orthographic;
+    p.ortho_scale = 0.0f;
+  });
   bad([](CameraParams& p) { p.pixel_aspect_y = 0.0f; });
   bad([](CameraParams& p) { p.clip_end = p.clip_start; });
   bad([](CameraParams& p) { p.shift_x = NAN; });
   bad([](CameraParams& p) { p.matrix_world[3][1] = INFINITY; });
   bad([](CameraParams& p) { p.matrix_world[0][3] = 0.5f; });  // not affine
   bad([](CameraParams& p) { p.matrix_world[2] = glm::vec4(0.0f); });
-  bad([](CameraParams& p) { p.use_border = true; p.border_min_x = 0.6f; p.border_max_x = 0.5f; });
-  bad([](CameraParams& p) { p.use_border = true; p.border_min_y = 0.5f; p.border_max_y = 0.501f; });  // no pixel
+  bad([](CameraParams& p) {
+    p.use_border = true;
+    p.border_min_x = 0.6f;
+    p.border_max_x = 0.5f;
+  });
+  bad([](CameraParams& p) {
+    p.use_border = true;
+    p.border_min_y = 0.5f;
+    p.border_max_y = 0.501f;
+  });  // no pixel
   EXPECT_NO_THROW(Camera::make(landscape()));
 }

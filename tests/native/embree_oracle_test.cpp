@@ -57,7 +57,9 @@ INSTANTIATE_TEST_SUITE_P(Builders, EmbreeOracle, ::testing::Values(BuilderKind::
                            return info.param == BuilderKind::Sah ? std::string("Sah") : std::string("Lbvh");
                          });
 
-TEST_P(EmbreeOracle, RandomTriangleSoupAgrees) { expect_agreement(GetParam(), "soup", triangle_soup(100000, 0.03f, 1)); }
+TEST_P(EmbreeOracle, RandomTriangleSoupAgrees) {
+  expect_agreement(GetParam(), "soup", triangle_soup(100000, 0.03f, 1));
+}
 
 TEST_P(EmbreeOracle, ClosedSphereAgrees) { expect_agreement(GetParam(), "sphere", uv_sphere(200, 400), true); }
 

@@ -37,7 +37,8 @@ MeshData first_triangles(const MeshData& m, size_t n) {
 void expect_same_as_reference(const MeshData& m, MortonBits bits) {
   const Prims p = prims_of(m);
   const LbvhConfig config{bits};
-  const LbvhHierarchy gpu = build_lbvh_hierarchy_opencl(p.boxes.data(), p.centers.data(), p.boxes.size(), config, nullptr, true);
+  const LbvhHierarchy gpu =
+      build_lbvh_hierarchy_opencl(p.boxes.data(), p.centers.data(), p.boxes.size(), config, nullptr, true);
   const LbvhHierarchy cpu = build_lbvh_hierarchy_reference(p.boxes.data(), p.centers.data(), p.boxes.size(), config);
   EXPECT_EQ(gpu.keys, cpu.keys);
   EXPECT_EQ(gpu.values, cpu.values);

@@ -49,9 +49,11 @@ void expect_converges(const Estimate& e, double exact, const char* what) {
       << what << ": standard error " << e.standard_error;
 }
 
-// Direct irradiance at p with normal n (red channel) from one light sample.
-double irradiance_sample(const Light& light, const Vec3& p, const Vec3& n, const Vec2& u) {
-  const LightSample s = sample_light(light, p, u);
+// Direct irradiance at p with normal n (red channel) from one light sample; `sampling` is the
+// render's estimator for rectangular area lights.
+double irradiance_sample(const Light& light, const Vec3& p, const Vec3& n, const Vec2& u,
+                         AreaSampling sampling = AreaSampling::SolidAngle) {
+  const LightSample s = sample_light(light, p, u, sampling);
   if (!s.valid()) return 0.0;
   return double(s.radiance.x) * std::max(0.0f, glm::dot(n, s.wi)) / s.pdf;
 }
@@ -71,8 +73,7 @@ double corner_solid_angle(double a, double b, double h) {
 }
 // Any rectangle [x0, x1] x [y0, y1] (relative to the foot of p) from corner rectangles by
 // inclusion-exclusion, with the quantity extended oddly to negative coordinates.
-double over_rectangle(double (*corner)(double, double, double), double x0, double x1, double y0, double y1,
-                      double h) {
+double over_rectangle(double (*corner)(double, double, double), double x0, double x1, double y0, double y1, double h) {
   const auto g = [&](double x, double y) {
     return (x < 0 ? -1.0 : 1.0) * (y < 0 ? -1.0 : 1.0) * corner(std::fabs(x), std::fabs(y), h);
   };
@@ -81,8 +82,8 @@ double over_rectangle(double (*corner)(double, double, double), double x0, doubl
 
 // A light 1 m wide rectangle `sx` x `sy` at height h above the origin, facing down (-Z, Blender's
 // default orientation), power P, white.
-AreaLight ceiling_light(AreaShape shape, float sx, float sy, float h, float power, AreaSampling sampling) {
-  return AreaLight::make(shape, sx, sy, glm::translate(Mat4(1.0f), Vec3(0.0f, 0.0f, h)), power, Vec3(1.0f), sampling);
+AreaLight ceiling_light(AreaShape shape, float sx, float sy, float h, float power) {
+  return AreaLight::make(shape, sx, sy, glm::translate(Mat4(1.0f), Vec3(0.0f, 0.0f, h)), power, Vec3(1.0f));
 }
 
 }  // namespace
@@ -141,7 +142,8 @@ TEST(SphereLight, IrradianceEqualsPointLightWhileAboveTheHorizon) {
   for (double tilt : {0.0, 0.5, 1.2}) {
     ASSERT_LT(tilt + theta_max, kPiD / 2);  // fully above the horizon
     const Vec3 n(float(std::sin(tilt)), 0.0f, float(std::cos(tilt)));
-    const Estimate e = monte_carlo(100000, [&](uint32_t i) { return irradiance_sample(light, Vec3(0.0f), n, rand2(i, 1)); });
+    const Estimate e =
+        monte_carlo(100000, [&](uint32_t i) { return irradiance_sample(light, Vec3(0.0f), n, rand2(i, 1)); });
     expect_converges(e, intensity * std::cos(tilt), "sphere light");
   }
 }
@@ -174,17 +176,18 @@ TEST(SphereLight, InsideTheSphereIrradianceIsPiL) {
   const Light light = PointLight::make(Vec3(0), 50.0f, Vec3(1.0f), 1.0f);
   const double radiance = std::get<PointLight>(light).radiance.x;
   const Vec3 n = glm::normalize(Vec3(0.3f, -1.0f, 0.2f));
-  const Estimate e = monte_carlo(100000, [&](uint32_t i) { return irradiance_sample(light, Vec3(0.2f, 0.1f, -0.3f), n, rand2(i, 3)); });
+  const Estimate e = monte_carlo(
+      100000, [&](uint32_t i) { return irradiance_sample(light, Vec3(0.2f, 0.1f, -0.3f), n, rand2(i, 3)); });
   expect_converges(e, kPiD * radiance, "inside a sphere light");
 }
 
 TEST(AreaLight, RadianceIsPowerOverFourArea) {
   const float power = 100.0f;
-  const AreaLight square = ceiling_light(AreaShape::Square, 2.0f, 0.0f, 1.0f, power, AreaSampling::Area);
+  const AreaLight square = ceiling_light(AreaShape::Square, 2.0f, 0.0f, 1.0f, power);
   EXPECT_FLOAT_EQ(square.radiance.x, power / (4.0f * 4.0f));
-  const AreaLight disk = ceiling_light(AreaShape::Disk, 2.0f, 0.0f, 1.0f, power, AreaSampling::Area);
+  const AreaLight disk = ceiling_light(AreaShape::Disk, 2.0f, 0.0f, 1.0f, power);
   EXPECT_FLOAT_EQ(disk.radiance.x, power / (4.0f * float(kPiD)));  // diameter 2: area pi
-  const AreaLight ellipse = ceiling_light(AreaShape::Ellipse, 2.0f, 0.5f, 1.0f, power, AreaSampling::Area);
+  const AreaLight ellipse = ceiling_light(AreaShape::Ellipse, 2.0f, 0.5f, 1.0f, power);
   EXPECT_FLOAT_EQ(ellipse.radiance.x, power / (4.0f * float(kPiD) * 0.25f));
   // The object's scale scales the light (Cycles), at constant power.
   const Mat4 scaled = glm::scale(glm::translate(Mat4(1.0f), Vec3(0, 0, 1)), Vec3(2.0f, 3.0f, 1.0f));
@@ -199,8 +202,10 @@ TEST(AreaLight, SmallLightsMatchCyclesPixelsOfBlenderUnits) {
   // pixel (albedo / pi) E: 5 cm square 7.950, 5 cm disk 7.953.
   for (auto [shape, measured] : {std::pair{AreaShape::Square, 7.950}, std::pair{AreaShape::Disk, 7.953}})
     for (AreaSampling sampling : {AreaSampling::Area, AreaSampling::SolidAngle}) {
-      const Light light = ceiling_light(shape, 0.05f, 0.0f, 1.0f, 100.0f, sampling);
-      const Estimate e = monte_carlo(20000, [&](uint32_t i) { return irradiance_sample(light, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 4)); });
+      const Light light = ceiling_light(shape, 0.05f, 0.0f, 1.0f, 100.0f);
+      const Estimate e = monte_carlo(20000, [&](uint32_t i) {
+        return irradiance_sample(light, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 4), sampling);
+      });
       EXPECT_NEAR(e.mean / kPiD, measured, 0.001 * measured);
     }
 }
@@ -208,14 +213,15 @@ TEST(AreaLight, SmallLightsMatchCyclesPixelsOfBlenderUnits) {
 TEST(AreaLight, BothEstimatorsConvergeToTheRectangleIrradiance) {
   const float power = 80.0f, h = 0.7f, sx = 1.6f, sy = 0.9f;
   for (AreaSampling sampling : {AreaSampling::Area, AreaSampling::SolidAngle}) {
-    const Light light = ceiling_light(AreaShape::Rectangle, sx, sy, h, power, sampling);
+    const Light light = ceiling_light(AreaShape::Rectangle, sx, sy, h, power);
     const double radiance = power / (4.0 * sx * sy);
     // Under the centre (four equal corner rectangles), and off-centre, partly outside the light.
     for (Vec3 p : {Vec3(0.0f), Vec3(0.5f, -0.3f, 0.0f), Vec3(1.2f, 0.8f, 0.2f)}) {
       const double height = h - p.z;
       const double exact = radiance * over_rectangle(corner_irradiance_over_radiance, -sx / 2 - p.x, sx / 2 - p.x,
                                                      -sy / 2 - p.y, sy / 2 - p.y, height);
-      const Estimate e = monte_carlo(100000, [&](uint32_t i) { return irradiance_sample(light, p, Vec3(0, 0, 1), rand2(i, 5)); });
+      const Estimate e = monte_carlo(
+          100000, [&](uint32_t i) { return irradiance_sample(light, p, Vec3(0, 0, 1), rand2(i, 5), sampling); });
       expect_converges(e, exact, sampling == AreaSampling::Area ? "area sampling" : "solid-angle sampling");
     }
   }
@@ -228,7 +234,7 @@ TEST(AreaLight, SolidAngleSamplesLieOnTheRectangleWithPdfOneOverSolidAngle) {
   // A tilted, rotated rectangle seen from several points in front of it.
   Mat4 m = glm::translate(Mat4(1.0f), Vec3(0.2f, 0.5f, 2.0f));
   m = glm::rotate(m, 0.6f, glm::normalize(Vec3(1.0f, 0.4f, 0.2f)));
-  const AreaLight light = AreaLight::make(AreaShape::Rectangle, 1.5f, 0.8f, m, 10.0f, Vec3(1.0f), AreaSampling::SolidAngle);
+  const AreaLight light = AreaLight::make(AreaShape::Rectangle, 1.5f, 0.8f, m, 10.0f, Vec3(1.0f));
   const Vec3 centre = light.center, ux = glm::normalize(light.edge_x), uy = glm::normalize(light.edge_y);
   int points = 0;
   for (uint32_t j = 0; j < 20; ++j) {
@@ -240,7 +246,7 @@ TEST(AreaLight, SolidAngleSamplesLieOnTheRectangleWithPdfOneOverSolidAngle) {
     const double px = glm::dot(p - centre, ux), py = glm::dot(p - centre, uy);
     const double omega = over_rectangle(corner_solid_angle, -0.75 - px, 0.75 - px, -0.4 - py, 0.4 - py, height);
     for (uint32_t i = 0; i < 500; ++i) {
-      const LightSample s = sample(light, p, rand2(i, 7));
+      const LightSample s = sample(light, p, rand2(i, 7), AreaSampling::SolidAngle);
       ASSERT_TRUE(s.valid());
       EXPECT_NEAR(s.pdf * omega, 1.0, 1e-4);
       const Vec3 local = s.point - centre;
@@ -248,7 +254,7 @@ TEST(AreaLight, SolidAngleSamplesLieOnTheRectangleWithPdfOneOverSolidAngle) {
       EXPECT_LE(std::fabs(glm::dot(local, ux)), 0.75f + 1e-5f);
       EXPECT_LE(std::fabs(glm::dot(local, uy)), 0.4f + 1e-5f);
       EXPECT_NEAR(glm::length(p + s.distance * s.wi - s.point), 0.0f, 1e-5f);
-      const LightEval e = evaluate(light, p, s.wi);
+      const LightEval e = evaluate(light, p, s.wi, AreaSampling::SolidAngle);
       ASSERT_TRUE(e.hit());
       EXPECT_NEAR(e.pdf, s.pdf, 1e-5f * s.pdf);
     }
@@ -262,9 +268,9 @@ TEST(AreaLight, MeanInversePdfIsTheSolidAngle) {
   const Vec3 p(0.3f, 0.1f, 0.0f);
   const double omega = over_rectangle(corner_solid_angle, -1.0 - p.x, 1.0 - p.x, -0.5 - p.y, 0.5 - p.y, h);
   for (AreaSampling sampling : {AreaSampling::Area, AreaSampling::SolidAngle}) {
-    const AreaLight light = ceiling_light(AreaShape::Rectangle, 2.0f, 1.0f, h, 1.0f, sampling);
+    const AreaLight light = ceiling_light(AreaShape::Rectangle, 2.0f, 1.0f, h, 1.0f);
     const Estimate e = monte_carlo(100000, [&](uint32_t i) {
-      const LightSample s = sample(light, p, rand2(i, 8));
+      const LightSample s = sample(light, p, rand2(i, 8), sampling);
       return s.valid() ? 1.0 / s.pdf : 0.0;
     });
     expect_converges(e, omega, "mean of 1 / pdf");
@@ -275,7 +281,7 @@ TEST(AreaLight, SolidAngleSamplerChiSquarePerSubRectangle) {
   // Each cell of an 8 x 8 grid on the light should receive its solid angle over Omega of the samples.
   constexpr int kGrid = 8, kN = 100000;
   const float sx = 2.0f, sy = 1.2f;
-  const AreaLight light = ceiling_light(AreaShape::Rectangle, sx, sy, 1.0f, 1.0f, AreaSampling::SolidAngle);
+  const AreaLight light = ceiling_light(AreaShape::Rectangle, sx, sy, 1.0f, 1.0f);
   for (Vec3 p : {Vec3(0.0f, 0.0f, 0.8f), Vec3(0.9f, -0.5f, 0.95f), Vec3(2.0f, 1.2f, 0.2f)}) {
     const double height = 1.0 - p.z;
     std::vector<double> counts(kGrid * kGrid, 0.0), expected(kGrid * kGrid);
@@ -288,7 +294,7 @@ TEST(AreaLight, SolidAngleSamplerChiSquarePerSubRectangle) {
         omega += expected[i * kGrid + j];
       }
     for (int n = 0; n < kN; ++n) {
-      const LightSample s = sample(light, p, rand2(n, 9));
+      const LightSample s = sample(light, p, rand2(n, 9), AreaSampling::SolidAngle);
       ASSERT_TRUE(s.valid());
       const int i = std::clamp(int((s.point.x + sx / 2) / sx * kGrid), 0, kGrid - 1);
       const int j = std::clamp(int((s.point.y + sy / 2) / sy * kGrid), 0, kGrid - 1);
@@ -322,8 +328,9 @@ TEST(AreaLight, SolidAngleSamplingHasLowerVarianceCloseToALargeLight) {
   const Vec3 p(0.3f, -0.2f, 0.9f), n(0, 0, 1);
   double variance[2];
   for (AreaSampling sampling : {AreaSampling::Area, AreaSampling::SolidAngle}) {
-    const Light light = ceiling_light(AreaShape::Square, 4.0f, 0.0f, 1.0f, 100.0f, sampling);
-    const Estimate e = monte_carlo(20000, [&](uint32_t i) { return irradiance_sample(light, p, n, rand2(i, 10)); });
+    const Light light = ceiling_light(AreaShape::Square, 4.0f, 0.0f, 1.0f, 100.0f);
+    const Estimate e =
+        monte_carlo(20000, [&](uint32_t i) { return irradiance_sample(light, p, n, rand2(i, 10), sampling); });
     variance[int(sampling)] = e.standard_error * e.standard_error;
   }
   std::printf("variance ratio area / solid angle: %.1f\n", variance[0] / variance[1]);
@@ -333,15 +340,16 @@ TEST(AreaLight, SolidAngleSamplingHasLowerVarianceCloseToALargeLight) {
 TEST(AreaLight, DiskAndEllipseIrradianceOnTheAxis) {
   const float h = 0.8f, power = 50.0f;
   // Disk of radius R: E = pi L R^2 / (h^2 + R^2).
-  const Light disk = ceiling_light(AreaShape::Disk, 1.2f, 0.0f, h, power, AreaSampling::Area);
+  const Light disk = ceiling_light(AreaShape::Disk, 1.2f, 0.0f, h, power);
   const double l_disk = std::get<AreaLight>(disk).radiance.x, r = 0.6;
-  const Estimate e_disk = monte_carlo(100000, [&](uint32_t i) { return irradiance_sample(disk, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 11)); });
+  const Estimate e_disk =
+      monte_carlo(100000, [&](uint32_t i) { return irradiance_sample(disk, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 11)); });
   expect_converges(e_disk, kPiD * l_disk * r * r / (h * h + r * r), "disk");
   // Ellipse with semi-axes a, b: in polar coordinates the radial integral of L h^2 rho / (h^2 +
   // rho^2)^2 is closed, leaving E = L integral over phi of rho_max^2 / (2 (h^2 + rho_max^2)),
   // rho_max^2 = 1 / (cos^2/a^2 + sin^2/b^2); the trapezoid rule is spectrally exact for this
   // smooth periodic integrand.
-  const Light ellipse = ceiling_light(AreaShape::Ellipse, 1.6f, 0.5f, h, power, AreaSampling::Area);
+  const Light ellipse = ceiling_light(AreaShape::Ellipse, 1.6f, 0.5f, h, power);
   const double l_ellipse = std::get<AreaLight>(ellipse).radiance.x, a = 0.8, b = 0.25;
   double integral = 0.0;
   constexpr int kSteps = 4096;
@@ -350,21 +358,23 @@ TEST(AreaLight, DiskAndEllipseIrradianceOnTheAxis) {
     const double rho2 = 1.0 / (std::pow(std::cos(phi) / a, 2) + std::pow(std::sin(phi) / b, 2));
     integral += rho2 / (2.0 * (h * h + rho2)) * (2.0 * kPiD / kSteps);
   }
-  const Estimate e_ellipse = monte_carlo(100000, [&](uint32_t i) { return irradiance_sample(ellipse, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 12)); });
+  const Estimate e_ellipse = monte_carlo(
+      100000, [&](uint32_t i) { return irradiance_sample(ellipse, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 12)); });
   expect_converges(e_ellipse, l_ellipse * integral, "ellipse");
 }
 
 TEST(AreaLight, IsOneSided) {
   for (AreaShape shape : {AreaShape::Rectangle, AreaShape::Disk}) {
-    const AreaLight light = ceiling_light(shape, 1.0f, 1.0f, 1.0f, 100.0f, AreaSampling::SolidAngle);
+    const AreaLight light = ceiling_light(shape, 1.0f, 1.0f, 1.0f, 100.0f);
     const Vec3 above(0.1f, 0.2f, 1.5f);  // behind the light: it emits downwards
-    EXPECT_FALSE(sample(light, above, Vec2(0.3f, 0.6f)).valid());
-    EXPECT_FALSE(evaluate(light, above, Vec3(0, 0, -1)).hit());
+    constexpr AreaSampling kSolid = AreaSampling::SolidAngle;
+    EXPECT_FALSE(sample(light, above, Vec2(0.3f, 0.6f), kSolid).valid());
+    EXPECT_FALSE(evaluate(light, above, Vec3(0, 0, -1), kSolid).hit());
     EXPECT_EQ(importance(light, above, Vec3(0, 0, -1)), 0.0f);
-    EXPECT_FALSE(sample(light, Vec3(3.0f, 0.0f, 1.0f), Vec2(0.3f, 0.6f)).valid());  // in its plane
+    EXPECT_FALSE(sample(light, Vec3(3.0f, 0.0f, 1.0f), Vec2(0.3f, 0.6f), kSolid).valid());  // in its plane
     // From below, a ray going down misses; going up hits.
-    EXPECT_FALSE(evaluate(light, Vec3(0.0f), Vec3(0, 0, -1)).hit());
-    EXPECT_TRUE(evaluate(light, Vec3(0.0f), Vec3(0, 0, 1)).hit());
+    EXPECT_FALSE(evaluate(light, Vec3(0.0f), Vec3(0, 0, -1), kSolid).hit());
+    EXPECT_TRUE(evaluate(light, Vec3(0.0f), Vec3(0, 0, 1), kSolid).hit());
   }
 }
 
@@ -387,9 +397,9 @@ TEST(LightSelector, ProbabilitiesSumToOneAndFollowTheImportance) {
   std::vector<Light> lights = {
       PointLight::make(Vec3(0, 0, 2), 100.0f, Vec3(1.0f)),
       PointLight::make(Vec3(3, 0, 1), 40.0f, Vec3(1.0f, 0.0f, 0.0f), 0.2f),
-      ceiling_light(AreaShape::Rectangle, 1.0f, 2.0f, 3.0f, 200.0f, AreaSampling::SolidAngle),
-      PointLight::make(Vec3(0, 0, -2), 100.0f, Vec3(1.0f)),  // below the receiver: cannot contribute
-      ceiling_light(AreaShape::Disk, 1.0f, 0.0f, -1.0f, 100.0f, AreaSampling::Area),  // faces away
+      ceiling_light(AreaShape::Rectangle, 1.0f, 2.0f, 3.0f, 200.0f),
+      PointLight::make(Vec3(0, 0, -2), 100.0f, Vec3(1.0f)),       // below the receiver: cannot contribute
+      ceiling_light(AreaShape::Disk, 1.0f, 0.0f, -1.0f, 100.0f),  // faces away
   };
   const LightSelector selector(lights);
   const Vec3 p(0.2f, 0.1f, 0.0f), n(0, 0, 1);
@@ -422,7 +432,7 @@ TEST(LightSelector, OneSampleEstimateIsUnbiased) {
   std::vector<Light> lights = {
       PointLight::make(Vec3(0.5f, 0, 1), 30.0f, Vec3(1.0f)),
       PointLight::make(Vec3(-2, 1, 3), 300.0f, Vec3(1.0f)),
-      ceiling_light(AreaShape::Rectangle, 1.0f, 2.0f, 1.5f, 100.0f, AreaSampling::SolidAngle),
+      ceiling_light(AreaShape::Rectangle, 1.0f, 2.0f, 1.5f, 100.0f),
   };
   const LightSelector selector(lights);
   const Vec3 p(0.0f), n(0, 0, 1);
@@ -445,8 +455,8 @@ TEST(LightSelector, ImportanceIsPositiveWhereverALightContributes) {
   // importance, otherwise selection would be biased.
   std::vector<Light> lights = {
       PointLight::make(Vec3(0, 0, 0), 10.0f, Vec3(1.0f), 0.5f),
-      ceiling_light(AreaShape::Rectangle, 2.0f, 1.0f, 0.0f, 10.0f, AreaSampling::SolidAngle),
-      ceiling_light(AreaShape::Ellipse, 2.0f, 1.0f, 0.0f, 10.0f, AreaSampling::Area),
+      ceiling_light(AreaShape::Rectangle, 2.0f, 1.0f, 0.0f, 10.0f),
+      ceiling_light(AreaShape::Ellipse, 2.0f, 1.0f, 0.0f, 10.0f),
   };
   int contributing = 0;
   for (uint32_t j = 0; j < 2000; ++j) {
@@ -454,7 +464,8 @@ TEST(LightSelector, ImportanceIsPositiveWhereverALightContributes) {
     const Vec3 n = glm::normalize(Vec3(rand2(j, 15), random_float(j, 0, 2, 15)) - Vec3(0.5f));
     for (const Light& light : lights) {
       bool contributes = false;
-      for (uint32_t i = 0; i < 16 && !contributes; ++i) contributes = irradiance_sample(light, p, n, rand2(i, 16 + j)) > 0.0;
+      for (uint32_t i = 0; i < 16 && !contributes; ++i)
+        contributes = irradiance_sample(light, p, n, rand2(i, 16 + j)) > 0.0;
       if (contributes) {
         ++contributing;
         EXPECT_GT(light_importance(light, p, n), 0.0f);

@@ -39,7 +39,7 @@ TEST(Fresnel, NormalIncidenceIsFourPercentForIor1_5) {
   const double expected = std::pow((1.0 - 1.5) / (1.0 + 1.5), 2);  // 0.04
   EXPECT_NEAR(fresnel_dielectric(1.0f, 1.5f), expected, 1e-7);
   EXPECT_NEAR(fresnel_dielectric(1.0f, 1.0f / 1.5f), expected, 1e-7);  // the same from inside
-  EXPECT_NEAR(fresnel_dielectric(0.3f, 1.0f), 0.0f, 1e-12f);            // no interface, no reflection
+  EXPECT_NEAR(fresnel_dielectric(0.3f, 1.0f), 0.0f, 1e-12f);           // no interface, no reflection
 }
 
 TEST(Fresnel, GoesToOneAtGrazing) {
@@ -82,7 +82,8 @@ TEST(Fresnel, BrewsterAngleReflectsOnlySPolarisation) {
   // F = r_s^2 / 2 = sin^2(theta_i - theta_t) / 2.
   for (double eta : {1.5, 1.0 / 1.5}) {
     const double theta_i = std::atan(eta), theta_t = kPiD / 2 - theta_i;
-    EXPECT_NEAR(fresnel_dielectric(float(std::cos(theta_i)), float(eta)), 0.5 * std::pow(std::sin(theta_i - theta_t), 2), 1e-6);
+    EXPECT_NEAR(fresnel_dielectric(float(std::cos(theta_i)), float(eta)),
+                0.5 * std::pow(std::sin(theta_i - theta_t), 2), 1e-6);
   }
 }
 
@@ -90,7 +91,8 @@ TEST(Fresnel, SameReflectanceFromBothSidesOfTheInterface) {
   for (int k = 0; k < 50; ++k) {
     const double theta_i = 1.5 * random_float(k, 0, 0, 2);
     const double theta_t = std::asin(std::sin(theta_i) / 1.5);
-    EXPECT_NEAR(fresnel_dielectric(float(std::cos(theta_i)), 1.5f), fresnel_dielectric(float(std::cos(theta_t)), 1.0f / 1.5f), 1e-5);
+    EXPECT_NEAR(fresnel_dielectric(float(std::cos(theta_i)), 1.5f),
+                fresnel_dielectric(float(std::cos(theta_t)), 1.0f / 1.5f), 1e-5);
   }
 }
 
@@ -105,8 +107,10 @@ TEST(Fresnel, GlassChoosesReflectionWithProbabilityF) {
       const SpecularSample s = sample(glass, wo, kUp, kUp, (i + 0.5f) / kN);  // stratified u
       reflected += s.reflected;
       EXPECT_FLOAT_EQ(s.probability, s.reflected ? f : 1.0f - f);
-      if (s.reflected) EXPECT_NEAR(glm::length(s.wi - reflect(wo, kUp)), 0.0f, 1e-6f);
-      else EXPECT_LT(s.wi.z, 0.0f);
+      if (s.reflected)
+        EXPECT_NEAR(glm::length(s.wi - reflect(wo, kUp)), 0.0f, 1e-6f);
+      else
+        EXPECT_LT(s.wi.z, 0.0f);
     }
     EXPECT_NEAR(double(reflected) / kN, f, 1.0 / kN);
   }
@@ -167,7 +171,7 @@ TEST(Refraction, TotalInternalReflectionMirrors) {
     const SpecularSample s = sample(glass, wo, kUp, kUp);
     EXPECT_TRUE(s.reflected && s.total_internal_reflection);
     EXPECT_NEAR(glm::length(s.wi - Vec3(-wo.x, -wo.y, wo.z)), 0.0f, 1e-6f);  // the mirror direction
-    EXPECT_LT(s.offset_normal.z, 0.0f);                                       // stays inside
+    EXPECT_LT(s.offset_normal.z, 0.0f);                                      // stays inside
   }
   EXPECT_FALSE(sample(glass, direction(critical - 1e-2, 0.7, true), kUp, kUp).reflected);
 }
@@ -252,8 +256,8 @@ TEST(Texture, TexelCentresReturnTheTexel) {
 TEST(Texture, HalfwayBetweenTexelsIsTheirAverage) {
   const std::vector<float> data = {0, 0, 0, 2, 4, 6, 10, 20, 30, 1, 1, 1};  // 2 x 2 RGB
   const Texture t = Texture::from_floats(2, 2, 3, data, ColorEncoding::Linear);
-  EXPECT_EQ(t.lookup(Vec2(0.5f, 0.25f)), glm::vec4(1, 2, 3, 1));      // between (0,0) and (1,0)
-  EXPECT_EQ(t.lookup(Vec2(0.25f, 0.5f)), glm::vec4(5, 10, 15, 1));    // between (0,0) and (0,1)
+  EXPECT_EQ(t.lookup(Vec2(0.5f, 0.25f)), glm::vec4(1, 2, 3, 1));             // between (0,0) and (1,0)
+  EXPECT_EQ(t.lookup(Vec2(0.25f, 0.5f)), glm::vec4(5, 10, 15, 1));           // between (0,0) and (0,1)
   EXPECT_EQ(t.lookup(Vec2(0.5f, 0.5f)), glm::vec4(3.25f, 6.25f, 9.25f, 1));  // all four
   // v = 0 is the bottom row (Blender's order): row 0 comes first in the data.
   EXPECT_EQ(t.texel(1, 0), glm::vec4(2, 4, 6, 1));

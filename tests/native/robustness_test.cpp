@@ -45,7 +45,8 @@ TEST(BBox, CentreOfABoxAtFloatMaxIsFinite) {
 
 TEST(BinnedSah, CentroidsSpanningMoreThanFloatMaxGiveAValidTree) {
   Boxes p;
-  for (int i = 0; i < 20; ++i) p.add(Vec3(i % 2 ? FLT_MAX : -FLT_MAX, float(i), 0.0f), Vec3(i % 2 ? FLT_MAX : -FLT_MAX, float(i) + 1, 1.0f));
+  for (int i = 0; i < 20; ++i)
+    p.add(Vec3(i % 2 ? FLT_MAX : -FLT_MAX, float(i), 0.0f), Vec3(i % 2 ? FLT_MAX : -FLT_MAX, float(i) + 1, 1.0f));
   p.add(Vec3(0.0f), Vec3(1.0f));
   const Bvh bvh = build_binned_sah(p.boxes.data(), p.centers.data(), p.boxes.size());
   EXPECT_EQ(bvh.validate(p.boxes.data(), p.boxes.size()), "");
@@ -61,7 +62,8 @@ TEST(BinnedSah, DenormalCentroidExtentGivesAValidTree) {
 TEST(LbvhReference, DenormalCentroidExtentGivesAValidTree) {
   // cells / 1e-45 is an infinite scale, and 0 * inf a NaN Morton coordinate before the fix.
   Boxes p;
-  for (int i = 0; i < 20; ++i) p.add(Vec3(float(i % 3) * 1e-45f, float(i), 0.0f), Vec3(float(i % 3) * 1e-45f, float(i), 1.0f));
+  for (int i = 0; i < 20; ++i)
+    p.add(Vec3(float(i % 3) * 1e-45f, float(i), 0.0f), Vec3(float(i % 3) * 1e-45f, float(i), 1.0f));
   for (MortonBits bits : {MortonBits::k30, MortonBits::k63}) {
     const Bvh bvh = build_lbvh_reference(p.boxes.data(), p.centers.data(), p.boxes.size(), LbvhConfig{bits});
     EXPECT_EQ(bvh.validate(p.boxes.data(), p.boxes.size()), "");

@@ -231,23 +231,22 @@ TEST(SamplingWarp, UniformDiskChiSquare) {
 
 TEST(SamplingWarp, CosineHemisphereChiSquare) {
   // Density cos(theta) / pi: P(theta' < theta) = sin^2(theta).
-  expect_directions_fit(sample_cosine_hemisphere, kPiD / 2, [](double t) { return std::pow(std::sin(t), 2); },
-                        "cosine hemisphere");
+  expect_directions_fit(
+      sample_cosine_hemisphere, kPiD / 2, [](double t) { return std::pow(std::sin(t), 2); }, "cosine hemisphere");
   EXPECT_FLOAT_EQ(cosine_hemisphere_pdf(0.5f), 0.5f / kPi);
 }
 
 TEST(SamplingWarp, UniformSphereChiSquare) {
   // Density 1 / (4 pi): P(theta' < theta) = (1 - cos theta) / 2.
-  expect_directions_fit(sample_uniform_sphere, kPiD, [](double t) { return (1.0 - std::cos(t)) / 2.0; },
-                        "uniform sphere");
+  expect_directions_fit(
+      sample_uniform_sphere, kPiD, [](double t) { return (1.0 - std::cos(t)) / 2.0; }, "uniform sphere");
 }
 
 TEST(SamplingWarp, UniformConeChiSquare) {
   for (double theta_max : {0.05, 0.6, kPiD / 2, 2.5}) {
     const float one_minus_cos = float(2.0 * std::pow(std::sin(theta_max / 2.0), 2));
     expect_directions_fit([&](Vec2 u) { return sample_uniform_cone(u, one_minus_cos); }, theta_max,
-                          [&](double t) { return (1.0 - std::cos(t)) / (1.0 - std::cos(theta_max)); },
-                          "uniform cone");
+                          [&](double t) { return (1.0 - std::cos(t)) / (1.0 - std::cos(theta_max)); }, "uniform cone");
     // The density integrates to one over the cap: pdf * solid angle = 1.
     EXPECT_NEAR(uniform_cone_pdf(one_minus_cos) * 2.0 * kPiD * (1.0 - std::cos(theta_max)), 1.0, 1e-5);
   }
@@ -268,7 +267,9 @@ TEST(SamplingWarp, UniformTriangleChiSquare) {
   std::vector<double> counts(kGrid * kGrid, 0.0), probabilities(kGrid * kGrid);
   for (int i = 0; i < kGrid; ++i)
     for (int j = 0; j < kGrid; ++j)
-      probabilities[i * kGrid + j] = i + j < kGrid - 1 ? 2.0 / (kGrid * kGrid) : i + j == kGrid - 1 ? 1.0 / (kGrid * kGrid) : 0.0;
+      probabilities[i * kGrid + j] = i + j < kGrid - 1    ? 2.0 / (kGrid * kGrid)
+                                     : i + j == kGrid - 1 ? 1.0 / (kGrid * kGrid)
+                                                          : 0.0;
   for (int n = 0; n < kN; ++n) {
     const Vec2 b = sample_uniform_triangle(rand2(n, 4));
     ASSERT_TRUE(b.x >= 0.0f && b.y >= 0.0f && b.x + b.y <= 1.0f + 1e-6f);

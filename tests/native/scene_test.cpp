@@ -4,8 +4,8 @@
 #include "oracle_compare.h"
 #include "test_scenes.h"
 
-#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include <random>
 
@@ -175,11 +175,138 @@ TEST(Scene, RejectsBadTransformsAndIndices) {
   Scene scene;
   EXPECT_THROW(scene.add_instance(0, Mat4(1.0f)), std::invalid_argument);  // no mesh yet
   const uint32_t id = scene.add_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
-  EXPECT_THROW(scene.add_instance(id, Mat4(0.0f)), std::invalid_argument);                  // not affine
+  EXPECT_THROW(scene.add_instance(id, Mat4(0.0f)), std::invalid_argument);                             // not affine
   EXPECT_THROW(scene.add_instance(id, glm::scale(Mat4(1.0f), Vec3(1, 0, 1))), std::invalid_argument);  // singular
   Mat4 nan(1.0f);
   nan[3][0] = std::nanf("");
   EXPECT_THROW(scene.add_instance(id, nan), std::invalid_argument);
   EXPECT_THROW(scene.add_mesh({{0, 0, 0}}, {{0, 0, 1}}), std::invalid_argument);
   EXPECT_THROW(scene.add_mesh({{0, 0, std::nanf("")}}, {}), std::invalid_argument);
+}
+
+// ---- the scene's policy: shading, materials, lights, commit ----------------------------------
+
+namespace {
+const std::vector<Vec3> kTriangle = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+const std::vector<Triangle> kOneTriangle = {{0, 1, 2}};
+
+MeshShading with_material(int32_t id) {
+  MeshShading sh;
+  sh.material_ids = {id};
+  return sh;
+}
+}  // namespace
+
+TEST(Scene, RejectsUnknownMaterialIdAtRenderNamingMeshAndId) {
+  Scene scene;
+  scene.add_mesh(kTriangle, kOneTriangle);
+  scene.add_mesh(kTriangle, kOneTriangle, with_material(7));
+  scene.add_instance(0, Mat4(1.0f));
+  scene.commit();
+  try {
+    scene.check_renderable();
+    FAIL() << "material id 7 of 0 materials was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "mesh 1 uses material id 7 but the scene has 0 materials");
+  }
+  // Materials may come after the meshes: once id 7 exists the scene renders.
+  for (int i = 0; i < 8; ++i) scene.add_material(Lambert{});
+  EXPECT_NO_THROW(scene.check_renderable());
+}
+
+TEST(Scene, MaterialIdZeroWithoutMaterialsIsTheDefaultGrey) {
+  Scene scene;
+  scene.add_mesh(kTriangle, kOneTriangle, with_material(0));
+  scene.commit();
+  EXPECT_NO_THROW(scene.check_renderable());
+}
+
+TEST(Scene, RefusesShadingOfTheWrongSizeOrValueAndChangesNothing) {
+  Scene scene;
+  MeshShading short_normals;
+  short_normals.corner_normals = {Vec3(0, 0, 1)};  // 3 per triangle needed
+  EXPECT_THROW(scene.add_mesh(kTriangle, kOneTriangle, short_normals), std::invalid_argument);
+  MeshShading nan_uvs;
+  nan_uvs.corner_uvs = {Vec2(0.0f), Vec2(std::nanf("")), Vec2(1.0f)};
+  EXPECT_THROW(scene.add_mesh(kTriangle, kOneTriangle, nan_uvs), std::invalid_argument);
+  EXPECT_THROW(scene.add_mesh(kTriangle, kOneTriangle, with_material(-1)), std::invalid_argument);
+  EXPECT_EQ(scene.mesh_count(), 0u);
+  const uint32_t id = scene.add_mesh(kTriangle, kOneTriangle, with_material(2));
+  EXPECT_THROW(scene.replace_mesh(id, kTriangle, kOneTriangle, short_normals), std::invalid_argument);
+  EXPECT_EQ(scene.shading(id).material_ids, std::vector<int32_t>{2});  // the old shading stays
+}
+
+TEST(Scene, RefusesUnknownIdsByTheirValue) {
+  Scene scene;
+  EXPECT_THROW(scene.add_material(Lambert{Vec3(0.5f), 0}), std::invalid_argument);  // no texture 0
+  const uint32_t tex = scene.add_texture(Texture::from_floats(1, 1, 3, {1, 1, 1}, ColorEncoding::Linear));
+  EXPECT_EQ(scene.add_material(Lambert{Vec3(0.5f), int32_t(tex)}), 0u);
+  EXPECT_THROW(scene.set_material(-1, Lambert{}), std::invalid_argument);
+  EXPECT_THROW(scene.set_material(1, Lambert{}), std::invalid_argument);
+  EXPECT_THROW(scene.set_texture(3, Texture::from_floats(1, 1, 3, {1, 1, 1}, ColorEncoding::Linear)),
+               std::invalid_argument);
+  try {
+    scene.add_instance(-1, Mat4(1.0f));
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "unknown mesh id -1 (the scene has 0 meshes)");
+  }
+  EXPECT_THROW(scene.set_instance_transform(0, Mat4(1.0f)), std::invalid_argument);
+  EXPECT_THROW(scene.set_background(Vec3(-1.0f, 0.0f, 0.0f)), std::invalid_argument);
+}
+
+TEST(Scene, LightsKeepTheirVisibilityAndClearTogether) {
+  Scene scene;
+  scene.add_light(PointLight::make(Vec3(0, 0, 1), 10.0f, Vec3(1.0f)), {false, true});
+  scene.add_light(PointLight::make(Vec3(0, 0, 2), 10.0f, Vec3(1.0f)));
+  ASSERT_EQ(scene.world().light_visibility.size(), 2u);
+  EXPECT_FALSE(scene.world().light_visibility[0].camera);
+  EXPECT_TRUE(scene.world().light_visibility[1].camera);
+  scene.clear_lights();
+  EXPECT_TRUE(scene.world().lights.empty() && scene.world().light_visibility.empty());
+}
+
+TEST(Scene, CommitRefusesBadOptions) {
+  Scene scene;
+  CommitOptions bad_threads;
+  bad_threads.threads = -1;
+  EXPECT_THROW(scene.commit(bad_threads), std::invalid_argument);
+  CommitOptions bad_rays;
+  bad_rays.expected_rays = -5.0;
+  EXPECT_THROW(scene.commit(bad_rays), std::invalid_argument);
+  bad_rays.expected_rays = std::nan("");
+  EXPECT_THROW(scene.commit(bad_rays), std::invalid_argument);
+  EXPECT_FALSE(scene.committed());
+}
+
+TEST(Scene, CommitCancelledByItsPollStaysUncommittedAndTheNextCommitAgrees) {
+  const MeshData m = triangle_soup(200000, 0.01f, 3);
+  Scene cancelled, full;
+  cancelled.add_instance(cancelled.add_mesh(m.vertices, m.triangles), Mat4(1.0f));
+  full.add_instance(full.add_mesh(m.vertices, m.triangles), Mat4(1.0f));
+  CommitOptions sah;
+  sah.builder = BuilderKind::Sah;
+  int polls = 0;
+  EXPECT_FALSE(cancelled.commit(sah, [&] { return ++polls > 0; }));
+  EXPECT_GT(polls, 0);
+  EXPECT_FALSE(cancelled.committed());
+  EXPECT_THROW(cancelled.check_committed(), std::logic_error);
+  EXPECT_TRUE(cancelled.commit(sah, [] { return false; }));
+  EXPECT_TRUE(full.commit(sah));
+  for (const Ray& r : random_rays(2000, 1.0f, 9)) {
+    const Hit a = cancelled.intersect(r), b = full.intersect(r);
+    EXPECT_EQ(a.prim, b.prim);
+    EXPECT_EQ(a.t, b.t);
+  }
+}
+
+TEST(Scene, AnExceptionFromTheCommitPollReachesTheCallerAfterTheBuildStops) {
+  const MeshData m = triangle_soup(200000, 0.01f, 4);
+  Scene scene;
+  scene.add_mesh(m.vertices, m.triangles);
+  CommitOptions sah;
+  sah.builder = BuilderKind::Sah;
+  EXPECT_THROW(scene.commit(sah, []() -> bool { throw std::runtime_error("from the poll"); }), std::runtime_error);
+  EXPECT_FALSE(scene.committed());
+  EXPECT_TRUE(scene.commit(sah));
 }

@@ -46,8 +46,8 @@ TEST(Triangle, MissesOutsideAndBehind) {
 TEST(Triangle, SegmentIsHalfOpen) {
   float t, u, v;
   const Vec3 o(0.2f, 0.2f, 1.0f), d(0, 0, -1), p0(0, 0, 0), p1(1, 0, 0), p2(0, 1, 0);
-  EXPECT_TRUE(hit(o, d, p0, p1, p2, t, u, v, 1.0f, 2.0f));    // t == tnear counts
-  EXPECT_FALSE(hit(o, d, p0, p1, p2, t, u, v, 0.0f, 1.0f));   // t == tfar does not
+  EXPECT_TRUE(hit(o, d, p0, p1, p2, t, u, v, 1.0f, 2.0f));   // t == tnear counts
+  EXPECT_FALSE(hit(o, d, p0, p1, p2, t, u, v, 0.0f, 1.0f));  // t == tfar does not
   EXPECT_FALSE(hit(o, d, p0, p1, p2, t, u, v, 1.5f, 2.0f));
 }
 

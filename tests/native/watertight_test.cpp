@@ -30,9 +30,11 @@ void expect_watertight(BuilderKind builder, const char* name, const MeshData& m,
     fast_leaks += !fast.intersect(r).found();
     robust_leaks += !robust.intersect(r).found();
   }
-  std::printf("[%s] %zu rays at vertices and edges: TOYRT %zu misses, Embree default %zu (%.3f %%), Embree robust %zu (%.4f %%)\n",
-              name, rays.size(), misses, fast_leaks, 100.0 * fast_leaks / rays.size(), robust_leaks,
-              100.0 * robust_leaks / rays.size());
+  std::printf(
+      "[%s] %zu rays at vertices and edges: TOYRT %zu misses, Embree default %zu (%.3f %%), Embree robust %zu (%.4f "
+      "%%)\n",
+      name, rays.size(), misses, fast_leaks, 100.0 * fast_leaks / rays.size(), robust_leaks,
+      100.0 * robust_leaks / rays.size());
   EXPECT_EQ(misses, 0u) << name;
   EXPECT_EQ(unoccluded, 0u) << name;
 }
@@ -63,7 +65,8 @@ TEST_P(Watertight, BumpyMeshHasNoGaps) {
 TEST_P(Watertight, HoldsFarFromTheOriginAndAtTinyScale) {
   for (float d : {1e3f, 1e5f, 1e6f}) {
     const Vec3 offset(d, -0.5f * d, 0.25f * d);
-    expect_watertight(GetParam(), ("far-" + std::to_string(int(d))).c_str(), transformed(uv_sphere(60, 120), 1.0f, offset), offset);
+    expect_watertight(GetParam(), ("far-" + std::to_string(int(d))).c_str(),
+                      transformed(uv_sphere(60, 120), 1.0f, offset), offset);
   }
   expect_watertight(GetParam(), "tiny-1e-3", transformed(uv_sphere(60, 120), 1e-3f, Vec3(0.0f)), Vec3(0.0f));
   expect_watertight(GetParam(), "tiny-1e-6", transformed(uv_sphere(60, 120), 1e-6f, Vec3(1e-6f)), Vec3(1e-6f));

@@ -16,8 +16,8 @@ EmbreeScene::EmbreeScene(const std::vector<Vec3>& vertices, const std::vector<Tr
   scene_ = rtcNewScene(device_);
   rtcSetSceneFlags(scene_, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                         3 * sizeof(float), vertices.size()));
+  auto* vb = static_cast<float*>(
+      rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertices.size()));
   auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                             3 * sizeof(uint32_t), triangles.size()));
   std::memcpy(vb, vertices.data(), vertices.size() * sizeof(Vec3));
@@ -36,8 +36,12 @@ EmbreeScene::~EmbreeScene() {
 
 namespace {
 void fill(RTCRay& r, const Ray& ray) {
-  r.org_x = ray.org.x; r.org_y = ray.org.y; r.org_z = ray.org.z;
-  r.dir_x = ray.dir.x; r.dir_y = ray.dir.y; r.dir_z = ray.dir.z;
+  r.org_x = ray.org.x;
+  r.org_y = ray.org.y;
+  r.org_z = ray.org.z;
+  r.dir_x = ray.dir.x;
+  r.dir_y = ray.dir.y;
+  r.dir_z = ray.dir.z;
   r.tnear = ray.tnear;
   r.tfar = ray.tfar;
   r.time = 0.0f;

@@ -9,8 +9,8 @@ namespace toyrt::testing {
 std::string Agreement::summary() const {
   std::ostringstream s;
   s << rays << " rays: " << both_hit << " both hit, " << both_miss << " both miss; TOYRT errors: " << toyrt_misses
-    << " misses, " << toyrt_false_hits << " false hits, " << t_mismatches << " t (max rel " << max_t_rel_error
-    << "), " << uv_mismatches << " uv, " << occluded_mismatches << " occluded; " << grazing
+    << " misses, " << toyrt_false_hits << " false hits, " << t_mismatches << " t (max rel " << max_t_rel_error << "), "
+    << uv_mismatches << " uv, " << occluded_mismatches << " occluded; " << grazing
     << " grazing; Embree errors: " << embree_leaks << " leaks, " << embree_false_hits << " false hits, "
     << embree_t_errors << " t (max rel " << max_t_rel_error_embree << ")";
   return s.str();
@@ -74,11 +74,10 @@ Agreement compare_with_embree(const Scene& scene, const EmbreeScene& embree, con
   for (const Ray& ray : rays) {
     const Hit mine = scene.intersect(ray), theirs = embree.intersect(ray);
     if (scene.occluded(ray) != mine.found()) ++a.occluded_mismatches;
-    const double scale = std::max(std::fabs(double(mine.found() ? mine.t : theirs.t)) * glm::length(ray.dir),
-                                  1e-2 * magnitude) / glm::length(ray.dir);
-    auto t_error = [&](const Hit& h) {
-      return std::fabs(double(h.t) - cross_in_double(mesh, h.prim, ray).t) / scale;
-    };
+    const double scale =
+        std::max(std::fabs(double(mine.found() ? mine.t : theirs.t)) * glm::length(ray.dir), 1e-2 * magnitude) /
+        glm::length(ray.dir);
+    auto t_error = [&](const Hit& h) { return std::fabs(double(h.t) - cross_in_double(mesh, h.prim, ray).t) / scale; };
     if (!mine.found() && !theirs.found()) {
       ++a.both_miss;
       continue;
@@ -104,16 +103,22 @@ Agreement compare_with_embree(const Scene& scene, const EmbreeScene& embree, con
     // The same triangle, or one at the same true distance (neighbours sharing the edge the ray
     // meets): agreed. True distances, since Embree's own t can be off by more than 1e-5.
     if (mine.found() && theirs.found() &&
-        (mine.prim == theirs.prim ||
-         std::fabs(cross_in_double(mesh, mine.prim, ray).t - cross_in_double(mesh, theirs.prim, ray).t) <= 1e-5 * scale))
+        (mine.prim == theirs.prim || std::fabs(cross_in_double(mesh, mine.prim, ray).t -
+                                               cross_in_double(mesh, theirs.prim, ray).t) <= 1e-5 * scale))
       continue;
     // Otherwise the nearer report decides who is wrong.
     const bool mine_nearer = mine.found() && (!theirs.found() || mine.t < theirs.t);
     const Hit& nearer = mine_nearer ? mine : theirs;
     switch (judge(mesh, nearer, ray)) {
-      case Verdict::Crossed: ++(mine_nearer ? a.embree_leaks : a.toyrt_misses); break;
-      case Verdict::Grazing: ++a.grazing; break;
-      case Verdict::NotCrossed: ++(mine_nearer ? a.toyrt_false_hits : a.embree_false_hits); break;
+      case Verdict::Crossed:
+        ++(mine_nearer ? a.embree_leaks : a.toyrt_misses);
+        break;
+      case Verdict::Grazing:
+        ++a.grazing;
+        break;
+      case Verdict::NotCrossed:
+        ++(mine_nearer ? a.toyrt_false_hits : a.embree_false_hits);
+        break;
     }
   }
   return a;
@@ -133,9 +138,12 @@ OcclusionAgreement compare_occlusion_with_embree(const Scene& scene, const Embre
     // The side that saw a blocker must show one the ray truly crosses.
     const Hit blocker = mine ? scene.intersect(ray) : embree.intersect(ray);
     const Verdict v = blocker.found() ? judge(mesh, blocker, ray) : Verdict::NotCrossed;
-    if (v == Verdict::Grazing) ++a.grazing;
-    else if ((v == Verdict::Crossed) == mine) ++a.embree_wrong;
-    else ++a.toyrt_wrong;
+    if (v == Verdict::Grazing)
+      ++a.grazing;
+    else if ((v == Verdict::Crossed) == mine)
+      ++a.embree_wrong;
+    else
+      ++a.toyrt_wrong;
   }
   return a;
 }

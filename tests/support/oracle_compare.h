@@ -27,17 +27,17 @@ Verdict judge(const MeshData& mesh, const Hit& hit, const Ray& ray);
 struct Agreement {
   size_t rays = 0, both_hit = 0, both_miss = 0;
   // TOYRT's errors (tests expect zero):
-  size_t toyrt_misses = 0;        // a nearer triangle the ray truly crosses was not reported
-  size_t toyrt_false_hits = 0;    // a reported triangle the ray does not cross
-  size_t t_mismatches = 0;        // t off the double-precision distance by more than 1e-5 relative
-  size_t uv_mismatches = 0;       // hit point from (u, v) off the true one by more than 1e-5 relative
-  size_t occluded_mismatches = 0; // occluded() disagrees with intersect()
+  size_t toyrt_misses = 0;         // a nearer triangle the ray truly crosses was not reported
+  size_t toyrt_false_hits = 0;     // a reported triangle the ray does not cross
+  size_t t_mismatches = 0;         // t off the double-precision distance by more than 1e-5 relative
+  size_t uv_mismatches = 0;        // hit point from (u, v) off the true one by more than 1e-5 relative
+  size_t occluded_mismatches = 0;  // occluded() disagrees with intersect()
   // Rounding at a triangle's boundary: either answer is right.
   size_t grazing = 0;
   // Embree's errors, for the record:
-  size_t embree_leaks = 0;        // Embree missed a nearer triangle the ray truly crosses
-  size_t embree_false_hits = 0;   // Embree reported a triangle the ray does not cross (e.g. behind tnear)
-  size_t embree_t_errors = 0;     // Embree's t off by more than 1e-5 relative
+  size_t embree_leaks = 0;       // Embree missed a nearer triangle the ray truly crosses
+  size_t embree_false_hits = 0;  // Embree reported a triangle the ray does not cross (e.g. behind tnear)
+  size_t embree_t_errors = 0;    // Embree's t off by more than 1e-5 relative
   double max_t_rel_error = 0.0, max_t_rel_error_embree = 0.0;
   std::string summary() const;
 };

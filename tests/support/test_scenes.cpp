@@ -23,7 +23,8 @@ MeshData uv_sphere(int rings, int segments, float radius, float bumps) {
     for (int j = 0; j < segments; ++j) {
       const float phi = 2.0f * kPi * float(j) / float(segments);
       const float r = r_at(theta, phi);
-      m.vertices.push_back({r * std::sin(theta) * std::cos(phi), r * std::sin(theta) * std::sin(phi), r * std::cos(theta)});
+      m.vertices.push_back(
+          {r * std::sin(theta) * std::cos(phi), r * std::sin(theta) * std::sin(phi), r * std::cos(theta)});
     }
   }
   m.vertices.push_back({0.0f, 0.0f, -radius});  // south pole

@@ -1,0 +1,71 @@
+// The one entry point to every BVH builder: a mesh, the top level, tests and benchmarks call
+// build_bvh() with a BuilderKind, and nothing else names a builder's own function to build a
+// scene. Adding a builder = its own file (as binned_sah_builder.h and lbvh_builder.h) + one case in
+// build_bvh() (builder.cpp) + its name in the parse table there.
+//
+// "auto" picks, per build, the builder whose build plus the tracing to come costs least ("model
+// no more than a scene needs"). The SAH tree traces faster; the LBVH builds faster. With n
+// primitives and R rays expected through them:
+//   cost(SAH)  = kSahBuildNs  * n + R * kTraceNs
+//   cost(LBVH) = kLbvhBuildNs * n + R * kTraceNs * kLbvhTraceFactor
+// so the LBVH wins when R < n * (kSahBuildNs - kLbvhBuildNs) / (kTraceNs * (kLbvhTraceFactor - 1)).
+// Break-even: about 11 rays per triangle. The constants were measured on this project's
+// machines; `make bench-lbvh` reports how close the choice lands to the better total.
+#pragma once
+
+#include "accel/binned_sah_builder.h"
+#include "accel/lbvh_builder.h"
+
+#include <cstddef>
+#include <string>
+
+namespace toyrt {
+
+enum class BuilderKind { Auto, Sah, Lbvh };
+
+// Parses "auto", "sah", "lbvh"; throws std::invalid_argument on anything else.
+BuilderKind parse_builder(const std::string& name);
+const char* builder_name(BuilderKind kind);
+
+struct BuilderCostModel {
+  // Measured by `make bench-lbvh` on 2 cores (docs/lbvh-bench.md), 10K to 4M triangles:
+  double sah_build_ns = 450.0;     // per triangle, binned SAH with TBB (420-750)
+  double lbvh_build_ns = 150.0;    // per triangle, LBVH kernels on PoCL (125-260)
+  double trace_ns = 130.0;         // per ray through a SAH tree, primary/diffuse/shadow mixed (100-230)
+  double lbvh_trace_factor = 1.2;  // an LBVH tree's ray cost relative to SAH's (1.06-1.28)
+
+  // expected_rays < 0: unknown, which keeps the SAH tree (the faster to trace).
+  BuilderKind choose(size_t triangles, double expected_rays) const {
+    if (expected_rays < 0.0) return BuilderKind::Sah;
+    const double sah = sah_build_ns * double(triangles) + expected_rays * trace_ns;
+    const double lbvh = lbvh_build_ns * double(triangles) + expected_rays * trace_ns * lbvh_trace_factor;
+    return lbvh < sah ? BuilderKind::Lbvh : BuilderKind::Sah;
+  }
+};
+
+// Every builder's settings; each builder reads its own part.
+struct BuildConfig {
+  BinnedSahConfig sah;
+  LbvhConfig lbvh;
+  BuilderCostModel cost_model;
+  // Rays the caller expects to trace through these primitives, for Auto; < 0: unknown (Auto
+  // keeps the SAH builder).
+  double expected_rays = -1.0;
+};
+
+struct BuildStats {
+  BuilderKind used = BuilderKind::Sah;  // the builder that made the tree (never Auto)
+  double lbvh_compile_ms = 0.0;         // OpenCL compilation inside this build (first LBVH build of the process)
+  // Set when the LBVH could not run (no OpenCL device, kernel build failure) and the SAH builder
+  // stood in.
+  std::string warning;
+};
+
+// Builds over `count` primitives given their boxes and centres, on the calling thread's TBB
+// arena. Auto resolves with config.cost_model for `count` primitives; an LBVH build that cannot
+// run falls back to SAH and says so in stats->warning. SAH builds throw BuildCancelled when
+// config.sah.cancel is set.
+Bvh build_bvh(BuilderKind kind, const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
+              const BuildConfig& config = {}, BuildStats* stats = nullptr);
+
+}  // namespace toyrt

@@ -1,0 +1,59 @@
+// Converters from Python values to the core's plain data: numpy arrays (points, triangles, the
+// (4, 4) matrix, per-ray values, shading arrays, texture pixels), the camera dict, colours.
+// They check types and shapes, raising TypeError / ValueError that name the argument; the
+// values themselves (finite, in range, known ids) are the core's to check (std::invalid_argument,
+// which the module turns into ValueError).
+#pragma once
+
+#include "camera/camera.h"
+#include "geometry/mesh.h"
+#include "materials/texture.h"
+#include "scene/mesh_shading.h"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <string>
+#include <vector>
+
+namespace toyrt::binding {
+
+namespace py = pybind11;
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+
+// The object as a numpy array (converting lists and the like), or a null array when it cannot be.
+py::array try_array(py::handle obj);
+// Whether an array holds numbers (float, signed or unsigned integer).
+bool is_numeric(const py::array& a);
+// "(3, 4)", "(5,)": shapes in error messages.
+std::string shape_of(const py::array& a);
+
+// Any array-like of numbers as a C-contiguous float32 array of shape (N, 3).
+FloatArray as_points(py::handle obj, const char* name);
+std::vector<Vec3> to_vec3s(const FloatArray& a);
+// (M, 3) integer vertex indices; negative or beyond 32 bits refused by triangle.
+std::vector<Triangle> to_triangles(py::handle obj);
+// The one matrix converter: a (4, 4) row-major matrix (Blender's matrix_world layout) as GLM's
+// column-major Mat4. Its values are checked by whoever uses it (instances, lights, the camera).
+Mat4 to_matrix(py::handle obj, const char* name);
+// Three numbers (a colour, a position).
+Vec3 to_vec3(py::handle obj, const char* name);
+
+// tnear / tfar: a number applied to every ray (stride 0), or one value per ray.
+struct PerRay {
+  FloatArray storage;
+  float scalar = 0.0f;
+  const float* data = nullptr;
+  size_t stride = 0;
+};
+PerRay per_ray(py::handle obj, size_t count, const char* name);
+
+// Shading attributes from their Python forms: per corner (M, 3, k) or per vertex (N, k); material
+// ids one int or (M,) ints. None: the mesh does not have the attribute.
+MeshShading to_shading(size_t vertex_count, const std::vector<Triangle>& tris, py::handle normals, py::handle uvs,
+                       py::handle material_ids);
+// (height, width, 3 or 4) float 0..1 or uint8 pixels, rows from the bottom.
+Texture to_texture(py::handle pixels, bool srgb);
+CameraParams to_camera(const py::dict& camera);
+
+}  // namespace toyrt::binding

@@ -1,0 +1,294 @@
+#include "python/py_scene.h"
+
+#include "python/convert.h"
+#include "render/renderer.h"
+
+#include <cstring>
+#include <mutex>
+
+namespace toyrt::binding {
+
+uint32_t PyScene::add_mesh(py::handle vertices, py::handle triangles, py::handle transform, py::handle normals,
+                           py::handle uvs, py::handle material_ids, bool instance) {
+  std::vector<Vec3> verts = to_vec3s(as_points(vertices, "vertices"));
+  std::vector<Triangle> tris = to_triangles(triangles);
+  if (!instance && !transform.is_none())
+    throw py::value_error("transform places the mesh's instance: pass None with instance=False");
+  const Mat4 m = transform.is_none() ? Mat4(1.0f) : to_matrix(transform, "transform");
+  MeshShading shading = to_shading(verts.size(), tris, normals, uvs, material_ids);
+  return write([&] {
+    if (instance) Scene::checked_inverse(m);  // before the mesh is added: a refused call changes nothing
+    const uint32_t id = scene_.add_mesh(std::move(verts), std::move(tris), std::move(shading));
+    if (instance) scene_.add_instance(id, m);
+    return id;
+  });
+}
+
+void PyScene::replace_mesh(int64_t mesh, py::handle vertices, py::handle triangles, py::handle normals, py::handle uvs,
+                           py::handle material_ids) {
+  std::vector<Vec3> verts = to_vec3s(as_points(vertices, "vertices"));
+  std::vector<Triangle> tris = to_triangles(triangles);
+  MeshShading shading = to_shading(verts.size(), tris, normals, uvs, material_ids);
+  write([&] { scene_.replace_mesh(mesh, std::move(verts), std::move(tris), std::move(shading)); });
+}
+
+uint32_t PyScene::add_instance(int64_t mesh, py::handle transform) {
+  const Mat4 m = to_matrix(transform, "transform");
+  return write([&] { return scene_.add_instance(mesh, m); });
+}
+
+void PyScene::set_instance_transform(int64_t instance, py::handle transform) {
+  const Mat4 m = to_matrix(transform, "transform");
+  write([&] { scene_.set_instance_transform(instance, m); });
+}
+
+void PyScene::clear_instances() {
+  write([&] { scene_.clear_instances(); });
+}
+
+uint32_t PyScene::add_material(const std::string& kind, py::handle color, int64_t texture, float ior) {
+  const Material material = make_material(kind, to_vec3(color, "color"), texture, ior);
+  return write([&] { return scene_.add_material(material); });
+}
+
+void PyScene::set_material(int64_t id, const std::string& kind, py::handle color, int64_t texture, float ior) {
+  const Material material = make_material(kind, to_vec3(color, "color"), texture, ior);
+  write([&] { scene_.set_material(id, material); });
+}
+
+uint32_t PyScene::add_texture(py::handle pixels, bool srgb) {
+  Texture t = to_texture(pixels, srgb);
+  return write([&] { return scene_.add_texture(std::move(t)); });
+}
+
+void PyScene::set_texture(int64_t id, py::handle pixels, bool srgb) {
+  Texture t = to_texture(pixels, srgb);
+  write([&] { scene_.set_texture(id, std::move(t)); });
+}
+
+uint32_t PyScene::add_point_light(py::handle position, float power, py::handle color, float radius, bool visible_camera,
+                                  bool visible_specular) {
+  const PointLight l = PointLight::make(to_vec3(position, "position"), power, to_vec3(color, "color"), radius);
+  return write([&] { return scene_.add_light(l, {visible_camera, visible_specular}); });
+}
+
+uint32_t PyScene::add_area_light(py::handle matrix, const std::string& shape, float size, py::handle size_y,
+                                 float power, py::handle color, bool visible_camera, bool visible_specular) {
+  const float sy = size_y.is_none() ? size : size_y.cast<float>();
+  const AreaLight l =
+      AreaLight::make(parse_area_shape(shape), size, sy, to_matrix(matrix, "matrix"), power, to_vec3(color, "color"));
+  return write([&] { return scene_.add_light(l, {visible_camera, visible_specular}); });
+}
+
+void PyScene::clear_lights() {
+  write([&] { scene_.clear_lights(); });
+}
+
+void PyScene::set_background(py::handle color) {
+  const Vec3 c = to_vec3(color, "background");
+  write([&] { scene_.set_background(c); });
+}
+
+py::tuple PyScene::background() {
+  const Vec3 b = read([&] { return scene_.world().background; });
+  return py::make_tuple(b.x, b.y, b.z);
+}
+
+void PyScene::set_background_lighting(bool on) {
+  write([&] { scene_.set_background_lighting(on); });
+}
+
+bool PyScene::background_lighting() {
+  return read([&] { return scene_.world().background_lights_surfaces; });
+}
+
+bool PyScene::commit(const std::string& builder, int threads, py::handle expected_rays, py::object should_cancel) {
+  CommitOptions options;
+  options.builder = parse_builder(builder);
+  options.threads = threads;
+  if (!expected_rays.is_none()) {
+    if (!py::isinstance<py::int_>(expected_rays) && !py::isinstance<py::float_>(expected_rays))
+      throw py::type_error("expected_rays must be a number (or None when unknown)");
+    options.expected_rays = expected_rays.cast<double>();
+  }
+  // Polled by the core on this thread (which released the GIL) every 10 ms: take the GIL for
+  // Python, as Blender's test_break needs.
+  CancelPoll poll;
+  if (!should_cancel.is_none()) {
+    poll = [&] {
+      py::gil_scoped_acquire gil;
+      return should_cancel().cast<bool>();
+    };
+  }
+  bool done;
+  std::string warning;
+  {
+    py::gil_scoped_release release;
+    std::unique_lock lock(mutex_);
+    done = scene_.commit(options, poll);
+    warning = scene_.commit_stats().warning;
+  }
+  // One clear warning when the LBVH could not run and the SAH builder stood in.
+  if (!warning.empty() && PyErr_WarnEx(PyExc_RuntimeWarning, warning.c_str(), 1) != 0) throw py::error_already_set();
+  return done;
+}
+
+py::dict PyScene::last_commit() {
+  const CommitStats st = read([&] { return scene_.commit_stats(); });
+  py::dict d;
+  d["build_ms"] = st.build_ms;
+  d["lbvh_compile_ms"] = st.lbvh_compile_ms;
+  d["meshes_built"] = st.meshes_built;
+  d["sah_meshes"] = st.sah_meshes;
+  d["lbvh_meshes"] = st.lbvh_meshes;
+  d["warning"] = st.warning;
+  return d;
+}
+
+py::array_t<float> PyScene::render(const py::dict& camera_settings, int samples, uint32_t seed, int max_specular_depth,
+                                   const std::string& area_light_sampling, const std::string& light_sampling,
+                                   int threads, int tile_size, py::object on_tile, py::object should_cancel,
+                                   int first_sample, int split_depth) {
+  const Camera camera = Camera::make(to_camera(camera_settings));
+  RenderSettings settings;
+  settings.samples = samples;
+  settings.first_sample = first_sample;
+  settings.tile_size = tile_size;
+  settings.threads = threads;
+  settings.integrator.seed = seed;
+  settings.integrator.max_specular_depth = max_specular_depth;
+  settings.integrator.split_depth = split_depth;
+  settings.integrator.area_sampling = parse_area_sampling(area_light_sampling);
+  settings.integrator.light_sampling = parse_light_sampling(light_sampling);
+
+  // Tiles and cancel polls arrive on this thread with the GIL released: take it for Python.
+  TileSink sink;
+  if (!on_tile.is_none()) {
+    sink = [&](const Tile& t, const RenderResult& r) {
+      py::gil_scoped_acquire gil;
+      py::array_t<float> pixels({py::ssize_t(t.height), py::ssize_t(t.width), py::ssize_t(4)});
+      float* out = pixels.mutable_data();
+      for (int j = 0; j < t.height; ++j)
+        std::memcpy(out + size_t(j) * t.width * 4, &r.rgba[(size_t(t.y + j) * r.width + t.x) * 4],
+                    size_t(t.width) * 4 * sizeof(float));
+      on_tile(t.x, t.y, t.width, t.height, pixels);
+    };
+  }
+  CancelPoll poll = [&]() {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C cancels too
+    return !should_cancel.is_none() && py::bool_(should_cancel());
+  };
+  RenderResult result;
+  {
+    // The scene is read in place under the shared lock: edits wait for the render to end.
+    py::gil_scoped_release release;
+    std::shared_lock lock(mutex_);
+    result = toyrt::render(scene_, camera, settings, sink, poll);
+  }
+  last_render_ = py::dict();
+  last_render_["cancelled"] = result.cancelled;
+  last_render_["tiles_done"] = result.tiles_done;
+  last_render_["tiles_total"] = result.tiles_total;
+  last_render_["render_ms"] = result.render_ms;
+  last_render_["cancel_latency_ms"] = result.cancel_latency_ms;
+  last_render_["samples"] = samples;
+  last_render_["first_sample"] = first_sample;
+  last_render_["light_sampling"] = light_sampling_name(result.light_sampling);
+  py::array_t<float> image({py::ssize_t(result.height), py::ssize_t(result.width), py::ssize_t(4)});
+  std::memcpy(image.mutable_data(), result.rgba.data(), result.rgba.size() * sizeof(float));
+  return image;
+}
+
+namespace {
+std::pair<FloatArray, FloatArray> rays(py::handle origins, py::handle directions) {
+  FloatArray org = as_points(origins, "origins"), dir = as_points(directions, "directions");
+  if (org.shape(0) != dir.shape(0))
+    throw py::value_error("origins and directions must hold the same number of rays, got " +
+                          std::to_string(org.shape(0)) + " and " + std::to_string(dir.shape(0)));
+  return {org, dir};
+}
+}  // namespace
+
+py::dict PyScene::intersect(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads) {
+  auto [org, dir] = rays(origins, directions);
+  const size_t n = size_t(org.shape(0));
+  const PerRay near = per_ray(tnear, n, "tnear"), far = per_ray(tfar, n, "tfar");
+  py::array_t<float> t(n), u(n), v(n);
+  py::array_t<int32_t> prim(n), instance(n);
+  const RayBatch batch{org.data(), dir.data(), near.data, near.stride, far.data, far.stride, n};
+  const HitBatch hits{t.mutable_data(), u.mutable_data(), v.mutable_data(), prim.mutable_data(),
+                      instance.mutable_data()};
+  {
+    py::gil_scoped_release release;
+    std::shared_lock lock(mutex_);
+    scene_.intersect(batch, hits, threads);
+  }
+  py::dict out;
+  out["t"] = t;
+  out["prim"] = prim;
+  out["instance"] = instance;
+  out["u"] = u;
+  out["v"] = v;
+  return out;
+}
+
+py::array_t<bool> PyScene::occluded(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar,
+                                    int threads) {
+  auto [org, dir] = rays(origins, directions);
+  const size_t n = size_t(org.shape(0));
+  const PerRay near = per_ray(tnear, n, "tnear"), far = per_ray(tfar, n, "tfar");
+  py::array_t<bool> blocked(n);
+  static_assert(sizeof(bool) == sizeof(uint8_t));
+  const RayBatch batch{org.data(), dir.data(), near.data, near.stride, far.data, far.stride, n};
+  {
+    py::gil_scoped_release release;
+    std::shared_lock lock(mutex_);
+    scene_.occluded(batch, reinterpret_cast<uint8_t*>(blocked.mutable_data()), threads);
+  }
+  return blocked;
+}
+
+py::dict PyScene::bvh_stats(int64_t mesh) {
+  struct Numbers {
+    size_t nodes, leaves;
+    int depth;
+    double sah_cost;
+  };
+  const Numbers n = read([&] {
+    scene_.check_committed();
+    const Bvh* bvh = &scene_.top_level();
+    if (mesh >= 0) {
+      if (size_t(mesh) >= scene_.mesh_count()) throw std::invalid_argument("unknown mesh id " + std::to_string(mesh));
+      bvh = &scene_.mesh(uint32_t(mesh)).bvh();
+    }
+    return Numbers{bvh->nodes.size(), bvh->leaf_count(), bvh->depth(), bvh->sah_cost()};
+  });
+  py::dict d;
+  d["nodes"] = n.nodes;
+  d["leaves"] = n.leaves;
+  d["depth"] = n.depth;
+  d["sah_cost"] = n.sah_cost;
+  return d;
+}
+
+size_t PyScene::mesh_count() {
+  return read([&] { return scene_.mesh_count(); });
+}
+size_t PyScene::instance_count() {
+  return read([&] { return scene_.instance_count(); });
+}
+size_t PyScene::triangle_count() {
+  return read([&] { return scene_.stored_triangle_count(); });
+}
+size_t PyScene::memory_bytes() {
+  return read([&] { return scene_.memory_bytes(); });
+}
+bool PyScene::committed() {
+  return read([&] { return scene_.committed(); });
+}
+double PyScene::build_ms() {
+  return read([&] { return scene_.commit_stats().build_ms; });
+}
+
+}  // namespace toyrt::binding

@@ -1,0 +1,86 @@
+// The Python-visible scene: the core Scene plus a readers/writer lock, so scripts that query
+// from several threads while another edits get consistent answers, never a crash. Each method
+// converts its arguments (python/convert.h), takes the lock, releases the GIL where the core
+// works for long, and calls the core, which holds the policy (validation, defaults, builder
+// choice, cancellation).
+#pragma once
+
+#include "scene/scene.h"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <mutex>
+#include <shared_mutex>
+#include <string>
+
+namespace toyrt::binding {
+
+namespace py = pybind11;
+
+class PyScene {
+ public:
+  uint32_t add_mesh(py::handle vertices, py::handle triangles, py::handle transform, py::handle normals, py::handle uvs,
+                    py::handle material_ids, bool instance);
+  void replace_mesh(int64_t mesh, py::handle vertices, py::handle triangles, py::handle normals, py::handle uvs,
+                    py::handle material_ids);
+  uint32_t add_instance(int64_t mesh, py::handle transform);
+  void set_instance_transform(int64_t instance, py::handle transform);
+  void clear_instances();
+
+  uint32_t add_material(const std::string& kind, py::handle color, int64_t texture, float ior);
+  void set_material(int64_t material, const std::string& kind, py::handle color, int64_t texture, float ior);
+  uint32_t add_texture(py::handle pixels, bool srgb);
+  void set_texture(int64_t texture, py::handle pixels, bool srgb);
+  uint32_t add_point_light(py::handle position, float power, py::handle color, float radius, bool visible_camera,
+                           bool visible_specular);
+  uint32_t add_area_light(py::handle matrix, const std::string& shape, float size, py::handle size_y, float power,
+                          py::handle color, bool visible_camera, bool visible_specular);
+  void clear_lights();
+  void set_background(py::handle color);
+  py::tuple background();
+  void set_background_lighting(bool on);
+  bool background_lighting();
+
+  bool commit(const std::string& builder, int threads, py::handle expected_rays, py::object should_cancel);
+  py::dict last_commit();
+  py::array_t<float> render(const py::dict& camera, int samples, uint32_t seed, int max_specular_depth,
+                            const std::string& area_light_sampling, const std::string& light_sampling, int threads,
+                            int tile_size, py::object on_tile, py::object should_cancel, int first_sample,
+                            int split_depth);
+  py::dict last_render() { return last_render_; }
+
+  py::dict intersect(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads);
+  py::array_t<bool> occluded(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads);
+  py::dict bvh_stats(int64_t mesh);
+
+  size_t mesh_count();
+  size_t instance_count();
+  size_t triangle_count();
+  size_t memory_bytes();
+  bool committed();
+  double build_ms();
+
+ private:
+  // Runs an edit under the exclusive lock with the GIL released while it waits: a render or
+  // commit holding the lock takes the GIL to poll its callbacks, so waiting with it would deadlock.
+  template <class F>
+  auto write(F&& edit) {
+    py::gil_scoped_release release;
+    std::unique_lock lock(mutex_);
+    return edit();
+  }
+  // Reads plain values under the shared lock, likewise without the GIL (build Python objects after).
+  template <class F>
+  auto read(F&& query) {
+    py::gil_scoped_release release;
+    std::shared_lock lock(mutex_);
+    return query();
+  }
+
+  Scene scene_;
+  py::dict last_render_;
+  std::shared_mutex mutex_;
+};
+
+}  // namespace toyrt::binding

@@ -1,0 +1,56 @@
+// The settings of one render, with their defaults: the one place they are written down (the
+// Python binding reads its argument defaults and toyrt.defaults from these structs, and the
+// add-on's properties are tested equal to them). check() holds the bounds; the names parse the
+// strings users pass.
+#pragma once
+
+#include "lights/area_light.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace toyrt {
+
+enum class LightSampling {
+  Auto,  // All up to kAllLightsUpTo lights, One beyond
+  All,   // one sample of every light at every diffuse hit
+  One,   // one light per hit, chosen by its expected contribution (LightSelector)
+};
+// "auto" samples every light at every hit up to this many lights: each costs a shadow ray, and
+// beyond a few the selector's one ray per hit wins.
+inline constexpr size_t kAllLightsUpTo = 4;
+
+// "auto", "all", "one"; throws std::invalid_argument on anything else.
+LightSampling parse_light_sampling(const std::string& name);
+const char* light_sampling_name(LightSampling sampling);
+// Auto resolved for a scene of `light_count` lights (All and One stay).
+LightSampling resolve_light_sampling(LightSampling sampling, size_t light_count);
+
+struct IntegratorSettings {
+  int max_specular_depth = 8;  // refraction / reflection events before a path is cut
+  LightSampling light_sampling = LightSampling::Auto;
+  // How rectangular area lights are sampled (disks and ellipses always by area).
+  AreaSampling area_sampling = AreaSampling::SolidAngle;
+  uint32_t seed = 0;
+  // Fresnel (glass) vertices before this depth trace both reflection and refraction, weighted by
+  // F and 1 - F; deeper ones pick one branch with those probabilities. 0 turns splitting off.
+  // Costs extra rays only in pixels that see glass; see docs/render.md for the measured gain.
+  int split_depth = 2;
+};
+
+struct RenderSettings {
+  int samples = 16;  // per pixel, on a Sobol-Owen pattern, box filter of one pixel
+  // The first sample index: a pass renders samples [first_sample, first_sample + samples) of the
+  // same sequence, so passes of n1 and n2 samples averaged with weights n1 and n2 equal one
+  // render of n1 + n2 samples (the viewport accumulates this way).
+  int first_sample = 0;
+  int tile_size = 32;  // pixels
+  int threads = 0;     // 0: all cores
+  IntegratorSettings integrator;
+
+  // Throws std::invalid_argument naming the first setting out of its bounds.
+  void check() const;
+};
+
+}  // namespace toyrt
