@@ -90,8 +90,8 @@ CXX_SOURCES = $(shell git ls-files '*.cpp' '*.h' 2>/dev/null || find native test
 PY_SOURCES  := addon scenes tests bench scripts
 
 lint: venv
-	clang-format-14 --dry-run --Werror $(CXX_SOURCES)
-	$(VENV)/bin/ruff check $(PY_SOURCES)
+	@clang-format-14 --dry-run --Werror $(CXX_SOURCES) && echo "lint: clang-format: $(words $(CXX_SOURCES)) C++ files formatted"
+	@$(VENV)/bin/ruff check $(PY_SOURCES)
 
 format:
 	clang-format-14 -i $(CXX_SOURCES)

@@ -91,7 +91,8 @@ def test_queries_before_commit_say_so():
     [
         (dict(origins=[[0, 0]], directions=[[0, 0, 1]]), ValueError, "origins must have shape (N, 3)"),
         (dict(origins=[[0, 0, 0]], directions=[[0, 0, 1], [0, 0, 1]]), ValueError, "same number of rays"),
-        (dict(origins=[[0, 0, 0]], directions=[[0, 0, 1]], tnear=[0.0, 1.0]), ValueError, "tnear must be a number or have shape (1,)"),
+        (dict(origins=[[0, 0, 0]], directions=[[0, 0, 1]], tnear=[0.0, 1.0]), ValueError,
+         "tnear must be a number or have shape (1,)"),
         (dict(origins=[[0, 0, 0]], directions=[[0, 0, 1]], tfar="far"), TypeError, "tfar"),
         (dict(origins=[[0, 0, 0]], directions=[[0, 0, 1]], tnear=float("nan")), ValueError, "tnear is NaN"),
         (dict(origins=[[0, 0, 0]], directions=[[0, 0, 1]], threads=-2), ValueError, "threads"),
