@@ -36,8 +36,9 @@ import numpy as np
 from . import materials
 from .camera import export_camera
 from .lights import LightSpec, light_spec
-from .materials import PLACEHOLDER, PLACEHOLDER_PIXELS, ImageKey
+from .materials import ImageKey
 from .mesh import RENDERABLE, ExportCancelled, evaluated_geometry, fingerprint, mesh_key, singular, stop_if, to_array
+from .sync_materials import MaterialSync
 from .world import WorldSpec, world_spec
 
 __all__ = ["SceneSync", "ExportCancelled", "export_scene", "for_render", "discard_render_cache",
@@ -48,7 +49,7 @@ _POLL_EVERY = 256
 _IDENTITY = np.eye(4)
 
 
-class SceneSync:
+class SceneSync(MaterialSync):
     """One native scene kept in step with a Blender depsgraph, and what each part was made from."""
 
     def __init__(self, toyrt, *, fingerprints: bool = True) -> None:
@@ -317,9 +318,9 @@ class SceneSync:
         if mid >= 0:
             self.scene.replace_mesh(mid, g.vertices, g.triangles, normals=g.normals, uvs=g.uvs, material_ids=mat_ids)
         else:
-            # add_mesh places one instance too: _place() lays every instance out again after it.
-            mid = self.scene.add_mesh(g.vertices, g.triangles, normals=g.normals, uvs=g.uvs, material_ids=mat_ids)
-            self.placed = None
+            # Stored only: _place() puts its instances where the walk found them.
+            mid = self.scene.add_mesh(g.vertices, g.triangles, normals=g.normals, uvs=g.uvs, material_ids=mat_ids,
+                                      instance=False)
         return [mid, len(g.triangles), fingerprint]
 
     def _empty(self, mid: int) -> None:
@@ -371,77 +372,6 @@ class SceneSync:
 
     def _note(self, notes) -> None:
         self.approximated.extend(n for n in notes if n not in self.approximated)
-
-    # ---- materials and textures ------------------------------------------------------------------
-    def _material_id(self, mat) -> int:
-        """The material id of a Blender material (None: an empty slot), converted on first use."""
-        name = mat.name_full if mat is not None else ""
-        sent = self.materials.get(name)
-        if sent is not None:
-            return sent[0]
-        converted = materials.material_spec(mat)
-        mid = self.scene.add_material(**self._material_arguments(converted))
-        self.materials[name] = (mid, converted.spec)
-        self._converted_now.add(name)
-        return mid
-
-    def _reconvert(self, mat) -> int:
-        """Convert `mat` again; send it into the id it has if it changed. Returns 1, or 0 if it
-        has no id yet (no mesh uses it)."""
-        sent = self.materials.get(mat.name_full)
-        if sent is None:
-            return 0
-        converted = materials.material_spec(mat)
-        arguments = self._material_arguments(converted)
-        if converted.spec != sent[1]:
-            self.scene.set_material(sent[0], **arguments)
-            self.materials[mat.name_full] = (sent[0], converted.spec)
-        return 1
-
-    def _material_arguments(self, converted: materials.ConvertedMaterial) -> dict:
-        self._note(converted.notes)
-        texture = converted.spec.texture
-        return converted.spec.arguments(self._texture_id(texture, converted.image) if texture is not None else -1)
-
-    def _texture_id(self, key: ImageKey, image) -> int:
-        tid = self.textures.get(key)
-        if tid is None:
-            pixels = None if key.placeholder else materials.image_pixels(image)
-            self.texture_notes[key] = () if key.placeholder else materials.image_notes(image, pixels)
-            tid = self._placeholder_id() if pixels is None else self.scene.add_texture(pixels, srgb=key.srgb)
-            self.textures[key] = tid
-        # Again for every material that reads it: a final render collects the notes afresh.
-        self._note(self.texture_notes[key])
-        return tid
-
-    def _placeholder_id(self) -> int:
-        tid = self.textures.get(PLACEHOLDER)
-        if tid is None:
-            tid = self.textures[PLACEHOLDER] = self.scene.add_texture(PLACEHOLDER_PIXELS, srgb=False)
-            self.texture_notes[PLACEHOLDER] = ()
-        return tid
-
-    def _refresh_image(self, image) -> int:
-        """Send an edited image's pixels again into its texture ids; an image that was missing
-        (the placeholder's id) gets its own texture, and its materials are sent again."""
-        count = 0
-        placeholder = self.textures.get(PLACEHOLDER)
-        for key, tid in list(self.textures.items()):
-            if key.placeholder or key.name != image.name_full:
-                continue
-            pixels = materials.image_pixels(image)
-            if pixels is None:
-                continue
-            if tid == placeholder:
-                tid = self.textures[key] = self.scene.add_texture(pixels, srgb=key.srgb)
-                for mid, spec in self.materials.values():
-                    if spec.texture == key:
-                        self.scene.set_material(mid, **spec.arguments(tid))
-            else:
-                self.scene.set_texture(tid, pixels, srgb=key.srgb)
-            self.texture_notes[key] = materials.image_notes(image, pixels)
-            count += 1
-        return count
 
 
 # ---------------------------------------------------------------------------------------------

@@ -1,0 +1,83 @@
+"""The material and texture half of SceneSync (sync.py): Blender materials and images -> the native
+scene's material and texture ids, converted on first use, sent again in place when they change.
+
+A mixin, not a class of its own, because it shares SceneSync's state (the scene, the notes, the
+id tables): it is here only to keep each file one concern. Nothing else uses it."""
+from __future__ import annotations
+
+from . import materials
+from .materials import PLACEHOLDER, PLACEHOLDER_PIXELS, ImageKey
+
+
+class MaterialSync:
+    """Needs from SceneSync: scene, materials, textures, texture_notes, _converted_now, _note()."""
+
+    def _material_id(self, mat) -> int:
+        """The material id of a Blender material (None: an empty slot), converted on first use."""
+        name = mat.name_full if mat is not None else ""
+        sent = self.materials.get(name)
+        if sent is not None:
+            return sent[0]
+        converted = materials.material_spec(mat)
+        mid = self.scene.add_material(**self._material_arguments(converted))
+        self.materials[name] = (mid, converted.spec)
+        self._converted_now.add(name)
+        return mid
+
+    def _reconvert(self, mat) -> int:
+        """Convert `mat` again; send it into the id it has if it changed. Returns 1, or 0 if it
+        has no id yet (no mesh uses it)."""
+        sent = self.materials.get(mat.name_full)
+        if sent is None:
+            return 0
+        converted = materials.material_spec(mat)
+        arguments = self._material_arguments(converted)
+        if converted.spec != sent[1]:
+            self.scene.set_material(sent[0], **arguments)
+            self.materials[mat.name_full] = (sent[0], converted.spec)
+        return 1
+
+    def _material_arguments(self, converted: materials.ConvertedMaterial) -> dict:
+        self._note(converted.notes)
+        texture = converted.spec.texture
+        return converted.spec.arguments(self._texture_id(texture, converted.image) if texture is not None else -1)
+
+    def _texture_id(self, key: ImageKey, image) -> int:
+        tid = self.textures.get(key)
+        if tid is None:
+            pixels = None if key.placeholder else materials.image_pixels(image)
+            self.texture_notes[key] = () if key.placeholder else materials.image_notes(image, pixels)
+            tid = self._placeholder_id() if pixels is None else self.scene.add_texture(pixels, srgb=key.srgb)
+            self.textures[key] = tid
+        # Again for every material that reads it: a final render collects the notes afresh.
+        self._note(self.texture_notes[key])
+        return tid
+
+    def _placeholder_id(self) -> int:
+        tid = self.textures.get(PLACEHOLDER)
+        if tid is None:
+            tid = self.textures[PLACEHOLDER] = self.scene.add_texture(PLACEHOLDER_PIXELS, srgb=False)
+            self.texture_notes[PLACEHOLDER] = ()
+        return tid
+
+    def _refresh_image(self, image) -> int:
+        """Send an edited image's pixels again into its texture ids; an image that was missing
+        (the placeholder's id) gets its own texture, and its materials are sent again."""
+        count = 0
+        placeholder = self.textures.get(PLACEHOLDER)
+        for key, tid in list(self.textures.items()):
+            if key.placeholder or key.name != image.name_full:
+                continue
+            pixels = materials.image_pixels(image)
+            if pixels is None:
+                continue
+            if tid == placeholder:
+                tid = self.textures[key] = self.scene.add_texture(pixels, srgb=key.srgb)
+                for mid, spec in self.materials.values():
+                    if spec.texture == key:
+                        self.scene.set_material(mid, **spec.arguments(tid))
+            else:
+                self.scene.set_texture(tid, pixels, srgb=key.srgb)
+            self.texture_notes[key] = materials.image_notes(image, pixels)
+            count += 1
+        return count
