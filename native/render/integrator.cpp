@@ -133,24 +133,33 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     const Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;
     const Material& m =
         s.material >= 0 && size_t(s.material) < materials.size() ? materials[size_t(s.material)] : kDefault;
-    // One generic dispatch per hit (material.h): no per-type code here.
+    // One generic dispatch per hit, no per-type code: the lambda is instantiated per material
+    // type, so for an inline scatter() (Lambert's) the compiler sees the answer's kind as a
+    // constant and keeps only the diffuse path, as fast as a hand-written case. It returns
+    // whether the path goes on along `ray`.
     const MaterialContext ctx{
         &scene.textures(), depth < settings.split_depth, pixel, sample, vertex_dimension(depth, 0), settings.seed};
-    const Scatter sc = scatter_material(m, ShadingPoint{wo, s.ng, s.ns, s.uv}, ctx);
-    if (sc.kind == Scatter::Kind::Diffuse) {
-      radiance += throughput * direct_lighting(scene, s, ng, ns, sc.f, depth, pixel, sample, settings);
-      break;
-    }
-    if (depth >= settings.max_specular_depth) break;
-    if (sc.kind == Scatter::Kind::Split) {
-      for (int b = 0; b < sc.count; ++b) {
-        const Ray branch{offset_ray_origin(s.p, sc.branches[b].offset_normal), 0.0f, sc.branches[b].wi, kInfinity};
-        radiance +=
-            throughput * sc.branches[b].probability * trace_from(scene, branch, depth + 1, pixel, sample, settings);
-      }
-      break;
-    }
-    ray = Ray{offset_ray_origin(s.p, sc.branches[0].offset_normal), 0.0f, sc.branches[0].wi, kInfinity};
+    const bool go_on = std::visit(
+        [&](const auto& material) {
+          const Scatter sc = scatter(material, ShadingPoint{wo, s.ng, s.ns, s.uv}, ctx);
+          if (sc.kind == Scatter::Kind::Diffuse) {
+            radiance += throughput * direct_lighting(scene, s, ng, ns, sc.f, depth, pixel, sample, settings);
+            return false;
+          }
+          if (depth >= settings.max_specular_depth) return false;
+          if (sc.kind == Scatter::Kind::Split) {
+            for (int b = 0; b < sc.count; ++b) {
+              const SpecularSample& branch = sc.branches[b];
+              const Ray next{offset_ray_origin(s.p, branch.offset_normal), 0.0f, branch.wi, kInfinity};
+              radiance += throughput * branch.probability * trace_from(scene, next, depth + 1, pixel, sample, settings);
+            }
+            return false;
+          }
+          ray = Ray{offset_ray_origin(s.p, sc.branches[0].offset_normal), 0.0f, sc.branches[0].wi, kInfinity};
+          return true;
+        },
+        m);
+    if (!go_on) break;
   }
   return radiance;
 }
