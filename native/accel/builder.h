@@ -1,7 +1,9 @@
 // The one entry point to every BVH builder: a mesh, the top level, tests and benchmarks call
 // build_bvh() with a BuilderKind, and nothing else names a builder's own function to build a
-// scene. Adding a builder = its own file (as binned_sah_builder.h and lbvh_builder.h) + one case in
-// build_bvh() (builder.cpp) + its name in the parse table there.
+// scene. Adding a builder = its own accel/<x>_builder.{h,cpp} (as binned_sah_builder and
+// lbvh_builder) + its entry in this pair: a BuilderKind value and its settings in BuilderSettings
+// here, one row of the table in builder.cpp (name, kind, build function). The scene's
+// CommitOptions inherit BuilderSettings, so the scene needs no edit.
 //
 // "auto" picks, per build, the builder whose build plus the tracing to come costs least ("model
 // no more than a scene needs"). The SAH tree traces faster; the LBVH builds faster. With n
@@ -43,11 +45,15 @@ struct BuilderCostModel {
   }
 };
 
-// Every builder's settings; each builder reads its own part.
-struct BuildConfig {
+// Every builder's settings; each builder reads its own part. A new builder's settings go here
+// (and reach Scene::commit through CommitOptions, which inherits them).
+struct BuilderSettings {
   BinnedSahConfig sah;
   LbvhConfig lbvh;
   BuilderCostModel cost_model;
+};
+
+struct BuildConfig : BuilderSettings {
   // Rays the caller expects to trace through these primitives, for Auto; < 0: unknown (Auto
   // keeps the SAH builder).
   double expected_rays = -1.0;

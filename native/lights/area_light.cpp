@@ -54,13 +54,26 @@ AreaLight AreaLight::make(AreaShape shape, float size, float size_y, const Mat4&
   return light;
 }
 
-LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u, AreaSampling sampling) {
+AreaLight AreaLight::from_params(const Params& params) {
+  const Settings d;
+  // Read one by one, so the first bad argument is the one reported, whatever the compiler's order.
+  const Mat4 matrix = params.matrix("matrix", d.matrix);
+  const AreaShape shape = parse_area_shape(params.text("shape", area_shape_name(d.shape)));
+  const float size = float(params.positive("size", d.size));
+  // Checked by make() where the shape uses it (the add-on sends Blender's size_y for any shape).
+  const float size_y = float(params.number("size_y", size));
+  const float power = float(params.non_negative("power", d.power));
+  const Vec3 color = params.color("color", d.color);
+  return make(shape, size, size_y, matrix, power, color);
+}
+
+LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u, const LightContext& ctx) {
   LightSample s;
   if (!(glm::dot(p - light.center, light.normal) > 0.0f)) return s;  // one-sided
   float pdf = 0.0f;
   Vec3 q;
   bool by_area = true;
-  if (use_solid_angle(light, sampling)) {
+  if (use_solid_angle(light, ctx.area_sampling)) {
     const SphericalRectangle rect = SphericalRectangle::make(p, light.corner(), light.edge_x, light.edge_y);
     if (rect.solid_angle >= SphericalRectangle::kMinSolidAngle) {
       q = rect.sample(u);
@@ -86,7 +99,7 @@ LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u, AreaSam
   return s;
 }
 
-LightEval evaluate(const AreaLight& light, const Vec3& p, const Vec3& wi, AreaSampling sampling) {
+LightEval evaluate(const AreaLight& light, const Vec3& p, const Vec3& wi, const LightContext& ctx) {
   LightEval e;
   const float height = glm::dot(p - light.center, light.normal);
   const float cos_light = -glm::dot(wi, light.normal);
@@ -100,7 +113,7 @@ LightEval evaluate(const AreaLight& light, const Vec3& p, const Vec3& wi, AreaSa
   e.radiance = light.radiance;
   e.distance = t;
   e.pdf = area_pdf(light, t, cos_light);
-  if (use_solid_angle(light, sampling)) {
+  if (use_solid_angle(light, ctx.area_sampling)) {
     const double omega = SphericalRectangle::make(p, light.corner(), light.edge_x, light.edge_y).solid_angle;
     if (omega >= SphericalRectangle::kMinSolidAngle) e.pdf = float(1.0 / omega);
   }

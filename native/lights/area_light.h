@@ -9,9 +9,15 @@
 //
 // Sampling: rectangles and squares by either estimator (AreaSampling), disks and ellipses by area.
 // The estimator is a render setting (IntegratorSettings::area_sampling), passed to sample() and
-// evaluate(), not part of the light: one scene renders with either without being copied.
+// evaluate() in the LightContext, not part of the light: one scene renders with either.
+//
+// Parameters (add_light('AREA', ...), Blender's names): matrix (the object's (4, 4) world
+// matrix, identity), shape ('SQUARE'), size (1 m), size_y (size; RECTANGLE and ELLIPSE only,
+// accepted and ignored otherwise), power (10 W), color ((1, 1, 1)): AreaLight::Settings.
 #pragma once
 
+#include "core/params.h"
+#include "lights/light_context.h"
 #include "lights/light_sample.h"
 #include "sampling/warp.h"
 
@@ -20,11 +26,24 @@
 namespace toyrt {
 
 enum class AreaShape { Rectangle, Square, Disk, Ellipse };  // Blender's shape enum
-// Uniform over the light's area (density dist^2 / (area cos) in solid angle), or uniform over the
-// solid angle of the spherical rectangle (Urena et al. 2013; rectangles and squares only).
-enum class AreaSampling { Area, SolidAngle };
 
 struct AreaLight {
+  static constexpr const char* kType = "AREA";  // Blender's light type
+  static constexpr const char* kParams =
+      "matrix ((4, 4) world matrix, identity; emits along local -Z), shape ('RECTANGLE', 'SQUARE', 'DISK',\n"
+      "    'ELLIPSE'; 'SQUARE'), size (m, 1), size_y (m, size; RECTANGLE and ELLIPSE), power (W, 10),\n"
+      "    color (linear RGB, (1, 1, 1))";
+
+  // Blender's settings, with the defaults of a new area light: a 1 m square of 10 W, white.
+  struct Settings {
+    Mat4 matrix{1.0f};  // the object's world matrix
+    AreaShape shape = AreaShape::Square;
+    float size = 1.0f;    // m
+    float size_y = 1.0f;  // m, RECTANGLE and ELLIPSE only; from_params defaults it to size
+    float power = 10.0f;  // W
+    Vec3 color{1.0f};
+  };
+
   AreaShape shape = AreaShape::Rectangle;
   Vec3 center{0.0f};
   Vec3 edge_x{1.0f, 0.0f, 0.0f}, edge_y{0.0f, 1.0f, 0.0f};  // full extents along local x and y (orthogonal)
@@ -38,26 +57,19 @@ struct AreaLight {
   // non-finite or non-affine matrix, a zero or sheared scale (the light must stay a rectangle).
   static AreaLight make(AreaShape shape, float size, float size_y, const Mat4& matrix_world, float power,
                         const Vec3& color);
+  // From Params named as Settings' members (shape as Blender's name); size_y defaults to size.
+  static AreaLight from_params(const Params& params);
 
   bool is_rectangle() const { return shape == AreaShape::Rectangle || shape == AreaShape::Square; }
   Vec3 corner() const { return center - 0.5f * edge_x - 0.5f * edge_y; }
 };
 
-// What an area light is when the caller does not say (the Python binding's argument defaults):
-// Blender's new area light, a 1 m square of 10 W, white.
-struct AreaLightDefaults {
-  AreaShape shape = AreaShape::Square;
-  float size = 1.0f;    // m
-  float power = 10.0f;  // W
-  Vec3 color{1.0f};
-};
-
 // A point on the light seen from shading point p (u: two uniform numbers). No sample when p is
 // behind or in the light's plane.
-// `sampling` applies to rectangles and squares; other shapes are always sampled by area.
-LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u, AreaSampling sampling);
+// ctx.area_sampling applies to rectangles and squares; other shapes are always sampled by area.
+LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u, const LightContext& ctx);
 // The light along direction wi from p, with the density `sample` would have given wi.
-LightEval evaluate(const AreaLight& light, const Vec3& p, const Vec3& wi, AreaSampling sampling);
+LightEval evaluate(const AreaLight& light, const Vec3& p, const Vec3& wi, const LightContext& ctx);
 
 // Blender's shape names: "RECTANGLE", "SQUARE", "DISK", "ELLIPSE"; throws std::invalid_argument.
 AreaShape parse_area_shape(const std::string& name);

@@ -24,6 +24,16 @@ PointLight PointLight::make(const Vec3& position, float power, const Vec3& color
   return light;
 }
 
+PointLight PointLight::from_params(const Params& params) {
+  const Settings d;
+  // Read one by one, so the first bad argument is the one reported, whatever the compiler's order.
+  const Vec3 position = params.point("position", d.position);
+  const float power = float(params.non_negative("power", d.power));
+  const Vec3 color = params.color("color", d.color);
+  const float radius = float(params.non_negative("radius", d.radius));
+  return make(position, power, color, radius);
+}
+
 namespace {
 
 // The sphere's cap seen from p, described without cancellation: 1 - cos(theta_max) from
@@ -47,7 +57,7 @@ float sphere_distance(const PointLight& light, const Vec3& p, const Vec3& wi, bo
 
 }  // namespace
 
-LightSample sample(const PointLight& light, const Vec3& p, const Vec2& u) {
+LightSample sample(const PointLight& light, const Vec3& p, const Vec2& u, const LightContext&) {
   LightSample s;
   const Vec3 to_centre = light.position - p;
   const float d2 = glm::dot(to_centre, to_centre);
@@ -82,7 +92,7 @@ LightSample sample(const PointLight& light, const Vec3& p, const Vec2& u) {
   return s;
 }
 
-LightEval evaluate(const PointLight& light, const Vec3& p, const Vec3& wi) {
+LightEval evaluate(const PointLight& light, const Vec3& p, const Vec3& wi, const LightContext&) {
   LightEval e;
   if (light.radius == 0.0f) return e;
   const Vec3 to_centre = light.position - p;

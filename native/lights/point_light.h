@@ -12,14 +12,32 @@
 // Where the whole sphere lies above the receiver's tangent plane its irradiance is
 // pi L sin^2(theta_max) cos(theta) = I cos(theta) / r^2 exactly, the point light's: the two only
 // differ close to the sphere and in their shadows.
+//
+// Parameters (add_light('POINT', ...), Blender's names): position ((0, 0, 0), m), power (10 W),
+// color ((1, 1, 1), linear RGB), radius (0 m: shadow_soft_size; 0 is a delta light, hard
+// shadows): PointLight::Settings.
 #pragma once
 
+#include "core/params.h"
+#include "lights/light_context.h"
 #include "lights/light_sample.h"
 #include "sampling/warp.h"
 
 namespace toyrt {
 
 struct PointLight {
+  static constexpr const char* kType = "POINT";  // Blender's light type
+  static constexpr const char* kParams =
+      "position (m, (0, 0, 0)), power (W, 10), color (linear RGB, (1, 1, 1)), radius (m, 0: hard shadows)";
+
+  // Blender's settings, with the defaults of a new point light (radius 0: hard shadows).
+  struct Settings {
+    Vec3 position{0.0f};  // m
+    float power = 10.0f;  // W
+    Vec3 color{1.0f};     // linear RGB
+    float radius = 0.0f;  // m
+  };
+
   Vec3 position{0.0f};
   float radius = 0.0f;   // m; 0: a delta light
   Vec3 intensity{0.0f};  // I = P colour / (4 pi), W/sr
@@ -28,19 +46,14 @@ struct PointLight {
   // Blender's settings: location, power (W), colour (linear RGB), radius (shadow_soft_size, m).
   // Throws std::invalid_argument for non-finite values, negative power, colour or radius.
   static PointLight make(const Vec3& position, float power, const Vec3& color, float radius = 0.0f);
-};
-
-// What a point light is when the caller does not say (the Python binding's argument defaults):
-// white, radius 0 (a delta light, hard shadows).
-struct PointLightDefaults {
-  Vec3 color{1.0f};
-  float radius = 0.0f;
+  // From Params named as Settings' members.
+  static PointLight from_params(const Params& params);
 };
 
 // A direction towards the light from shading point p (u: two uniform numbers, used for R > 0).
-LightSample sample(const PointLight& light, const Vec3& p, const Vec2& u);
+LightSample sample(const PointLight& light, const Vec3& p, const Vec2& u, const LightContext& ctx = {});
 // The sphere along direction wi from p (nothing for radius 0: a delta light cannot be hit).
-LightEval evaluate(const PointLight& light, const Vec3& p, const Vec3& wi);
+LightEval evaluate(const PointLight& light, const Vec3& p, const Vec3& wi, const LightContext& ctx = {});
 // The light's expected contribution at p with normal n (n = 0: no cosine), for light selection:
 // mean intensity over distance^2, times a bound of the receiver's cosine over the sphere. Zero
 // exactly when no point of the light is above p's tangent plane.

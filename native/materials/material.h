@@ -1,15 +1,20 @@
-// The closed set of materials, dispatched statically (std::variant): the integrator visits the
-// material once per hit with one case per type (an Overloaded set, core/overloaded.h), so a type
-// added here without its case in the integrator fails to compile, and a scene without refractive
-// materials never runs refraction code.
+// The closed set of materials, dispatched statically (std::variant), as lights are: the variant
+// is the one table of material types. A new type is its own materials/<x>.{h,cpp} and one entry
+// below. Each type provides
+//     static constexpr const char* kType, kParams;  static X from_params(const Params&);  (make_material)
+//     Scatter scatter(const X&, const ShadingPoint&, const MaterialContext&);     (the integrator)
+//     int32_t texture_index(const X&);   // the texture it reads, -1: none         (the scene's check)
+// and a type without them fails to compile here or in the integrator's generic visit; a scene
+// without refractive materials never runs refraction code.
 #pragma once
 
-#include "core/overloaded.h"
+#include "core/type_table.h"
 #include "materials/lambert.h"
 #include "materials/refraction.h"
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <variant>
 
 namespace toyrt {
@@ -18,17 +23,22 @@ using Material = std::variant<Lambert, PerfectRefraction, FresnelDielectric>;
 
 // The texture a material reads (-1: none).
 inline int32_t texture_of(const Material& material) {
-  return std::visit(
-      Overloaded{[](const Lambert& m) { return m.texture; }, [](const PerfectRefraction&) { return int32_t(-1); },
-                 [](const FresnelDielectric&) { return int32_t(-1); }},
-      material);
+  return std::visit([](const auto& m) { return texture_index(m); }, material);
 }
 
-// A material from Blender-facing settings: kind "diffuse" (Lambert with `color`, linear RGB >= 0,
-// or texture `texture`; -1: none), "refraction" (PerfectRefraction) or "glass"
-// (FresnelDielectric), both with `ior`. Throws std::invalid_argument for another kind or a bad
-// value. Texture ids are checked against the scene's textures by Scene::add_material.
+inline Scatter scatter_material(const Material& material, const ShadingPoint& s, const MaterialContext& ctx) {
+  return std::visit([&](const auto& m) { return scatter(m, s, ctx); }, material);
+}
+
+// A material of kind `kind` ("diffuse", "refraction", "glass": the kTypes) from its parameters.
+// Throws std::invalid_argument for another kind (listing the known ones), a bad value or an
+// argument the kind does not read. Texture ids are checked against the scene's textures by
+// Scene::add_material.
 inline constexpr const char* kDefaultMaterialKind = "diffuse";
-Material make_material(const std::string& kind, const Vec3& color, int64_t texture, float ior);
+inline Material make_material(std::string_view kind, const Params& params) {
+  return make_from_params<Material>(kind, params, "material", "kind");
+}
+// "'diffuse', 'refraction' or 'glass'".
+inline std::string material_kind_names() { return type_names<Material>(); }
 
 }  // namespace toyrt

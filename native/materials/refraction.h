@@ -18,28 +18,29 @@
 #pragma once
 
 #include "core/math.h"
+#include "core/params.h"
+#include "materials/scatter.h"
+
+#include <cstdint>
 
 namespace toyrt {
 
+// Parameters of both (add_material('refraction' or 'glass', ...)): ior (1.45, Blender's
+// default), positive and finite.
 struct PerfectRefraction {
+  static constexpr const char* kType = "refraction";
+  static constexpr const char* kParams = "ior (1.45): perfect refraction, Blender's Refraction BSDF";
   float ior = 1.45f;  // Blender's default; must be positive and finite
   static PerfectRefraction make(float ior);
+  static PerfectRefraction from_params(const Params& params);
 };
 
 struct FresnelDielectric {
+  static constexpr const char* kType = "glass";
+  static constexpr const char* kParams = "ior (1.45): Fresnel reflection and refraction, Blender's Glass BSDF";
   float ior = 1.45f;
   static FresnelDielectric make(float ior);
-};
-
-struct SpecularSample {
-  Vec3 wi{0.0f};           // unit direction leaving the surface
-  bool reflected = false;  // mirror direction (always, under total internal reflection)
-  bool total_internal_reflection = false;
-  bool entering = false;     // wo was on the geometric normal's side
-  float probability = 1.0f;  // of this branch: 1, or F / 1 - F for FresnelDielectric; f / pdf is 1
-                             // (times the material's colour) in every case
-  // The geometric normal on the side wi leaves into: offset_ray_origin(p, offset_normal).
-  Vec3 offset_normal{0.0f};
+  static FresnelDielectric from_params(const Params& params);
 };
 
 // Mirror of wo about n: 2 (wo . n) n - wo.
@@ -64,5 +65,12 @@ SpecularSample sample(const FresnelDielectric& m, const Vec3& wo, const Vec3& ng
 // its Fresnel weight in `probability` (F and 1 - F, summing to 1), or one branch of weight 1
 // when only one exists (total internal reflection, or F = 0). Returns the branch count (1 or 2).
 int split(const FresnelDielectric& m, const Vec3& wo, const Vec3& ng, const Vec3& ns, SpecularSample out[2]);
+
+// The integrator's interface (materials/scatter.h). Refraction always continues along one
+// branch; glass splits when ctx.split, and otherwise draws ctx.uniform() to choose.
+Scatter scatter(const PerfectRefraction& m, const ShadingPoint& s, const MaterialContext& ctx);
+Scatter scatter(const FresnelDielectric& m, const ShadingPoint& s, const MaterialContext& ctx);
+inline int32_t texture_index(const PerfectRefraction&) { return -1; }
+inline int32_t texture_index(const FresnelDielectric&) { return -1; }
 
 }  // namespace toyrt

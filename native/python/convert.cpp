@@ -302,4 +302,39 @@ CameraParams to_camera(const py::dict& camera) {
   return p;
 }
 
+Params to_params(const py::dict& kwargs) {
+  Params params;
+  for (auto item : kwargs) {
+    const std::string name = py::str(item.first);
+    py::handle v = item.second;
+    if (v.is_none()) continue;
+    if (py::isinstance<py::bool_>(v)) {
+      params.set(name, v.cast<bool>());
+    } else if (py::isinstance<py::int_>(v) || py::isinstance<py::float_>(v)) {
+      const double x = PyFloat_AsDouble(v.ptr());
+      if (x == -1.0 && PyErr_Occurred()) {
+        PyErr_Clear();
+        throw py::value_error(name + " is too large to be a number");
+      }
+      params.set(name, x);
+    } else if (py::isinstance<py::str>(v)) {
+      params.set(name, v.cast<std::string>());
+    } else {
+      const py::array a = try_array(v);
+      if (a && is_numeric(a) && a.ndim() == 0) {
+        params.set(name, a.cast<double>());
+      } else if (a && is_numeric(a) && a.size() == 3 && a.ndim() == 1) {
+        params.set(name, to_vec3(v, name.c_str()));
+      } else if (a && is_numeric(a) && a.ndim() == 2 && a.shape(0) == 4 && a.shape(1) == 4) {
+        params.set(name, to_matrix(v, name.c_str()));
+      } else {
+        throw py::type_error(name + " must be a bool, a number, text, 3 numbers or a (4, 4) matrix, not " +
+                             std::string(py::str(py::type::handle_of(v).attr("__name__"))) +
+                             (a ? " of shape " + shape_of(a) : std::string()));
+      }
+    }
+  }
+  return params;
+}
+
 }  // namespace toyrt::binding

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "camera/camera.h"
+#include "core/params.h"
 #include "geometry/mesh.h"
 #include "materials/texture.h"
 #include "scene/mesh_shading.h"
@@ -55,5 +56,9 @@ MeshShading to_shading(size_t vertex_count, const std::vector<Triangle>& tris, p
 // (height, width, 3 or 4) float 0..1 or uint8 pixels, rows from the bottom.
 Texture to_texture(py::handle pixels, bool srgb);
 CameraParams to_camera(const py::dict& camera);
+// Keyword arguments as Params, by the value's Python type: bool -> bool; int, float -> number;
+// str -> text; an array-like of 3 numbers -> Vec3; of shape (4, 4) -> Mat4 (row-major, as
+// to_matrix); None -> left out (the type's default). Anything else: TypeError naming the argument.
+Params to_params(const py::dict& kwargs);
 
 }  // namespace toyrt::binding

@@ -55,6 +55,17 @@ py::dict core_defaults() {
   return d;
 }
 
+// add_material's and set_material's parameters: the keywords documented since the first
+// materials (color, texture, ior), which every kind accepts and ignores where it has no use for
+// them (the add-on sends all three whatever the kind), plus any other keyword, which the kind
+// must read (a typo is an error).
+Params material_params(py::handle color, int64_t texture, float ior, const py::kwargs& extra) {
+  Params p = to_params(extra);
+  p.set("color", to_vec3(color, "color")).set("texture", double(texture)).set("ior", double(ior));
+  for (const char* shared : {"color", "texture", "ior"}) p.allow_unread(shared);
+  return p;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(toyrt, m) {
@@ -99,6 +110,17 @@ PYBIND11_MODULE(toyrt, m) {
       "split_depth: glass (Fresnel) surfaces among the first split_depth path vertices trace both reflection\n"
       "and refraction, weighted by F and 1 - F; deeper ones choose one. 0: never split.");
 
+  // The types and their parameters, read from the core's tables (each type documents its own).
+  static const std::string light_doc =
+      "Adds a light of Blender type `type` with its parameters as keywords; returns its id. Types:\n" +
+      type_docs<Light>() +
+      "visible_camera / visible_specular: whether camera rays / rays through glass see the light itself.\n"
+      "An unknown type or keyword raises ValueError naming it; None leaves a parameter at its default.";
+  static const std::string material_doc =
+      "Adds a material; returns its id. kind and its parameters (other keywords than color, texture and ior\n"
+      "must be ones the kind reads):\n" +
+      type_docs<Material>() + "color, texture and ior are accepted by every kind; kinds without them ignore them.";
+
   py::class_<PyScene>(m, "Scene", "A two-level scene: meshes stored once, placed by instances.")
       .def(py::init<>())
       .def("add_mesh", &PyScene::add_mesh, py::arg("vertices"), py::arg("triangles"), py::arg("transform") = py::none(),
@@ -112,30 +134,60 @@ PYBIND11_MODULE(toyrt, m) {
            "Degenerate (zero-area) triangles are kept but can never be hit.\n"
            "For rendering: normals (M, 3, 3) per corner or (N, 3) per vertex (smooth shading; None: flat),\n"
            "uvs (M, 3, 2) or (N, 2), material_ids: one int or (M,) ints into the scene's materials.")
-      .def("add_material", &PyScene::add_material, py::arg("kind") = kDefaultMaterialKind,
-           py::arg("color") = as_tuple(Lambert{}.albedo), py::arg("texture") = Lambert{}.texture,
-           py::arg("ior") = tidy(PerfectRefraction{}.ior),
-           "Adds a material; returns its id. kind: 'diffuse' (Lambert, linear RGB colour or a texture id),\n"
-           "'refraction' (perfect refraction, Blender's Refraction BSDF, with its ior) or 'glass' (Fresnel\n"
-           "reflection and refraction, Blender's Glass BSDF).")
+      .def(
+          "add_material",
+          [](PyScene& self, const std::string& kind, py::handle color, int64_t texture, float ior,
+             const py::kwargs& params) {
+            return self.add_material(kind, material_params(color, texture, ior, params));
+          },
+          py::arg("kind") = kDefaultMaterialKind, py::arg("color") = as_tuple(Lambert{}.albedo),
+          py::arg("texture") = Lambert{}.texture, py::arg("ior") = tidy(PerfectRefraction{}.ior), material_doc.c_str())
       .def("add_texture", &PyScene::add_texture, py::arg("pixels"), py::arg("srgb") = true,
            "Adds an image; returns its id. pixels: (height, width, 3 or 4), float 0..1 or uint8, rows from\n"
            "the bottom (Blender's Image.pixels order); srgb: decode from sRGB to linear, as Blender does.")
-      .def("add_point_light", &PyScene::add_point_light, py::arg("position"), py::arg("power"),
-           py::arg("color") = as_tuple(PointLightDefaults{}.color), py::arg("radius") = PointLightDefaults{}.radius,
-           py::arg("visible_camera") = LightVisibility{}.camera,
-           py::arg("visible_specular") = LightVisibility{}.specular,
-           "Adds a point light in Blender's units: power in watts, linear colour, radius in metres (0: hard shadows).\n"
-           "visible_camera / visible_specular: whether camera rays / rays through glass see the sphere itself.")
-      .def("add_area_light", &PyScene::add_area_light, py::arg("matrix"),
-           py::arg("shape") = area_shape_name(AreaLightDefaults{}.shape), py::arg("size") = AreaLightDefaults{}.size,
-           py::arg("size_y") = py::none(), py::arg("power") = AreaLightDefaults{}.power,
-           py::arg("color") = as_tuple(AreaLightDefaults{}.color), py::arg("visible_camera") = LightVisibility{}.camera,
-           py::arg("visible_specular") = LightVisibility{}.specular,
-           "Adds an area light in Blender's units: the light object's (4, 4) world matrix (it emits along its\n"
-           "local -Z, one-sided), shape 'RECTANGLE', 'SQUARE', 'DISK' or 'ELLIPSE', size (and size_y) in metres,\n"
-           "power in watts (radiance = power / (4 area), as Cycles). visible_camera / visible_specular: whether\n"
-           "camera rays / rays through glass see the light's surface (Cycles' defaults: both).")
+      .def(
+          "add_light",
+          [](PyScene& self, const std::string& type, bool visible_camera, bool visible_specular,
+             const py::kwargs& params) {
+            return self.add_light(type, to_params(params), {visible_camera, visible_specular});
+          },
+          py::arg("type"), py::arg("visible_camera") = LightVisibility{}.camera,
+          py::arg("visible_specular") = LightVisibility{}.specular, light_doc.c_str())
+      .def(
+          "add_point_light",
+          [](PyScene& self, py::handle position, float power, py::handle color, float radius, bool visible_camera,
+             bool visible_specular) {
+            Params p;
+            p.set("position", to_vec3(position, "position")).set("power", double(power));
+            p.set("color", to_vec3(color, "color")).set("radius", double(radius));
+            return self.add_light(PointLight::kType, p, {visible_camera, visible_specular});
+          },
+          py::arg("position"), py::arg("power"), py::arg("color") = as_tuple(PointLight::Settings{}.color),
+          py::arg("radius") = PointLight::Settings{}.radius, py::arg("visible_camera") = LightVisibility{}.camera,
+          py::arg("visible_specular") = LightVisibility{}.specular,
+          "Adds a point light in Blender's units: power in watts, linear colour, radius in metres (0: hard shadows).\n"
+          "visible_camera / visible_specular: whether camera rays / rays through glass see the sphere itself.\n"
+          "The same as add_light('POINT', ...).")
+      .def(
+          "add_area_light",
+          [](PyScene& self, py::handle matrix, const std::string& shape, float size, py::handle size_y, float power,
+             py::handle color, bool visible_camera, bool visible_specular) {
+            Params p;
+            p.set("matrix", to_matrix(matrix, "matrix")).set("shape", shape).set("size", double(size));
+            if (!size_y.is_none()) p.set("size_y", double(size_y.cast<float>()));
+            p.set("power", double(power)).set("color", to_vec3(color, "color"));
+            return self.add_light(AreaLight::kType, p, {visible_camera, visible_specular});
+          },
+          py::arg("matrix"), py::arg("shape") = area_shape_name(AreaLight::Settings{}.shape),
+          py::arg("size") = AreaLight::Settings{}.size, py::arg("size_y") = py::none(),
+          py::arg("power") = AreaLight::Settings{}.power, py::arg("color") = as_tuple(AreaLight::Settings{}.color),
+          py::arg("visible_camera") = LightVisibility{}.camera,
+          py::arg("visible_specular") = LightVisibility{}.specular,
+          "Adds an area light in Blender's units: the light object's (4, 4) world matrix (it emits along its\n"
+          "local -Z, one-sided), shape 'RECTANGLE', 'SQUARE', 'DISK' or 'ELLIPSE', size (and size_y) in metres,\n"
+          "power in watts (radiance = power / (4 area), as Cycles). visible_camera / visible_specular: whether\n"
+          "camera rays / rays through glass see the light's surface (Cycles' defaults: both).\n"
+          "The same as add_light('AREA', ...).")
       .def_property("background", &PyScene::background, &PyScene::set_background,
                     "Radiance (linear RGB) of rays that leave the scene: the world colour.")
       .def_property("background_lighting", &PyScene::background_lighting, &PyScene::set_background_lighting,
@@ -153,10 +205,15 @@ PYBIND11_MODULE(toyrt, m) {
           "last_render", &PyScene::last_render,
           "What the last render did: cancelled, cancel_latency_ms, tiles_done, tiles_total, render_ms,\n"
           "samples, light_sampling.")
-      .def("set_material", &PyScene::set_material, py::arg("material"), py::arg("kind") = kDefaultMaterialKind,
-           py::arg("color") = as_tuple(Lambert{}.albedo), py::arg("texture") = Lambert{}.texture,
-           py::arg("ior") = tidy(PerfectRefraction{}.ior),
-           "Replaces material `material` in place (same arguments as add_material); meshes keep their ids.")
+      .def(
+          "set_material",
+          [](PyScene& self, int64_t material, const std::string& kind, py::handle color, int64_t texture, float ior,
+             const py::kwargs& params) {
+            self.set_material(material, kind, material_params(color, texture, ior, params));
+          },
+          py::arg("material"), py::arg("kind") = kDefaultMaterialKind, py::arg("color") = as_tuple(Lambert{}.albedo),
+          py::arg("texture") = Lambert{}.texture, py::arg("ior") = tidy(PerfectRefraction{}.ior),
+          "Replaces material `material` in place (same arguments as add_material); meshes keep their ids.")
       .def("set_texture", &PyScene::set_texture, py::arg("texture"), py::arg("pixels"), py::arg("srgb") = true,
            "Replaces texture `texture` in place (same arguments as add_texture).")
       .def("clear_lights", &PyScene::clear_lights, "Removes every light (to send them again after an edit).")

@@ -46,13 +46,13 @@ void PyScene::clear_instances() {
   write([&] { scene_.clear_instances(); });
 }
 
-uint32_t PyScene::add_material(const std::string& kind, py::handle color, int64_t texture, float ior) {
-  const Material material = make_material(kind, to_vec3(color, "color"), texture, ior);
+uint32_t PyScene::add_material(const std::string& kind, const Params& params) {
+  const Material material = make_material(kind, params);
   return write([&] { return scene_.add_material(material); });
 }
 
-void PyScene::set_material(int64_t id, const std::string& kind, py::handle color, int64_t texture, float ior) {
-  const Material material = make_material(kind, to_vec3(color, "color"), texture, ior);
+void PyScene::set_material(int64_t id, const std::string& kind, const Params& params) {
+  const Material material = make_material(kind, params);
   write([&] { scene_.set_material(id, material); });
 }
 
@@ -66,18 +66,9 @@ void PyScene::set_texture(int64_t id, py::handle pixels, bool srgb) {
   write([&] { scene_.set_texture(id, std::move(t)); });
 }
 
-uint32_t PyScene::add_point_light(py::handle position, float power, py::handle color, float radius, bool visible_camera,
-                                  bool visible_specular) {
-  const PointLight l = PointLight::make(to_vec3(position, "position"), power, to_vec3(color, "color"), radius);
-  return write([&] { return scene_.add_light(l, {visible_camera, visible_specular}); });
-}
-
-uint32_t PyScene::add_area_light(py::handle matrix, const std::string& shape, float size, py::handle size_y,
-                                 float power, py::handle color, bool visible_camera, bool visible_specular) {
-  const float sy = size_y.is_none() ? size : size_y.cast<float>();
-  const AreaLight l =
-      AreaLight::make(parse_area_shape(shape), size, sy, to_matrix(matrix, "matrix"), power, to_vec3(color, "color"));
-  return write([&] { return scene_.add_light(l, {visible_camera, visible_specular}); });
+uint32_t PyScene::add_light(const std::string& type, const Params& params, LightVisibility visibility) {
+  const Light light = make_light(type, params);
+  return write([&] { return scene_.add_light(light, visibility); });
 }
 
 void PyScene::clear_lights() {

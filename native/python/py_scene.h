@@ -28,14 +28,13 @@ class PyScene {
   void set_instance_transform(int64_t instance, py::handle transform);
   void clear_instances();
 
-  uint32_t add_material(const std::string& kind, py::handle color, int64_t texture, float ior);
-  void set_material(int64_t material, const std::string& kind, py::handle color, int64_t texture, float ior);
+  // Generic over the types: the core makes the material or light from its name and parameters
+  // (make_material, make_light), so a new type needs no method here.
+  uint32_t add_material(const std::string& kind, const Params& params);
+  void set_material(int64_t material, const std::string& kind, const Params& params);
   uint32_t add_texture(py::handle pixels, bool srgb);
   void set_texture(int64_t texture, py::handle pixels, bool srgb);
-  uint32_t add_point_light(py::handle position, float power, py::handle color, float radius, bool visible_camera,
-                           bool visible_specular);
-  uint32_t add_area_light(py::handle matrix, const std::string& shape, float size, py::handle size_y, float power,
-                          py::handle color, bool visible_camera, bool visible_specular);
+  uint32_t add_light(const std::string& type, const Params& params, LightVisibility visibility);
   void clear_lights();
   void set_background(py::handle color);
   py::tuple background();

@@ -1,6 +1,5 @@
 #include "render/integrator.h"
 
-#include "core/overloaded.h"
 #include "geometry/offset_ray.h"
 #include "lights/light_selector.h"
 #include "sampling/frame.h"
@@ -134,43 +133,31 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     const Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;
     const Material& m =
         s.material >= 0 && size_t(s.material) < materials.size() ? materials[size_t(s.material)] : kDefault;
-    // One dispatch per hit, one case per material type: a type added to Material without its
-    // case here does not compile. Each case either ends the path (returns false) or sets the
-    // next ray of the chain (returns true).
+    // One generic dispatch per hit, no per-type code: the lambda is instantiated per material
+    // type, so for an inline scatter() (Lambert's) the compiler sees the answer's kind as a
+    // constant and keeps only the diffuse path, as fast as a hand-written case. It returns
+    // whether the path goes on along `ray`.
+    const MaterialContext ctx{
+        &scene.textures(), depth < settings.split_depth, pixel, sample, vertex_dimension(depth, 0), settings.seed};
     const bool go_on = std::visit(
-        Overloaded{
-            [&](const Lambert& lambert) {
-              const Vec3 f = lambert_f(lambert_albedo(lambert, scene.textures(), s.uv));
-              radiance += throughput * direct_lighting(scene, s, ng, ns, f, depth, pixel, sample, settings);
-              return false;
-            },
-            [&](const PerfectRefraction& refraction) {
-              if (depth >= settings.max_specular_depth) return false;
-              const SpecularSample next = toyrt::sample(refraction, wo, s.ng, s.ns);
-              ray = Ray{offset_ray_origin(s.p, next.offset_normal), 0.0f, next.wi, kInfinity};
-              return true;
-            },
-            [&](const FresnelDielectric& glass) {
-              if (depth >= settings.max_specular_depth) return false;
-              if (depth < settings.split_depth) {
-                // Splitting: both branches, each weighted by its Fresnel term, instead of choosing
-                // one with that probability. A light seen in a reflection with F = 0.04 is
-                // otherwise an all-or-nothing sample in 4 % of the paths, the largest variance in
-                // a glass scene (docs/render.md).
-                SpecularSample branches[2];
-                const int n = split(glass, wo, s.ng, s.ns, branches);
-                for (int b = 0; b < n; ++b) {
-                  const Ray branch{offset_ray_origin(s.p, branches[b].offset_normal), 0.0f, branches[b].wi, kInfinity};
-                  radiance += throughput * branches[b].probability *
-                              trace_from(scene, branch, depth + 1, pixel, sample, settings);
-                }
-                return false;
-              }
-              const float u = sobol_owen_1d(pixel, sample, vertex_dimension(depth, 0), settings.seed);
-              const SpecularSample next = toyrt::sample(glass, wo, s.ng, s.ns, u);
-              ray = Ray{offset_ray_origin(s.p, next.offset_normal), 0.0f, next.wi, kInfinity};
-              return true;
-            }},
+        [&](const auto& material) {
+          const Scatter sc = scatter(material, ShadingPoint{wo, s.ng, s.ns, s.uv}, ctx);
+          if (sc.kind == Scatter::Kind::Diffuse) {
+            radiance += throughput * direct_lighting(scene, s, ng, ns, sc.f, depth, pixel, sample, settings);
+            return false;
+          }
+          if (depth >= settings.max_specular_depth) return false;
+          if (sc.kind == Scatter::Kind::Split) {
+            for (int b = 0; b < sc.count; ++b) {
+              const SpecularSample& branch = sc.branches[b];
+              const Ray next{offset_ray_origin(s.p, branch.offset_normal), 0.0f, branch.wi, kInfinity};
+              radiance += throughput * branch.probability * trace_from(scene, next, depth + 1, pixel, sample, settings);
+            }
+            return false;
+          }
+          ray = Ray{offset_ray_origin(s.p, sc.branches[0].offset_normal), 0.0f, sc.branches[0].wi, kInfinity};
+          return true;
+        },
         m);
     if (!go_on) break;
   }

@@ -198,10 +198,8 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
   instances_.shrink_to_fit();  // many instances are added one by one: drop the growth slack
   committed_ = false;          // until this commit completes (it may be cancelled)
   BuildConfig config;
-  config.sah = options.sah;
+  static_cast<BuilderSettings&>(config) = options;  // every builder's settings, whatever builders there are
   config.sah.cancel = cancel;
-  config.lbvh = options.lbvh;
-  config.cost_model = options.cost_model;
   config.expected_rays = options.expected_rays.value_or(-1.0);
   auto check_cancel = [&] {
     if (cancel && cancel->load(std::memory_order_relaxed)) throw BuildCancelled();

@@ -27,15 +27,13 @@
 
 namespace toyrt {
 
-struct CommitOptions {
+// The builders' own settings (sah, lbvh, cost_model) come from BuilderSettings (accel/builder.h).
+struct CommitOptions : BuilderSettings {
   BuilderKind builder = BuilderKind::Auto;
   int threads = 0;  // 0: all cores
   // Rays the caller expects to trace (pixels x samples x rays per sample), for "auto"; unset:
   // unknown, and "auto" keeps the SAH builder. Must be finite and >= 0 when set.
   std::optional<double> expected_rays;
-  BinnedSahConfig sah;
-  LbvhConfig lbvh;
-  BuilderCostModel cost_model;
 };
 
 struct CommitStats {

@@ -328,8 +328,14 @@ void fuzz_render(FuzzedDataProvider& in) {
   for (int m = in.ConsumeIntegralInRange<int>(0, 4); m > 0; --m) {
     static const char* kinds[] = {"diffuse", "refraction", "glass", "metal"};
     try {
-      scene.add_material(make_material(kinds[in.ConsumeIntegralInRange<int>(0, 3)], fuzz_vec3(in),
-                                       in.ConsumeIntegralInRange<int64_t>(-2, 1), fuzz_float(in)));
+      // The binding's parameters: color, texture and ior for every kind (allowed unread), consumed
+      // in the order clang evaluated the former make_material(kind, color, texture, ior) call.
+      const char* kind = kinds[in.ConsumeIntegralInRange<int>(0, 3)];
+      Params params;
+      params.set("color", fuzz_vec3(in)).set("texture", double(in.ConsumeIntegralInRange<int64_t>(-2, 1)));
+      params.set("ior", double(fuzz_float(in)));
+      for (const char* shared : {"color", "texture", "ior"}) params.allow_unread(shared);
+      scene.add_material(make_material(kind, params));
     } catch (const std::invalid_argument&) {
     }
   }

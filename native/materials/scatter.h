@@ -1,0 +1,75 @@
+// The one interaction a material offers the integrator, with one signature for every type:
+//     Scatter scatter(const X&, const ShadingPoint&, const MaterialContext&);
+// The answer is either "diffuse with BRDF value f" (the integrator samples the lights there and
+// ends the path: direct lighting, as Cycles with max bounces 0) or up to two specular branches,
+// which the path follows. The integrator has no per-type code: it visits the Material variant
+// with a generic lambda, so a type without scatter() fails to compile.
+#pragma once
+
+#include "core/math.h"
+#include "materials/texture.h"
+#include "sampling/sobol_owen.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace toyrt {
+
+// The hit as a material sees it. Normals come as stored (either side of the surface): each
+// material orients them (refraction.h says how the sides decide entering and leaving).
+struct ShadingPoint {
+  Vec3 wo{0.0f};  // unit, back along the incoming ray
+  Vec3 ng{0.0f};  // unit geometric normal
+  Vec3 ns{0.0f};  // unit shading (smooth) normal
+  Vec2 uv{0.0f};
+};
+
+// What a material may read besides the hit: the scene's textures and the render's choices.
+struct MaterialContext {
+  const std::vector<Texture>* textures = nullptr;
+  // Split a random choice (reflect or refract) into all its branches, each weighted by its
+  // probability, instead of drawing one (IntegratorSettings::split_depth).
+  bool split = false;
+  // The one uniform number a material may draw at this vertex: a Sobol-Owen dimension fixed per
+  // path vertex, computed only when asked for, so a diffuse hit pays for none.
+  uint32_t pixel = 0, sample = 0, dimension = 0, seed = 0;
+  float uniform() const { return sobol_owen_1d(pixel, sample, dimension, seed); }
+};
+
+struct SpecularSample {
+  Vec3 wi{0.0f};           // unit direction leaving the surface
+  bool reflected = false;  // mirror direction (always, under total internal reflection)
+  bool total_internal_reflection = false;
+  bool entering = false;     // wo was on the geometric normal's side
+  float probability = 1.0f;  // of this branch: 1, or F / 1 - F for FresnelDielectric; f / pdf is 1
+                             // (times the material's colour) in every case
+  // The geometric normal on the side wi leaves into: offset_ray_origin(p, offset_normal).
+  Vec3 offset_normal{0.0f};
+};
+
+struct Scatter {
+  enum class Kind : uint8_t {
+    Diffuse,   // direct lighting with BRDF value f, then the path ends
+    Specular,  // the path continues along branches[0] with weight 1 (f / pdf = 1)
+    Split,     // each of the `count` branches is traced on its own, weighted by its probability
+  };
+  Kind kind = Kind::Diffuse;
+  Vec3 f{0.0f};  // Diffuse: for directions on wo's side of the surface
+  int count = 0;
+  SpecularSample branches[2];
+
+  static Scatter diffuse(const Vec3& f) {
+    Scatter s;
+    s.f = f;
+    return s;
+  }
+  static Scatter specular(const SpecularSample& branch) {
+    Scatter s;
+    s.kind = Kind::Specular;
+    s.count = 1;
+    s.branches[0] = branch;
+    return s;
+  }
+};
+
+}  // namespace toyrt
