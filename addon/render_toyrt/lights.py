@@ -1,9 +1,9 @@
 """Blender light objects -> light specs: plain data, one dataclass per light type the core has.
 
-Each spec names the toyrt.Scene method that takes it (`scene_method`) and gives that method's
-keyword arguments (`arguments()`), so sync.py sends any spec the same way and compares the specs
-with those it sent (lights are re-sent only when they changed). A new light type touches this
-file and the core only.
+Each spec names its core light type (`light_type`, Blender's light.type) and gives that type's
+parameters (`arguments()`), so sync.py sends any spec the same way, `Scene.add_light(type,
+**arguments)`, and compares the specs with those it sent (lights are re-sent only when they
+changed). A new light type touches this file and the core only (docs/architecture.md).
 
 Units across Blender versions: the core's area light has Blender 3.x's radiance P / (4 area)
 (docs/render.md); light_power converts 4.x's watts, exposure and unnormalized area lights."""
@@ -21,7 +21,7 @@ Vec3 = tuple[float, float, float]
 
 @dataclass(frozen=True)
 class PointLightSpec:
-    scene_method: ClassVar[str] = "add_point_light"
+    light_type: ClassVar[str] = "POINT"
     position: Vec3
     power: float                        # watts
     color: Vec3
@@ -36,7 +36,7 @@ class PointLightSpec:
 
 @dataclass(frozen=True)
 class AreaLightSpec:
-    scene_method: ClassVar[str] = "add_area_light"
+    light_type: ClassVar[str] = "AREA"
     matrix: tuple[tuple[float, ...], ...]   # the light object's (4, 4) world matrix, rows
     shape: str                              # 'SQUARE', 'RECTANGLE', 'DISK', 'ELLIPSE'
     size: float

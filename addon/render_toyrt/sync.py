@@ -357,7 +357,7 @@ class SceneSync(MaterialSync):
             return
         self.scene.clear_lights()
         for spec in specs:
-            getattr(self.scene, spec.scene_method)(**spec.arguments())
+            self.scene.add_light(spec.light_type, **spec.arguments())
         self.lights = specs
         self.counters["light_sends"] += 1
 
