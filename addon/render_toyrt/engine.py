@@ -70,6 +70,10 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         except sync.ExportCancelled:
             sync.discard_render_cache(depsgraph)  # half updated: the next F12 starts afresh
             return
+        except Exception:
+            # Any other failure mid-walk leaves it half updated too (meshes neither kept nor freed).
+            sync.discard_render_cache(depsgraph)
+            raise
         t_scene, stats = cache.scene, cache.stats
         if cache.approximated:
             self.report({"WARNING"}, "TOYRT approximated: " + "; ".join(cache.approximated))

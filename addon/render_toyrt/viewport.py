@@ -81,7 +81,7 @@ class ViewportSession:
         self.samples_done = 0       # of the current view, read by tests and the status text
         self.passes = 0
         self.restarts = 0
-        self.error = None
+        self.error = None           # why the last render thread stopped early, shown in the view's header
         self.first_pass_ms = None   # time from a restart to its first image (the coarse pass)
         _sessions.add(self)
 
@@ -114,6 +114,8 @@ class ViewportSession:
         key = _view_key(camera)
         if self._stale or key != self._view:
             self._restart(camera, key)
+        if self.error is not None:
+            engine.update_stats("", f"TOYRT: {self.error}")  # the viewport's header text, as Cycles' status
         latest = self._latest
         if latest is None:
             return
@@ -150,6 +152,7 @@ class ViewportSession:
         import time
 
         self._stop_thread()
+        self.error = None
         self._stale = False
         self._view = key
         self.samples_done = 0
@@ -195,7 +198,7 @@ class ViewportSession:
                 self.passes += 1
                 self._publish(version, total / done, done)
                 count = min(count * 2, MAX_PASS_SAMPLES)
-        except Exception as err:  # shown by the engine; the thread ends either way
+        except Exception as err:  # shown by draw() in the view's header; the thread ends either way
             self.error = str(err)
             print(f"TOYRT: viewport render failed: {err}", flush=True)
 

@@ -141,7 +141,7 @@ void Params::allow_unread(std::string_view name) {
 void Params::check_all_read() const {
   read_.resize(values_.size(), false);
   for (size_t i = 0; i < values_.size(); ++i)
-    if (!read_[i]) throw std::invalid_argument("unknown argument '" + values_[i].first + "' for a " + subject_);
+    if (!read_[i]) throw UnknownArgument("unknown argument '" + values_[i].first + "' for a " + subject_);
 }
 
 }  // namespace toyrt

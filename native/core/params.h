@@ -9,6 +9,7 @@
 
 #include "core/math.h"
 
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -16,6 +17,12 @@
 #include <vector>
 
 namespace toyrt {
+
+// An argument no getter asked for (a typo, or a parameter of another type). Python raises
+// TypeError for an unexpected keyword; the binding translates this one the same way.
+struct UnknownArgument : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
 
 class Params {
  public:

@@ -37,7 +37,5 @@ inline float light_importance(const Light& light, const Vec3& p, const Vec3& n) 
 inline Light make_light(std::string_view type, const Params& params) {
   return make_from_params<Light>(type, params, "light");
 }
-// "'POINT' or 'AREA'".
-inline std::string light_type_names() { return type_names<Light>(); }
 
 }  // namespace toyrt

@@ -142,9 +142,14 @@ MeshShading to_shading(size_t vertex_count, const std::vector<Triangle>& tris, p
       vec.resize(3 * m);
       float* out = reinterpret_cast<float*>(vec.data());
       for (size_t t = 0; t < m; ++t)
-        for (int c = 0; c < 3; ++c)
+        for (int c = 0; c < 3; ++c) {
+          // Checked here, before the read: the Mesh that refuses such an index is built later.
+          if (tris[t][c] >= vertex_count)
+            throw py::value_error("triangle " + std::to_string(t) + " indexes a vertex out of range (" +
+                                  std::to_string(vertex_count) + " vertices)");
           std::memcpy(out + (3 * t + size_t(c)) * size_t(k), a.data() + size_t(tris[t][c]) * size_t(k),
                       size_t(k) * sizeof(float));
+        }
     } else {
       throw py::value_error(std::string(name) + " must have shape (" + std::to_string(m) + ", 3, " + std::to_string(k) +
                             ") per corner or (" + std::to_string(vertex_count) + ", " + std::to_string(k) +

@@ -1,6 +1,7 @@
 // The Python module `toyrt`: the definitions (classes, functions, argument names, defaults and
 // docstrings). Converters live in python/convert.*, the scene wrapper in python/py_scene.*, the
 // policy in the core. Argument defaults are read from the core's structs, never written here.
+#include "core/params.h"
 #include "geometry/offset_ray.h"
 #include "python/convert.h"
 #include "python/py_scene.h"
@@ -77,7 +78,9 @@ PYBIND11_MODULE(toyrt, m) {
       if (p) std::rethrow_exception(p);
     } catch (const std::logic_error& e) {
       // std::invalid_argument is bad input; other logic errors are calls in the wrong order.
-      if (dynamic_cast<const std::invalid_argument*>(&e))
+      if (dynamic_cast<const UnknownArgument*>(&e))
+        PyErr_SetString(PyExc_TypeError, e.what());  // as Python's own unexpected-keyword error
+      else if (dynamic_cast<const std::invalid_argument*>(&e))
         PyErr_SetString(PyExc_ValueError, e.what());
       else
         PyErr_SetString(PyExc_RuntimeError, e.what());

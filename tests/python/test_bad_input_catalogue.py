@@ -76,6 +76,14 @@ def test_index_past_the_last_vertex_is_refused():
     refused(lambda: toyrt.Scene().add_mesh(TRI_V, [[0, 1, 3]]), ValueError, "triangle 0 indexes a vertex out of range")
 
 
+def test_index_past_the_last_vertex_is_refused_before_per_vertex_shading_reads_it():
+    # Per-vertex normals and UVs are gathered per corner through the triangle indices: an index
+    # past the vertices must be refused before that read (it read far past the buffer).
+    for kw in (dict(normals=np.zeros((3, 3))), dict(uvs=np.zeros((3, 2)))):
+        refused(lambda: toyrt.Scene().add_mesh(TRI_V, [[0, 1, 4_000_000_000]], **kw), ValueError,
+                "triangle 0 indexes a vertex out of range (3 vertices)")
+
+
 def test_negative_index_is_refused():
     refused(lambda: toyrt.Scene().add_mesh(TRI_V, np.array([[0, 1, 2], [0, -2, 1]])), ValueError,
             "triangle 1 has a negative vertex index")
