@@ -117,7 +117,8 @@ PYBIND11_MODULE(toyrt, m) {
   static const std::string light_doc =
       "Adds a light of Blender type `type` with its parameters as keywords; returns its id. Types:\n" +
       type_docs<Light>() +
-      "visible_camera / visible_specular: whether camera rays / rays through glass see the light itself.\n"
+      "visible_camera / visible_specular: whether camera rays / rays through glass see the light itself;\n"
+      "visible_diffuse: whether it lights diffuse surfaces; cast_shadow: whether surfaces shadow it.\n"
       "An unknown type or keyword raises ValueError naming it; None leaves a parameter at its default.";
   static const std::string material_doc =
       "Adds a material; returns its id. kind and its parameters (other keywords than color, texture and ior\n"
@@ -150,12 +151,15 @@ PYBIND11_MODULE(toyrt, m) {
            "the bottom (Blender's Image.pixels order); srgb: decode from sRGB to linear, as Blender does.")
       .def(
           "add_light",
-          [](PyScene& self, const std::string& type, bool visible_camera, bool visible_specular,
-             const py::kwargs& params) {
-            return self.add_light(type, to_params(params), {visible_camera, visible_specular});
+          [](PyScene& self, const std::string& type, bool visible_camera, bool visible_specular, bool visible_diffuse,
+             bool cast_shadow, const py::kwargs& params) {
+            return self.add_light(type, to_params(params),
+                                  {visible_camera, visible_specular, visible_diffuse, cast_shadow});
           },
           py::arg("type"), py::arg("visible_camera") = LightVisibility{}.camera,
-          py::arg("visible_specular") = LightVisibility{}.specular, light_doc.c_str())
+          py::arg("visible_specular") = LightVisibility{}.specular,
+          py::arg("visible_diffuse") = LightVisibility{}.diffuse, py::arg("cast_shadow") = LightVisibility{}.shadow,
+          light_doc.c_str())
       .def(
           "add_point_light",
           [](PyScene& self, py::handle position, float power, py::handle color, float radius, bool visible_camera,

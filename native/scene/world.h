@@ -8,12 +8,16 @@
 
 namespace toyrt {
 
-// Per light: whether camera rays, and rays continuing through refraction or reflection, see the
-// light itself (Blender's ray visibility of the light object; Cycles shows lights to both by
-// default). Point lights of radius 0 can never be seen.
+// Per light, Blender's settings of the light object (all on by default, as in Cycles): whether
+// camera rays, and rays continuing through refraction or reflection, see the light itself (point
+// and spot lights of radius 0 and suns of angle 0 can never be seen); whether it lights diffuse
+// surfaces at all (the object's diffuse ray visibility); whether surfaces between it and a
+// point shadow it (Cycles 3.x light.cycles.cast_shadow, 4.x+ light.use_shadow).
 struct LightVisibility {
   bool camera = true;
   bool specular = true;
+  bool diffuse = true;
+  bool shadow = true;
 };
 
 struct World {
