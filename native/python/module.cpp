@@ -197,6 +197,14 @@ PYBIND11_MODULE(toyrt, m) {
           "The same as add_light('AREA', ...).")
       .def_property("background", &PyScene::background, &PyScene::set_background,
                     "Radiance (linear RGB) of rays that leave the scene: the world colour.")
+      .def("set_environment", &PyScene::set_environment, py::arg("texture"), py::arg("strength") = as_tuple(Vec3(1.0f)),
+           py::arg("matrix") = py::none(),
+           "Lights the world with texture `texture` (an equirectangular image added with add_texture), times\n"
+           "strength (linear RGB), as Blender's Environment Texture into a Background node: seen by rays that leave\n"
+           "the scene (instead of `background`) and lighting diffuse surfaces (importance-sampled by the image's\n"
+           "luminance, combined with cosine sampling). matrix: None, or a (3, 3) (or (4, 4): its rotation and scale)\n"
+           "row-major matrix taking world directions into the map's frame (the Mapping node's rotation). The image's\n"
+           "centre column looks along -X, its top row up (+Z). texture=-1 removes the environment.")
       .def_property("background_lighting", &PyScene::background_lighting, &PyScene::set_background_lighting,
                     "Whether the background also lights diffuse surfaces, as Cycles' world does (default True).")
       .def("render", &PyScene::render, py::arg("camera"), py::arg("samples") = RenderSettings{}.samples,

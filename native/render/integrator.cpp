@@ -73,9 +73,30 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     }
     sum += f * ls.radiance * (cos_s / (ls.pdf * select_probability));
   };
-  // The world as a light: a constant background seen over the hemisphere. A cosine-distributed
-  // direction makes the estimate f L cos / pdf = albedo L when nothing blocks it.
-  if (world.background_lights_surfaces && world.background != Vec3(0.0f)) {
+  // The world as a light. An environment map: one sample from the map's distribution and one
+  // cosine-distributed, combined by the power heuristic, so a bright sun in the map and a
+  // uniform sky are both found with little noise. A constant background: the cosine-distributed
+  // direction alone makes the estimate f L cos / pdf = albedo L when nothing blocks it, exactly.
+  if (world.background_lights_surfaces && world.environment.active()) {
+    const Environment& env = world.environment;
+    const Texture& image = scene.textures()[size_t(env.texture)];
+    const EnvironmentSample es = sample_environment(
+        env, image, sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 2), settings.seed));
+    if (es.pdf > 0.0f) {
+      const float cos_s = glm::dot(ns, es.wi);
+      if (cos_s > 0.0f && glm::dot(ng, es.wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, es.wi, kInfinity})) {
+        const float pc = cos_s * kInvPi;
+        sum += f * es.radiance * (cos_s * es.pdf / (es.pdf * es.pdf + pc * pc));
+      }
+    }
+    const Vec3 local = sample_cosine_hemisphere(
+        sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 1), settings.seed));
+    const Vec3 wi = Frame::from_normal(ns).to_world(local);
+    if (glm::dot(ng, wi) > 0.0f && local.z > 0.0f && !scene.occluded(Ray{origin, 0.0f, wi, kInfinity})) {
+      const float pc = local.z * kInvPi, pe = environment_pdf(env, wi);
+      sum += f * environment_radiance(env, image, wi) * (local.z * pc / (pe * pe + pc * pc));
+    }
+  } else if (world.background_lights_surfaces && world.background != Vec3(0.0f)) {
     const Vec3 local = sample_cosine_hemisphere(
         sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 1), settings.seed));
     const Vec3 wi = Frame::from_normal(ns).to_world(local);
@@ -130,7 +151,11 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
                                               settings.area_sampling);
     }
     if (!hit.found()) {
-      radiance += throughput * world.background;
+      const Environment& env = world.environment;
+      const Vec3 seen = env.active() ? environment_radiance(env, scene.textures()[size_t(env.texture)],
+                                                            glm::normalize(ray.dir))
+                                     : world.background;
+      radiance += throughput * seen;
       break;
     }
     const SurfaceHit s = surface_at(scene, hit);

@@ -1,8 +1,9 @@
 // What lights the scene besides its surfaces: the lights with their ray visibility, and the
-// world (a constant background). Plain data held by Scene; the integrator reads it.
+// world (a constant background, or an environment map). Plain data held by Scene; the integrator reads it.
 #pragma once
 
 #include "lights/light.h"
+#include "scene/environment.h"
 
 #include <vector>
 
@@ -24,6 +25,7 @@ struct World {
   std::vector<Light> lights;
   std::vector<LightVisibility> light_visibility;  // parallel to lights
   Vec3 background{0.0f};  // radiance of rays that leave the scene (the world colour), linear RGB
+  Environment environment;  // when active, the radiance of rays that leave the scene instead
   // Whether the background also lights diffuse surfaces (Cycles samples the world as a light;
   // Blender's world ray visibility for diffuse rays turns it off).
   bool background_lights_surfaces = true;
