@@ -152,9 +152,9 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     }
     if (!hit.found()) {
       const Environment& env = world.environment;
-      const Vec3 seen = env.active() ? environment_radiance(env, scene.textures()[size_t(env.texture)],
-                                                            glm::normalize(ray.dir))
-                                     : world.background;
+      const Vec3 seen = env.active()
+                            ? environment_radiance(env, scene.textures()[size_t(env.texture)], glm::normalize(ray.dir))
+                            : world.background;
       radiance += throughput * seen;
       break;
     }

@@ -48,10 +48,11 @@ Distribution2D Distribution2D::build(const std::vector<float>& weights, int widt
   d.width = width;
   d.height = height;
   d.conditional.resize(size_t(height) * size_t(width + 1));
-  std::vector<float> rows(size_t(height));
+  std::vector<float> rows(static_cast<size_t>(height));
   double total = 0.0;
   for (int y = 0; y < height; ++y) {
-    rows[size_t(y)] = float(make_cdf(&weights[size_t(y) * size_t(width)], width, &d.conditional[size_t(y) * (width + 1)]));
+    rows[size_t(y)] =
+        float(make_cdf(&weights[size_t(y) * size_t(width)], width, &d.conditional[size_t(y) * (width + 1)]));
     total += rows[size_t(y)];
   }
   d.marginal.resize(size_t(height) + 1);

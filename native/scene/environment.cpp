@@ -34,8 +34,10 @@ Environment make_environment(int32_t texture, const Texture& image, const Vec3& 
   env.texture = texture;
   env.strength = strength;
   env.to_map = to_map;
-  // The sampling grid: the image averaged onto at most kMaxSamplingWidth columns and half as many
-  // rows (a box filter over the texels each cell covers).
+  // The sampling grid: at most kMaxSamplingWidth columns and half as many rows, each cell
+  // weighted by the brightest texel it covers or borders. The border counts because bilinear
+  // lookups spread a texel into its neighbours' area: a one-texel sun weighted by its own cell
+  // alone would leave its halo to cells sampled as dim sky (fireflies, and slow convergence).
   const int w = std::min(image.width, Environment::kMaxSamplingWidth);
   const int h = std::max(1, std::min(image.height, Environment::kMaxSamplingWidth / 2));
   std::vector<float> weights(size_t(w) * size_t(h), 0.0f);
@@ -45,10 +47,11 @@ Environment make_environment(int32_t texture, const Texture& image, const Vec3& 
     const float sin_theta = std::sin((1.0f - (y + 0.5f) / float(h)) * kPi);
     for (int x = 0; x < w; ++x) {
       const int x0 = int(int64_t(x) * image.width / w), x1 = std::max(x0 + 1, int(int64_t(x + 1) * image.width / w));
-      double sum = 0.0;
-      for (int j = y0; j < y1; ++j)
-        for (int i = x0; i < x1; ++i) sum += std::max(0.0f, luminance(image.texel(i, j)));
-      weights[size_t(y) * w + x] = float(sum / double((y1 - y0) * (x1 - x0))) * sin_theta;
+      float brightest = 0.0f;
+      for (int j = std::max(0, y0 - 1); j <= std::min(image.height - 1, y1); ++j)
+        for (int i = x0 - 1; i <= x1; ++i)  // columns wrap around (the map is periodic in u)
+          brightest = std::max(brightest, luminance(image.texel((i + image.width) % image.width, j)));
+      weights[size_t(y) * w + x] = brightest * sin_theta;
     }
   }
   env.sampling = Distribution2D::build(weights, w, h);

@@ -8,11 +8,10 @@
 // from the bottom (v = 0).
 //
 // Importance sampling: a piecewise-constant density over a grid of at most kMaxSamplingWidth x
-// kMaxSamplingWidth / 2 cells (the image averaged down onto it), weight = mean luminance x
-// sin(theta) of the cell, so bright regions (a sun in the sky) are found by few samples; the
-// density in solid angle is pdf(u, v) / (2 pi^2 sin(theta)). The integrator combines it with
-// cosine sampling by multiple importance sampling, so regions the grid under-weights are still
-// covered.
+// kMaxSamplingWidth / 2 cells, weight = the brightest luminance in and around the cell (bilinear
+// lookups spread each texel over its neighbours) x sin(theta), so bright regions (a sun in the sky) are found by few
+// samples; the density in solid angle is pdf(u, v) / (2 pi^2 sin(theta)). The integrator combines it with cosine
+// sampling by multiple importance sampling, so regions the grid under-weights are still covered.
 #pragma once
 
 #include "materials/texture.h"
@@ -25,10 +24,10 @@ namespace toyrt {
 struct Environment {
   static constexpr int kMaxSamplingWidth = 1024;
 
-  int32_t texture = -1;       // the scene's texture; -1: no environment (a constant background)
-  Vec3 strength{1.0f};        // the Background node's strength (times its colour, if constant)
-  glm::mat3 to_map{1.0f};     // world direction -> the map's frame
-  Distribution2D sampling;    // over the grid described above
+  int32_t texture = -1;     // the scene's texture; -1: no environment (a constant background)
+  Vec3 strength{1.0f};      // the Background node's strength (times its colour, if constant)
+  glm::mat3 to_map{1.0f};   // world direction -> the map's frame
+  Distribution2D sampling;  // over the grid described above
 
   bool active() const { return texture >= 0; }
 };

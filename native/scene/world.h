@@ -24,7 +24,7 @@ struct LightVisibility {
 struct World {
   std::vector<Light> lights;
   std::vector<LightVisibility> light_visibility;  // parallel to lights
-  Vec3 background{0.0f};  // radiance of rays that leave the scene (the world colour), linear RGB
+  Vec3 background{0.0f};    // radiance of rays that leave the scene (the world colour), linear RGB
   Environment environment;  // when active, the radiance of rays that leave the scene instead
   // Whether the background also lights diffuse surfaces (Cycles samples the world as a light;
   // Blender's world ray visibility for diffuse rays turns it off).
