@@ -11,8 +11,8 @@
 namespace toyrt {
 
 struct LightSample {
-  Vec3 point{0.0f};  // the sampled point on the light
-  Vec3 wi{0.0f};     // unit direction from the shading point to `point`
+  Vec3 point{0.0f};       // the sampled point on the light
+  Vec3 wi{0.0f};          // unit direction from the shading point to `point`
   float distance = 0.0f;  // infinite for a light at infinity (a sun): the shadow ray is unbounded
   // Radiance arriving along -wi, W / (m^2 sr) per channel. For a delta light (a point light of
   // radius 0) there is no radiance: this holds its irradiance at normal incidence, I / d^2
