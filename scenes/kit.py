@@ -282,6 +282,28 @@ def camera(location, target=None, rotation=(0, 0, 0), lens=50.0, ortho_scale=Non
     return obj
 
 
+def environment_world(image, strength=1.0, rotation=(0.0, 0.0, 0.0)):
+    """The world as an Environment Texture of `image` (equirectangular) into a Background of
+    `strength`, its directions turned by a Mapping node's `rotation` (Euler XYZ, radians)."""
+    world = bpy.data.worlds.new("environment")
+    world.use_nodes = True
+    nodes, links = world.node_tree.nodes, world.node_tree.links
+    background = nodes.get("Background") or nodes.new("ShaderNodeBackground")
+    background.inputs["Strength"].default_value = strength
+    texture = nodes.new("ShaderNodeTexEnvironment")
+    texture.image = image
+    mapping = nodes.new("ShaderNodeMapping")
+    mapping.inputs["Rotation"].default_value = rotation
+    coords = nodes.new("ShaderNodeTexCoord")
+    links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+    links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
+    links.new(texture.outputs["Color"], background.inputs["Color"])
+    output = nodes.get("World Output") or nodes.new("ShaderNodeOutputWorld")
+    links.new(background.outputs["Background"], output.inputs["Surface"])
+    bpy.context.scene.world = world
+    return world
+
+
 def world(color, lights_diffuse=True):
     """A constant background of linear RGB `color`, or none (black, lighting nothing) for None.
     lights_diffuse=False: seen by camera, glossy and transmission rays but lighting no diffuse

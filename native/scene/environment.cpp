@@ -59,8 +59,12 @@ Environment make_environment(int32_t texture, const Texture& image, const Vec3& 
 }
 
 Vec3 environment_radiance(const Environment& env, const Texture& image, const Vec3& wi) {
-  const Vec3 d = env.to_map * wi;
-  return Vec3(image.lookup(direction_to_uv(glm::normalize(d)))) * env.strength;
+  Vec2 uv = direction_to_uv(glm::normalize(env.to_map * wi));
+  // Columns wrap around; rows must not: the texture's repeat would blend the top row with the
+  // bottom one over the poles. Clamped to the outer rows' centres, as Cycles' lookup extends them.
+  const float half_row = 0.5f / float(image.height);
+  uv.y = std::clamp(uv.y, half_row, 1.0f - half_row);
+  return Vec3(image.lookup(uv)) * env.strength;
 }
 
 EnvironmentSample sample_environment(const Environment& env, const Texture& image, const Vec2& u) {

@@ -138,6 +138,32 @@ def scene_near_point(p):
     kit.world((0, 0, 0))
 
 
+def sky_image(width, height, sun_elevation, sun_azimuth, sun_radiance):
+    """An equirectangular float sky (rows from the bottom): a bluish gradient above the horizon, a
+    dim brown ground below, and a small bright sun (a Gaussian a few texels wide)."""
+    v = (np.arange(height) + 0.5) / height
+    u = (np.arange(width) + 0.5) / width
+    elevation = (v - 0.5) * np.pi
+    azimuth = (0.5 - u) * 2 * np.pi
+    el, az = np.meshgrid(elevation, azimuth, indexing="ij")
+    up = np.clip(np.sin(el), 0, 1)[..., None]
+    sky = np.where(el[..., None] > 0, (0.25 + 0.5 * up) * np.array([0.45, 0.6, 1.0]), np.array([0.12, 0.09, 0.06]))
+    d = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], -1)
+    s = np.array([np.cos(sun_elevation) * np.cos(sun_azimuth), np.cos(sun_elevation) * np.sin(sun_azimuth),
+                  np.sin(sun_elevation)])
+    angle = np.arccos(np.clip(d @ s, -1, 1))
+    sky = sky + sun_radiance * np.exp(-0.5 * (angle / np.radians(2.0)) ** 2)[..., None] * np.array([1.0, 0.9, 0.75])
+    rgba = np.concatenate([sky, np.ones((height, width, 1))], axis=2).astype(np.float32)
+    return kit.image("sky", rgba, float_buffer=True)
+
+
+def scene_hdri(p):
+    kit.plane("floor", 8.0, kit.diffuse("white", (0.8, 0.8, 0.8)))
+    kit.box("occluder", 0.8, (0.0, 0.0, 0.4), kit.diffuse("red", (0.7, 0.2, 0.1)))
+    kit.environment_world(sky_image(128, 64, *p["sun"]), p["strength"], p["rotation"])
+    camera(p["camera"], (0, 0, 0.3))
+
+
 # A real file: five 1 m point lights of 100 W a metre above a torus, from Debian's assimp-testmodels
 # (Blender 2.50; the Makefile installs it). Its own camera, lights and grey world.
 TORUS_FILE = Path("/usr/share/assimp/models/BLEND/TorusLightsCams_250_compressed.blend")
@@ -184,6 +210,10 @@ SCENES_SPEC = [
                                                        soft_falloff=True, camera=(0.0, -6.0, 4.5)), 0),
     ("point_near_sphere", scene_near_point, dict(light=(0.0, 0.0, 1.2), power=150.0, radius=1.0,
                                                  soft_falloff=False, camera=(0.0, -6.0, 4.5)), 0),
+    # An HDRI world with a small bright sun, turned by a Mapping node; seen by the camera above the
+    # horizon and lighting the floor and the box.
+    ("hdri_sky", scene_hdri, dict(sun=(0.6, 0.8, 60.0), strength=1.5, rotation=(0.0, 0.0, 0.7),
+                                  camera=(0.0, -6.0, 2.0)), 0),
     # Cycles 4.x/5.x renders this file's torus 2.6 % darker than 3.4 does, with no difference on
     # simpler scenes with the same lights (docs/parity-blender-5.0.md): measured and reported
     # there, asserted on 3.4 only until the cause is found.
@@ -400,6 +430,8 @@ if __name__ == "__main__":
         traceback.print_exc()
         print("parity: 0 passed, 1 failed (error)", flush=True)
         sys.exit(1)
-    print(f"parity: {len(results) - len(failures)} passed, {len(failures)} failed"
-          + (f" ({', '.join(failures)})" if failures else ""), flush=True)
+    gaps = [r["name"] for r in results if not r["ok"] and not r["asserted"]]
+    print(f"parity: {sum(r['ok'] for r in results)} passed, {len(failures)} failed"
+          + (f" ({', '.join(failures)})" if failures else "")
+          + (f"; reported, not asserted: {', '.join(gaps)}" if gaps else ""), flush=True)
     sys.exit(1 if failures else 0)
