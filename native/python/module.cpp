@@ -123,7 +123,11 @@ PYBIND11_MODULE(toyrt, m) {
   static const std::string material_doc =
       "Adds a material; returns its id. kind and its parameters (other keywords than color, texture and ior\n"
       "must be ones the kind reads):\n" +
-      type_docs<Material>() + "color, texture and ior are accepted by every kind; kinds without them ignore them.";
+      type_docs<Material>() +
+      "color, texture and ior are accepted by every kind; kinds without them ignore them. Every kind also\n"
+      "emits: emission (linear RGB radiance, Blender's colour x strength, both sides; (0, 0, 0): none) and\n"
+      "emission_sampling ('AUTO', 'FRONT_AND_BACK', 'FRONT', 'BACK': sampled as a light towards those sides;\n"
+      "'NONE': only seen by rays that hit it).";
 
   py::class_<PyScene>(m, "Scene", "A two-level scene: meshes stored once, placed by instances.")
       .def(py::init<>())

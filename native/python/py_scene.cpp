@@ -46,14 +46,39 @@ void PyScene::clear_instances() {
   write([&] { scene_.clear_instances(); });
 }
 
+namespace {
+
+// The emission every material kind accepts (materials/emission.h), read before the kind reads
+// its own parameters: emission (linear RGB radiance, colour x strength) and emission_sampling
+// (Blender 4.x's names: 'NONE', 'AUTO', 'FRONT', 'BACK', 'FRONT_AND_BACK'; AUTO samples both).
+MaterialEmission emission_of(const Params& params) {
+  MaterialEmission e;
+  e.radiance = params.color("emission", e.radiance);
+  const std::string sampling = params.text("emission_sampling", "AUTO");
+  if (sampling == "NONE")
+    e.sampled = false;
+  else if (sampling == "FRONT")
+    e.sides = EmitterSides::Front;
+  else if (sampling == "BACK")
+    e.sides = EmitterSides::Back;
+  else if (sampling != "AUTO" && sampling != "FRONT_AND_BACK")
+    throw std::invalid_argument("emission_sampling must be 'NONE', 'AUTO', 'FRONT', 'BACK' or 'FRONT_AND_BACK', got '" +
+                                sampling + "'");
+  return e;
+}
+
+}  // namespace
+
 uint32_t PyScene::add_material(const std::string& kind, const Params& params) {
+  const MaterialEmission emission = emission_of(params);
   const Material material = make_material(kind, params);
-  return write([&] { return scene_.add_material(material); });
+  return write([&] { return scene_.add_material(material, emission); });
 }
 
 void PyScene::set_material(int64_t id, const std::string& kind, const Params& params) {
+  const MaterialEmission emission = emission_of(params);
   const Material material = make_material(kind, params);
-  write([&] { scene_.set_material(id, material); });
+  write([&] { scene_.set_material(id, material, emission); });
 }
 
 uint32_t PyScene::add_texture(py::handle pixels, bool srgb) {

@@ -103,6 +103,17 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     if (glm::dot(ng, wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, wi, kInfinity}))
       sum += f * world.background * kPi;  // f = albedo / pi
   }
+  // Emissive triangles: one sample from their power distribution, whatever their number.
+  if (!scene.emitters().empty()) {
+    const LightSample ls =
+        sample_emitters(scene.emitters(), s.p,
+                        sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 3), settings.seed));
+    if (ls.valid()) {
+      const float cos_s = glm::dot(ns, ls.wi);
+      if (cos_s > 0.0f && glm::dot(ng, ls.wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, ls.point - origin, 1.0f}))
+        sum += f * ls.radiance * (cos_s / ls.pdf);
+    }
+  }
   const std::vector<Light>& lights = world.lights;
   if (settings.light_sampling != LightSampling::One || lights.size() == 1) {
     for (size_t j = 0; j < lights.size(); ++j) add(j, 1.0f, 1 + uint32_t(j));
@@ -166,6 +177,10 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     const Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;
     const Material& m =
         s.material >= 0 && size_t(s.material) < materials.size() ? materials[size_t(s.material)] : kDefault;
+    // A camera or specular ray sees an emitting surface's radiance (both sides, as Cycles' mesh
+    // lights); its BSDF (black for a pure Emission shader) still scatters below.
+    if (scene.any_emission() && s.material >= 0 && size_t(s.material) < materials.size())
+      radiance += throughput * scene.emission()[size_t(s.material)].radiance;
     // One generic dispatch per hit, no per-type code: the lambda is instantiated per material
     // type, so for an inline scatter() (Lambert's) the compiler sees the answer's kind as a
     // constant and keeps only the diffuse path, as fast as a hand-written case. It returns

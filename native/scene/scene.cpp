@@ -1,5 +1,7 @@
 #include "scene/scene.h"
 
+#include <algorithm>
+
 #include "accel/traverse.h"
 #include "core/parallel.h"
 
@@ -97,17 +99,30 @@ void check_texture_id(const Material& m, size_t textures) {
 }
 }  // namespace
 
-uint32_t Scene::add_material(const Material& material) {
+uint32_t Scene::add_material(const Material& material, const MaterialEmission& emission) {
   check_texture_id(material, textures_.size());
+  emission.check();
   materials_.push_back(material);
+  emission_.push_back(emission);
+  if (emission.emits()) {
+    any_emission_ = true;
+    committed_ = false;
+  }
   return uint32_t(materials_.size() - 1);
 }
 
-void Scene::set_material(int64_t material, const Material& replacement) {
+void Scene::set_material(int64_t material, const Material& replacement, const MaterialEmission& emission) {
   if (material < 0 || size_t(material) >= materials_.size())
     throw std::invalid_argument("unknown material id " + std::to_string(material));
   check_texture_id(replacement, textures_.size());
+  emission.check();
   materials_[size_t(material)] = replacement;
+  if (!(emission_[size_t(material)] == emission)) {
+    emission_[size_t(material)] = emission;
+    any_emission_ =
+        std::any_of(emission_.begin(), emission_.end(), [](const MaterialEmission& e) { return e.emits(); });
+    committed_ = false;  // the emissive triangles are gathered again
+  }
 }
 
 uint32_t Scene::add_texture(Texture texture) {
@@ -257,6 +272,7 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
     for (uint32_t& id : top_.prim_ids) id = placed[id];
   });
   single_identity_ = instances_.size() == 1 && instances_[0].identity;
+  gather_emitters();
   committed_ = true;
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }

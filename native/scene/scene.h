@@ -14,6 +14,8 @@
 #include "core/cancel_poll.h"
 #include "core/ray.h"
 #include "geometry/mesh.h"
+#include "lights/mesh_emitters.h"
+#include "materials/emission.h"
 #include "materials/material.h"
 #include "materials/texture.h"
 #include "scene/instance.h"
@@ -92,8 +94,10 @@ class Scene {
   // ---- materials, textures, world. Edits in place, so meshes keep their material ids; they
   // do not touch the geometry (no commit needed).
   // A Lambert texture id must name one of the scene's textures (or be -1).
-  uint32_t add_material(const Material& material);
-  void set_material(int64_t material, const Material& replacement);
+  // `emission`: what the material emits beside its BSDF (materials/emission.h); a change of it
+  // leaves the scene uncommitted, since commit() gathers the emissive triangles.
+  uint32_t add_material(const Material& material, const MaterialEmission& emission = {});
+  void set_material(int64_t material, const Material& replacement, const MaterialEmission& emission = {});
   uint32_t add_texture(Texture texture);
   void set_texture(int64_t texture, Texture replacement);
   uint32_t add_light(const Light& light, LightVisibility visibility = {});
@@ -140,6 +144,9 @@ class Scene {
   const MeshShading& shading(uint32_t mesh) const { return shading_[mesh]; }  // one per mesh, always
   const std::vector<Material>& materials() const { return materials_; }       // empty: all default grey
   const std::vector<Texture>& textures() const { return textures_; }
+  const std::vector<MaterialEmission>& emission() const { return emission_; }  // parallel to materials()
+  bool any_emission() const { return any_emission_; }
+  const MeshEmitters& emitters() const { return emitters_; }  // the sampled emissive triangles, by commit()
   const World& world() const { return world_; }
   // Triangles stored (each mesh counted once) and placed (each instance counting its mesh).
   size_t stored_triangle_count() const;
@@ -152,11 +159,15 @@ class Scene {
   // commit()'s work; throws BuildCancelled when *cancel turns true.
   void build(const CommitOptions& options, const std::atomic<bool>* cancel);
   void check_mesh_id(int64_t mesh) const;
+  void gather_emitters();  // scene_emitters.cpp: emitters_ from the instances and emission_
 
   std::vector<std::unique_ptr<Mesh>> meshes_;
   std::vector<MeshShading> shading_;      // parallel to meshes_
   std::vector<int32_t> max_material_id_;  // parallel to meshes_: MeshShading::check's answer
   std::vector<Material> materials_;
+  std::vector<MaterialEmission> emission_;  // parallel to materials_
+  bool any_emission_ = false;
+  MeshEmitters emitters_;
   std::vector<Texture> textures_;
   World world_;
   std::vector<Instance> instances_;
