@@ -86,11 +86,27 @@ def glass(name, ior=1.5):
     return mat
 
 
-def emission(name, color):
-    """An Emission shader at strength 1 (TOYRT approximates it by a Diffuse BSDF of that colour)."""
+def emission(name, color, strength=1.0, sampling=None):
+    """An Emission shader: a surface of radiance colour x strength on both sides, black itself.
+    sampling: whether Cycles samples it as a light (4.x+ emission_sampling names; 3.x reads
+    'NONE' as sample_as_light off); None leaves Blender's default (sampled)."""
     mat, node = surface(name, "ShaderNodeEmission")
     node.inputs["Color"].default_value = (*color, 1.0)
+    node.inputs["Strength"].default_value = strength
+    if sampling is not None:
+        if hasattr(mat.cycles, "emission_sampling"):
+            mat.cycles.emission_sampling = sampling
+        else:
+            mat.cycles.sample_as_light = sampling != "NONE"
     return mat
+
+
+def input_of(node, *names):
+    """The first of the named input sockets `node` has (Blender renamed some in 4.0)."""
+    for n in names:
+        if n in node.inputs:
+            return node.inputs[n]
+    raise KeyError(f"{node.bl_idname} has none of the inputs {names}")
 
 
 def principled(name, color):

@@ -10,7 +10,7 @@ were renamed are reached by both names (Principled "Transmission" -> "Transmissi
 4.0, "Specular" -> "Specular IOR Level", "Emission" -> "Emission Color")."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -43,10 +43,13 @@ class MaterialSpec:
     color: tuple[float, float, float] = DEFAULT_GREY
     texture: ImageKey | None = None
     ior: float = 1.45
+    emission: tuple[float, float, float] = (0.0, 0.0, 0.0)   # colour x strength, linear radiance
+    emission_sampling: str = "AUTO"                           # Blender 4.x's names (3.x: AUTO or NONE)
 
     def arguments(self, texture_id: int = -1) -> dict:
         """Keyword arguments of toyrt.Scene.add_material / set_material, with the texture's id."""
-        return dict(kind=self.kind, color=self.color, texture=texture_id, ior=self.ior)
+        return dict(kind=self.kind, color=self.color, texture=texture_id, ior=self.ior, emission=self.emission,
+                    emission_sampling=self.emission_sampling)
 
 
 @dataclass(frozen=True)
@@ -62,7 +65,30 @@ def material_spec(mat) -> ConvertedMaterial:
     """A Blender material (None: an empty slot) as the core's material."""
     notes = []
     spec, image = _convert(mat, notes)
+    if any(c > 0.0 for c in spec.emission):
+        spec = replace(spec, emission_sampling=_emission_sampling(mat))
     return ConvertedMaterial(spec, tuple(dict.fromkeys(notes)), image)
+
+
+def _emission_sampling(mat) -> str:
+    """Whether Cycles samples the material's emission as a light, and towards which sides:
+    4.x+ material.cycles.emission_sampling, 3.x material.cycles.sample_as_light."""
+    cycles = getattr(mat, "cycles", None)
+    sampling = getattr(cycles, "emission_sampling", None)
+    if isinstance(sampling, str):
+        return sampling
+    return "AUTO" if getattr(cycles, "sample_as_light", True) else "NONE"
+
+
+def _emission(name, color, strength, notes) -> tuple[float, float, float]:
+    """Colour x strength of an Emission shader's or a Principled BSDF's emission sockets, as
+    constants (a linked socket: its constant value, noted)."""
+    if color is None:
+        return (0.0, 0.0, 0.0)
+    if color.is_linked or (strength is not None and strength.is_linked):
+        notes.append(f"material '{name}': linked emission colour or strength (its constant value)")
+    k = float(strength.default_value) if strength is not None else 1.0
+    return tuple(max(0.0, c * k) for c in rgb(color.default_value))
 
 
 def image_key(image) -> ImageKey:
@@ -205,6 +231,10 @@ def _convert(mat, notes):
         return _color_material(name, input_socket(node, "Color"), notes)
     if t == "BSDF_PRINCIPLED":
         return _principled(name, node, notes)
+    if t == "EMISSION":
+        # Emission alone has no BSDF: a black surface that glows (Cycles).
+        emission = _emission(name, input_socket(node, "Color"), input_socket(node, "Strength"), notes)
+        return MaterialSpec("diffuse", color=(0.0, 0.0, 0.0), emission=emission), None
     if t == "BSDF_REFRACTION":
         _check_sharp(name, node, "Refraction", notes)
         return MaterialSpec("refraction", ior=_ior(name, node, notes)), None
@@ -254,14 +284,12 @@ def _principled(name, node, notes):
     spec = input_socket(node, "Specular IOR Level", "Specular")
     if spec is not None and (spec.is_linked or spec.default_value > 0.0):
         extras.append("specular")
-    emis = input_socket(node, "Emission Color", "Emission")
-    strength = input_socket(node, "Emission Strength")
-    if (emis is not None and (emis.is_linked or any(c > 0 for c in tuple(emis.default_value)[:3]))
-            and (strength is None or strength.is_linked or strength.default_value > 0.0)):
-        extras.append("emission")
+    emission = _emission(name, input_socket(node, "Emission Color", "Emission"),  # 4.0+ / 3.x
+                         input_socket(node, "Emission Strength"), notes)
     if extras:
         notes.append(f"material '{name}': Principled {', '.join(extras)} (Lambert base colour)")
-    return _color_material(name, input_socket(node, "Base Color"), notes)
+    spec, image = _color_material(name, input_socket(node, "Base Color"), notes)
+    return replace(spec, emission=emission), image
 
 
 def _color_material(name, sock, notes):

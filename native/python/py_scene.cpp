@@ -173,6 +173,8 @@ py::dict PyScene::last_commit() {
   d["meshes_built"] = st.meshes_built;
   d["sah_meshes"] = st.sah_meshes;
   d["lbvh_meshes"] = st.lbvh_meshes;
+  d["emissive_triangles"] = st.emissive_triangles;
+  d["emitters_ms"] = st.emitters_ms;
   d["warning"] = st.warning;
   return d;
 }

@@ -49,6 +49,12 @@ SurfaceHit surface_at(const Scene& scene, const Hit& hit) {
   return s;
 }
 
+// The material id of the triangle a hit found (-1: none given).
+int32_t material_of(const Scene& scene, const Hit& hit) {
+  const MeshShading& sh = scene.shading(scene.instance(uint32_t(hit.instance)).mesh);
+  return sh.material_ids.empty() ? 0 : sh.material_ids[size_t(hit.prim)];
+}
+
 // Light arriving at a diffuse point: one sample per light, or one light chosen by contribution.
 Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f, int depth,
                      uint32_t pixel, uint32_t sample, const IntegratorSettings& settings) {
@@ -112,6 +118,27 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
       const float cos_s = glm::dot(ns, ls.wi);
       if (cos_s > 0.0f && glm::dot(ng, ls.wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, ls.point - origin, 1.0f}))
         sum += f * ls.radiance * (cos_s / ls.pdf);
+    }
+  }
+  // Emitters, or sides of them, that shadow rays do not sample (Blender's emission sampling None,
+  // Front, Back) still light diffuse surfaces in Cycles: its last bounce collects the emission
+  // its BSDF-sampled ray finds (with full weight where light sampling has no density). One
+  // cosine ray does the same, counting only what the emitter sampling leaves out, so the two
+  // estimators split the emitters between them; only scenes with such emitters pay for it.
+  if (scene.any_unsampled_emission()) {
+    const Vec3 local = sample_cosine_hemisphere(
+        sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 4), settings.seed));
+    const Vec3 wi = Frame::from_normal(ns).to_world(local);
+    if (glm::dot(ng, wi) > 0.0f && local.z > 0.0f) {
+      const Hit hit = scene.intersect(Ray{origin, 0.0f, wi, kInfinity});
+      const int32_t m = hit.found() ? material_of(scene, hit) : -1;
+      if (m >= 0 && size_t(m) < scene.emission().size()) {
+        const MaterialEmission& e = scene.emission()[size_t(m)];
+        const bool front = glm::dot(surface_at(scene, hit).ng, wi) < 0.0f;
+        const uint8_t side = uint8_t(front ? EmitterSides::Front : EmitterSides::Back);
+        if (e.emits() && (!e.sampled || !(uint8_t(e.sides) & side)))
+          sum += f * e.radiance * kPi;  // f L cos / (cos / pi)
+      }
     }
   }
   const std::vector<Light>& lights = world.lights;

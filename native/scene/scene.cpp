@@ -106,6 +106,7 @@ uint32_t Scene::add_material(const Material& material, const MaterialEmission& e
   emission_.push_back(emission);
   if (emission.emits()) {
     any_emission_ = true;
+    any_unsampled_emission_ = any_unsampled_emission_ || !emission.sampled || emission.sides != EmitterSides::Both;
     committed_ = false;
   }
   return uint32_t(materials_.size() - 1);
@@ -121,6 +122,9 @@ void Scene::set_material(int64_t material, const Material& replacement, const Ma
     emission_[size_t(material)] = emission;
     any_emission_ =
         std::any_of(emission_.begin(), emission_.end(), [](const MaterialEmission& e) { return e.emits(); });
+    any_unsampled_emission_ = std::any_of(emission_.begin(), emission_.end(), [](const MaterialEmission& e) {
+      return e.emits() && (!e.sampled || e.sides != EmitterSides::Both);
+    });
     committed_ = false;  // the emissive triangles are gathered again
   }
 }
@@ -272,7 +276,11 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
     for (uint32_t& id : top_.prim_ids) id = placed[id];
   });
   single_identity_ = instances_.size() == 1 && instances_[0].identity;
+  const auto gather_start = std::chrono::steady_clock::now();
   gather_emitters();
+  stats_.emissive_triangles = emitters_.triangles.size();
+  stats_.emitters_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - gather_start).count();
   committed_ = true;
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }

@@ -43,6 +43,8 @@ struct CommitStats {
   double lbvh_compile_ms = 0.0;  // OpenCL kernel compilation inside it (first LBVH build of the process)
   size_t meshes_built = 0;       // meshes whose BVH the last commit (re)built
   size_t sah_meshes = 0, lbvh_meshes = 0;
+  size_t emissive_triangles = 0;  // sampled as lights (world space, each instance's counted)
+  double emitters_ms = 0.0;       // gathering them, part of build_ms
   // Set when an LBVH build could not run (no OpenCL device, kernel build failure) and the SAH
   // builder stood in: one message per commit.
   std::string warning;
@@ -146,6 +148,8 @@ class Scene {
   const std::vector<Texture>& textures() const { return textures_; }
   const std::vector<MaterialEmission>& emission() const { return emission_; }  // parallel to materials()
   bool any_emission() const { return any_emission_; }
+  // Emitters (or sides of them) that shadow rays do not sample: emission sampling None, Front, Back.
+  bool any_unsampled_emission() const { return any_unsampled_emission_; }
   const MeshEmitters& emitters() const { return emitters_; }  // the sampled emissive triangles, by commit()
   const World& world() const { return world_; }
   // Triangles stored (each mesh counted once) and placed (each instance counting its mesh).
@@ -167,6 +171,7 @@ class Scene {
   std::vector<Material> materials_;
   std::vector<MaterialEmission> emission_;  // parallel to materials_
   bool any_emission_ = false;
+  bool any_unsampled_emission_ = false;
   MeshEmitters emitters_;
   std::vector<Texture> textures_;
   World world_;

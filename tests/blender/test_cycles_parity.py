@@ -138,6 +138,21 @@ def scene_near_point(p):
     kit.world((0, 0, 0))
 
 
+def scene_emitters(p):
+    # An Emission panel above a floor, a box in its light, a glowing sphere (2,208 emissive
+    # triangles), and (with transmission) a glass sphere the panel is seen through.
+    kit.plane("floor", 8.0, kit.diffuse("white", (0.8, 0.8, 0.8)))
+    kit.box("occluder", 0.5, (0.6, 0.3, 0.25), kit.diffuse("grey", (0.5, 0.5, 0.5)))
+    panel = kit.plane("panel", 1.2, kit.emission("glow", (1.0, 0.85, 0.6), p["strength"], p["sampling"]),
+                      (-0.4, 0.6, 1.6))
+    panel.rotation_euler = (0.5, 0.3, 0.0)
+    kit.uv_sphere("glowing_ball", 0.3, (-1.2, -0.6, 0.3), kit.emission("ball_glow", (0.2, 0.5, 1.0), 2.0))
+    if p["glass"]:
+        kit.uv_sphere("ball", 0.5, (0.0, -0.8, 0.5), kit.glass("glass", 1.45))
+    camera(p["camera"], (0, 0, 0.3))
+    kit.world((0, 0, 0))
+
+
 def sky_image(width, height, sun_elevation, sun_azimuth, sun_radiance):
     """An equirectangular float sky (rows from the bottom): a bluish gradient above the horizon, a
     dim brown ground below, and a small bright sun (a Gaussian a few texels wide)."""
@@ -210,6 +225,17 @@ SCENES_SPEC = [
                                                        soft_falloff=True, camera=(0.0, -6.0, 4.5)), 0),
     ("point_near_sphere", scene_near_point, dict(light=(0.0, 0.0, 1.2), power=150.0, radius=1.0,
                                                  soft_falloff=False, camera=(0.0, -6.0, 4.5)), 0),
+    # Emissive meshes: sampled as lights, seen directly and (second scene) through glass; and an
+    # emitter Cycles does not sample (emission sampling None), which lights nothing.
+    ("emitters", scene_emitters, dict(strength=6.0, sampling=None, glass=False, camera=(0.5, -5.5, 3.0),
+                                      sample_factor=4), 0),
+    ("emitters_through_glass", scene_emitters, dict(strength=6.0, sampling=None, glass=True,
+                                                    camera=(0.5, -5.5, 3.0), sample_factor=4), 8),
+    # Not sampled as a light, Cycles' emitter still lights the floor through the BSDF-sampled ray
+    # of the last bounce (emission is collected before the path ends); TOYRT traces one cosine
+    # ray per diffuse hit for such emitters only.
+    ("emitter_not_sampled", scene_emitters, dict(strength=6.0, sampling="NONE", glass=False,
+                                                 camera=(0.5, -5.5, 3.0), sample_factor=8), 0),
     # An HDRI world with a small bright sun, turned by a Mapping node; seen by the camera above the
     # horizon and lighting the floor and the box.
     ("hdri_sky", scene_hdri, dict(sun=(0.6, 0.8, 60.0), strength=1.5, rotation=(0.0, 0.0, 0.7),

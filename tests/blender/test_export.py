@@ -13,7 +13,7 @@
 #      and 10,000 instances, in less than one mesh's bytes + 400 bytes per instance; the same for
 #      10,000 geometry-node instances; export times printed (and of a 1M-triangle mesh).
 #   3. a missing image: the render succeeds, one warning names the image, the placeholder is magenta.
-#   4. an unsupported shader node (Emission): exactly one approximation warning naming it.
+#   4. an unsupported shader node (Toon): exactly one approximation warning naming it.
 #   5. cancel: the native render stops (cancelled, fewer tiles than total) within a fraction of a
 #      second, and leaves no thread behind.
 #   6. animation: bpy.ops.render.render(animation=True) writes one PNG per frame, a moving object
@@ -397,7 +397,8 @@ def test_missing_texture():
 def test_unsupported_node():
     sync, toyrt = addon()
     scene = clear_scene()
-    mat = kit.emission("glowing", (0.2, 0.6, 0.9))
+    mat, toon = kit.surface("glowing", "ShaderNodeBsdfToon")
+    toon.inputs["Color"].default_value = (0.2, 0.6, 0.9, 1.0)
     kit.plane("glowing_plane", 2.0, material=mat)
     kit.box("glowing_cube", 0.4, (0, 0, 0.2), material=mat)            # same material twice: still one note
     kit.point_light("point", (0, 0, 2), 100.0)
@@ -408,17 +409,17 @@ def test_unsupported_node():
     _, _, stats = sync.export_scene(bpy.context.evaluated_depsgraph_get(), toyrt,
                                       report=lambda kind, msg: reports.append((kind, msg)))
     warnings = [m for k, m in reports if "WARNING" in k]
-    check(len(reports) == 1 and len(warnings) == 1 and "ShaderNodeEmission" in warnings[0]
+    check(len(reports) == 1 and len(warnings) == 1 and "ShaderNodeBsdfToon" in warnings[0]
           and stats["approximated"] == [a for a in stats["approximated"] if "glowing" in a]
           and len(stats["approximated"]) == 1,
-          f"exactly one approximation warning, naming the Emission node: {warnings}")
+          f"exactly one approximation warning, naming the Toon node: {warnings}")
     path = os.path.join(tempfile.mkdtemp(dir=TMP), "emission.exr")
     result, log = render_to(path)
     shown = [line for line in log.splitlines() if "approximated" in line]
-    check(result == {"FINISHED"} and os.path.exists(path) and len(shown) == 1 and "ShaderNodeEmission" in shown[0],
+    check(result == {"FINISHED"} and os.path.exists(path) and len(shown) == 1 and "ShaderNodeBsdfToon" in shown[0],
           f"the render succeeds and Blender shows that one warning: {shown}")
     px = kit.read_image(path)[..., :3]
-    check(np.isfinite(px).all() and px.mean() > 0, "the image is lit (the Emission colour as a diffuse)")
+    check(np.isfinite(px).all() and px.mean() > 0, "the image is lit (the Toon colour as a diffuse)")
 
 
 # ---- 5. cancel and threads ------------------------------------------------------------------------

@@ -8,6 +8,7 @@
 #   an Environment Texture world   a missing image: the render finishes, one note names it, the sky
 #                                  is the magenta placeholder; inf and NaN texels: a note, a finite
 #                                  image; a 1 x 1 image: a uniform world (the floor's albedo x L)
+#   a Principled BSDF's emission   seen by the camera as colour x strength (3.x and 4.x socket names)
 import math
 import os
 import sys
@@ -129,7 +130,21 @@ def test_one_pixel_environment_is_a_uniform_world():
           f"a 1 x 1 environment of 0.6 lights a floor of albedo 0.5 with {got:.4f} (0.3)")
 
 
+def test_principled_emission_is_seen_as_colour_times_strength():
+    scene_with_floor()
+    mat = kit.principled("glowing", (0.5, 0.5, 0.5))
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    kit.input_of(bsdf, "Emission Color", "Emission").default_value = (0.2, 0.5, 1.0, 1.0)   # 4.0+ / 3.x
+    bsdf.inputs["Emission Strength"].default_value = 3.0
+    kit.plane("glowing_plane", 10.0, mat, (0, 0, 0.5))
+    result, px, _ = render("principled_emission")
+    got = px[..., :3].reshape(-1, 3).mean(0) if px is not None else np.zeros(3)
+    check(result == {"FINISHED"} and np.allclose(got, (0.6, 1.5, 3.0), rtol=1e-5),
+          f"a Principled BSDF's emission, no lights: the camera sees {np.round(got, 4)} (0.6 1.5 3)")
+
+
 PARTS = [test_sun_over_a_floor_gives_strength_cos_over_pi, test_portal_is_not_a_light,
          test_shadow_switch_removes_the_shadow, test_missing_environment_image_is_magenta_with_one_note,
-         test_non_finite_texels_are_noted_and_the_image_stays_finite, test_one_pixel_environment_is_a_uniform_world]
+         test_non_finite_texels_are_noted_and_the_image_stays_finite, test_one_pixel_environment_is_a_uniform_world,
+         test_principled_emission_is_seen_as_colour_times_strength]
 run_script(PARTS, "lights and world", TMP)
