@@ -18,6 +18,7 @@ the add-on goes through here, so the rule is kept in one place:
   phases already make: no thread of its own."""
 from __future__ import annotations
 
+import os
 import re
 import time
 import warnings
@@ -27,9 +28,19 @@ from contextlib import contextmanager
 import bpy
 
 NOTE_PREFIX = "TOYRT note: "
+
+
+def _seconds(name: str, default: float) -> float:
+    try:
+        return max(float(os.environ.get(name, default)), 0.0)
+    except ValueError:
+        return default
+
+
 # A sign of life at least this often (s) in every phase: Flamenco fails a task silent for 10
-# minutes, other managers sooner; a stats line costs ~20 us, so this is no slowdown.
-HEARTBEAT_S = 5.0
+# minutes, other managers sooner; a stats line costs ~20 us, so this is no slowdown. The farm
+# test sets TOYRT_PROGRESS_SECONDS lower to see the longest step between two polls.
+HEARTBEAT_S = _seconds("TOYRT_PROGRESS_SECONDS", 5.0)
 # Sample lines no more often than this (s) while the count moves: Cycles, too, skips counts.
 SAMPLE_LINE_S = 1.0
 
