@@ -85,7 +85,7 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         window = toyrt.camera_window(camera)
         width, height = window["x1"] - window["x0"], window["y1"] - window["y0"]
         rays_per_sample = 2 + stats.get("lights", 0)  # camera ray, shadow rays, a specular step
-        progress.phase("Building BVH")
+        progress.phase("Building BVH", locked=True)
         # Esc is polled during the build too: a million-triangle SAH build takes about a second.
         with report.notes_from_warnings(self.report):  # the LBVH builder's fallback on SAH
             built = cache.commit(builder=settings.builder, threads=self._threads(scene),

@@ -116,24 +116,29 @@ class Progress:
         self.samples = max(int(samples), 1)
         self.memory: Callable[[], int] = lambda: 0  # bytes the native scene holds, once there is one
         self.memory_mb = self.peak_mb = 0.0
+        self.locked = False  # the phase runs native code holding the scene's lock (build, render)
         self.status = ""
         self.render_started: float | None = None
         self.fraction = 0.0
         self.shown_samples = -1
         self.last_shown = 0.0
 
-    def phase(self, status: str) -> None:
-        self.status = status
+    def phase(self, status: str, locked: bool = False) -> None:
+        """A new phase; locked: its polls come from native code that holds the scene's lock."""
+        self.status, self.locked = status, locked
         self._measure()
         self._show()
 
     def poll(self) -> bool:
         if time.perf_counter() - self.last_shown >= HEARTBEAT_S:
+            if not self.locked:
+                self._measure()
             self._show()
         return self.engine.test_break()
 
     def rendering(self) -> None:
         self._measure()
+        self.locked = True
         self.render_started = time.perf_counter()
         self.fraction = 0.0
         self._show_samples(force=True)
@@ -148,7 +153,7 @@ class Progress:
         self.fraction = 1.0
         if self.shown_samples != self.samples:
             self._show_samples(force=True)
-        self.phase(f"Finished | {summary}")
+        self.phase(f"Finished | {summary}")  # after the render: the lock is free again
 
     # ---------------------------------------------------------------------------------------
     def _show_samples(self, force: bool) -> None:
@@ -160,7 +165,7 @@ class Progress:
             self._show()
 
     def _measure(self) -> None:
-        # Only between the native calls: the polls and tiles come while the scene's lock is held
+        # Never from a locked phase's polls or tiles: they come while the scene's lock is held
         # (the build holds it exclusively), and memory_bytes would wait for it forever.
         self.memory_mb = self.memory() / 2**20
         self.peak_mb = max(self.peak_mb, self.memory_mb)
