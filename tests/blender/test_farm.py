@@ -172,6 +172,7 @@ def test_exit_codes():
     with_e, lines_e = blender(["-b", blend, "-E", "TOYRT", "-o", out, "-F", "PNG", "-f", "1"], env)
     without_e, lines = blender(["-b", blend, "-o", out, "-F", "PNG", "-f", "1"], env)
     MEASURED["exit codes without the add-on"] = dict(with_E=with_e, without_E=without_e)
+    MEASURED["printed without -E"] = [x for x in lines if "TOYRT" in x][:1]
     check(with_e != 0, f"-E TOYRT without the add-on exits {with_e}: {[x for x in lines_e if 'TOYRT' in x][:1]}")
     # Which engine that was: the file as this worker opens it.
     _, engine = blender(["-b", blend, "--python-expr", "import bpy; print('engine:', bpy.context.scene.render.engine)"],
