@@ -87,10 +87,11 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         rays_per_sample = 2 + stats.get("lights", 0)  # camera ray, shadow rays, a specular step
         progress.phase("Building BVH", locked=True)
         # Esc is polled during the build too: a million-triangle SAH build takes about a second.
-        with report.notes_from_warnings(self.report):  # the LBVH builder's fallback on SAH
-            built = cache.commit(builder=settings.builder, threads=self._threads(scene),
-                                 expected_rays=float(width * height * samples * rays_per_sample),
-                                 should_cancel=progress.poll)
+        built = cache.commit(builder=settings.builder, threads=self._threads(scene),
+                             expected_rays=float(width * height * samples * rays_per_sample),
+                             should_cancel=progress.poll)
+        if built:
+            report.commit_notes(t_scene, self.report)  # the LBVH builder's fallback on SAH
         build_ms = t_scene.last_commit["build_ms"] if built else 0.0
         if self.test_break():
             return
@@ -159,8 +160,9 @@ def _on_load_pre(*_args):
 def register() -> None:
     import atexit
 
-    from . import viewport
+    from . import report, viewport
 
+    report.register()
     bpy.utils.register_class(TOYRTRenderEngine)
     bpy.app.handlers.load_pre.append(_on_load_pre)
     atexit.register(viewport.close_all)  # Blender quitting: no render thread may outlive it

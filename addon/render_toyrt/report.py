@@ -9,8 +9,8 @@ the add-on goes through here, so the rule is kept in one place:
   `TOYRT note: ...` line containing none of the words warning, error or exception in any case.
   A report would print `Warning: ...` there, and farm managers fail a task on those words (AWS
   Deadline Cloud's strict mode: `.*Exception:.*|.*Error:.*|.*Warning.*`), though the frame is
-  fine. A Python warning raised inside notes_from_warnings() (the native module's RuntimeWarning
-  for the LBVH fallback) becomes a note.
+  fine. The LBVH builder's fallback on SAH (no OpenCL driver) is such a note (commit_notes()), in
+  place of the RuntimeWarning the native module raises for it.
 - Progress (Progress) is the render engine's stats line in the layout Cycles gives it, which
   Blender prints in background mode as `Fra:N Mem:.. | Time:.. | Remaining:.. | Mem:.., Peak:.. |
   Scene, ViewLayer | Sample k/N`, the line farm managers parse, and which comes at least every
@@ -23,7 +23,6 @@ import re
 import time
 import warnings
 from collections.abc import Callable
-from contextlib import contextmanager
 
 import bpy
 
@@ -38,8 +37,9 @@ def _seconds(name: str, default: float) -> float:
 
 
 # A sign of life at least this often (s) in every phase: Flamenco fails a task silent for 10
-# minutes, other managers sooner; a stats line costs ~20 us, so this is no slowdown. The farm
-# test sets TOYRT_PROGRESS_SECONDS lower to see the longest step between two polls.
+# minutes, other managers sooner. A poll adds one clock read; the line itself comes every few
+# seconds at most. The farm test sets TOYRT_PROGRESS_SECONDS lower to see the longest step
+# between two polls.
 HEARTBEAT_S = _seconds("TOYRT_PROGRESS_SECONDS", 5.0)
 # Sample lines no more often than this (s) while the count moves: Cycles, too, skips counts.
 SAMPLE_LINE_S = 1.0
@@ -74,20 +74,23 @@ def error(text: str, report: Report = None) -> None:
         print(f"TOYRT: {text}", flush=True)
 
 
-@contextmanager
-def notes_from_warnings(report: Report = None, once: set | None = None):
-    """Python warnings raised in the block (the native module's RuntimeWarning when the LBVH
-    builder falls back on SAH) become notes instead of `RuntimeWarning: ...` lines, each text
-    once per block, or once ever when a set `once` keeps the texts already noted. On Blender's
-    main thread only: the warnings filters are process-wide."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        yield
-    for text in dict.fromkeys(str(w.message) for w in caught):
-        if once is None or text not in once:
-            note(text, report)
-            if once is not None:
-                once.add(text)
+def commit_notes(scene, report: Report = None, once: set | None = None) -> None:
+    """After a commit that built: the builder's fallback (toyrt.Scene.last_commit["warning"]) as a
+    note, each text once when a set `once` keeps those already noted (the viewport commits often)."""
+    text = scene.last_commit.get("warning", "")
+    if text and (once is None or text not in once):
+        note(text, report)
+        if once is not None:
+            once.add(text)
+
+
+def register() -> None:
+    """The module's own RuntimeWarning for the LBVH fallback, raised under the add-on's commit
+    (sync.py), is silenced: commit_notes() says it, as a note. A warnings filter rather than
+    catch_warnings() around each commit, which is process-wide state and not safe while F12's
+    render thread and the viewport commit at once. Scripts calling toyrt themselves still get it."""
+    warnings.filterwarnings("ignore", message="LBVH builder unavailable", category=RuntimeWarning,
+                            module=r".*render_toyrt\.sync")
 
 
 def timecode(seconds: float) -> str:

@@ -84,7 +84,7 @@ class ViewportSession:
         self.passes = 0
         self.restarts = 0
         self.error = None           # why the last render thread stopped early, shown in the view's header
-        self._notes_shown = set()   # the fallback notes this session reported (report.notes_from_warnings)
+        self._notes_shown = set()   # the fallback notes this session reported (report.commit_notes)
         self.first_pass_ms = None   # time from a restart to its first image (the coarse pass)
         _sessions.add(self)
 
@@ -104,9 +104,9 @@ class ViewportSession:
         rays = float(region.width * region.height * s.viewport_samples * (2 + self.cache.stats.get("lights", 0)))
         # The cost model picks the builder: interactive work (few rays) favours the fast LBVH builds,
         # whose fallback on SAH (no OpenCL) is a note in the view's header, once per session.
-        engine = self._engine()
-        with report.notes_from_warnings(engine.report if engine is not None else None, once=self._notes_shown):
-            self.cache.commit(builder=s.builder, threads=threads, expected_rays=rays)
+        if self.cache.commit(builder=s.builder, threads=threads, expected_rays=rays):
+            engine = self._engine()
+            report.commit_notes(self.cache.scene, engine.report if engine is not None else None, self._notes_shown)
         self._stale = True
 
     def draw(self, context, depsgraph) -> None:
