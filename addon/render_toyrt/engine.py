@@ -28,15 +28,14 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
 
     # ---- 3D viewport (viewport.py) ----------------------------------------------------------------
     def view_update(self, context, depsgraph) -> None:
-        from . import native, viewport
+        from . import native, report, viewport
 
         try:
             if self._viewport is None:
                 self._viewport = viewport.ViewportSession(native(), self)
             self._viewport.update(context, depsgraph)
         except Exception as err:  # shown in the viewport's header, never raised into Blender's UI
-            self.report({"ERROR"}, f"TOYRT: {err}")
-            print(f"TOYRT: viewport update failed: {err!r}", flush=True)
+            report.error(f"viewport update failed: {err}", self.report)
 
     def view_draw(self, context, depsgraph) -> None:
         if self._viewport is not None:
@@ -45,28 +44,32 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
     # ---- F12 and command-line renders ---------------------------------------------------------------
 
     def render(self, depsgraph) -> None:
-        from . import native
+        from . import native, report
 
         try:
             self._render(depsgraph, native())
         except Exception as err:  # reaches the user (and makes a farm's frame fail), never crashes Blender
-            self.report({"ERROR"}, f"TOYRT: {err}")
-            print(f"TOYRT: render failed: {err}", flush=True)
+            report.error(f"render failed: {err}", self.report)
 
     def _render(self, depsgraph, toyrt):
-        from . import sync
+        from . import report, sync
         from .camera import export_camera
 
         scene = depsgraph.scene
         settings = scene.toyrt
         started = time.perf_counter()
-        self.update_stats("TOYRT", "Exporting scene")
+        samples = settings.samples
+        # The stats line farms parse, Cycles' layout; progress.poll is every phase's cancel poll.
+        progress = report.Progress(self, depsgraph, samples)
+        progress.phase("Exporting scene")
         camera = export_camera(depsgraph)  # fails early without a camera
         # One cache per Blender scene: the frames of an animation reuse the meshes that did not
         # change, and the native scene is edited in place, so memory stays flat.
         cache = sync.for_render(depsgraph, toyrt)
+        t_scene = cache.scene
+        progress.memory = lambda: t_scene.memory_bytes
         try:
-            cache.sync(depsgraph, should_cancel=self.test_break)
+            cache.sync(depsgraph, should_cancel=progress.poll)
         except sync.ExportCancelled:
             sync.discard_render_cache(depsgraph)  # half updated: the next F12 starts afresh
             return
@@ -74,20 +77,21 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             # Any other failure mid-walk leaves it half updated too (meshes neither kept nor freed).
             sync.discard_render_cache(depsgraph)
             raise
-        t_scene, stats = cache.scene, cache.stats
+        stats = cache.stats
         if cache.approximated:
-            self.report({"WARNING"}, "TOYRT approximated: " + "; ".join(cache.approximated))
+            report.note("approximated: " + "; ".join(cache.approximated), self.report)
         if self.test_break():
             return
         window = toyrt.camera_window(camera)
         width, height = window["x1"] - window["x0"], window["y1"] - window["y0"]
-        samples = settings.samples
         rays_per_sample = 2 + stats.get("lights", 0)  # camera ray, shadow rays, a specular step
-        self.update_stats("TOYRT", "Building BVH")
+        progress.phase("Building BVH", locked=True)
         # Esc is polled during the build too: a million-triangle SAH build takes about a second.
         built = cache.commit(builder=settings.builder, threads=self._threads(scene),
                              expected_rays=float(width * height * samples * rays_per_sample),
-                             should_cancel=self.test_break)
+                             should_cancel=progress.poll)
+        if built:
+            report.commit_notes(t_scene, self.report)  # the LBVH builder's fallback on SAH
         build_ms = t_scene.last_commit["build_ms"] if built else 0.0
         if self.test_break():
             return
@@ -98,7 +102,6 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         tiles_done = [0]
         tile = 32
         tiles_total = max(1, -(-width // tile) * -(-height // tile))
-        last_print = [time.perf_counter()]
         frame = scene.frame_current
 
         def on_tile(x, y, w, h, pixels):
@@ -107,25 +110,19 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             _set_rect(result.layers[0].passes["Combined"].rect, np.ascontiguousarray(pixels[::-1]))
             self.end_result(result)
             tiles_done[0] += 1
-            self.update_progress(tiles_done[0] / tiles_total)
-            now = time.perf_counter()
-            if now - last_print[0] > 5.0:  # a sign of life for farm managers that watch stdout
-                print(f"TOYRT: frame {frame}: {tiles_done[0]} tiles done, {now - started:.1f} s", flush=True)
-                last_print[0] = now
+            progress.tiles(tiles_done[0], tiles_total)
 
-        self.update_stats("TOYRT", f"Rendering {samples} samples")
+        progress.rendering()
         image = t_scene.render(
             camera, samples=samples, seed=settings.seed + frame, max_specular_depth=settings.max_specular_depth,
             area_light_sampling=settings.area_light_sampling, light_sampling=settings.light_sampling,
-            threads=self._threads(scene), tile_size=tile, on_tile=on_tile, should_cancel=self.test_break)
+            threads=self._threads(scene), tile_size=tile, on_tile=on_tile, should_cancel=progress.poll)
         info = t_scene.last_render
-        if info["tiles_total"]:
-            self.update_progress(info["tiles_done"] / info["tiles_total"])
+        if info["cancelled"]:
+            return
         elapsed = time.perf_counter() - started
-        self.update_stats(
-            "TOYRT",
-            f"Samples {samples} | Export {stats['export_s'] * 1000:.0f} ms | BVH {build_ms:.0f} ms | "
-            f"Render {info['render_ms'] / 1000:.2f} s | {stats.get('triangles', 0):,} triangles | {elapsed:.2f} s")
+        progress.finished(f"Export {stats['export_s'] * 1000:.0f} ms, BVH {build_ms:.0f} ms, "
+                          f"Render {info['render_ms'] / 1000:.2f} s, {stats.get('triangles', 0):,} triangles")
         print(f"TOYRT: frame {frame} done in {elapsed:.2f} s ({image.shape[1]}x{image.shape[0]}, {samples} samples)",
               flush=True)
 
@@ -163,8 +160,9 @@ def _on_load_pre(*_args):
 def register() -> None:
     import atexit
 
-    from . import viewport
+    from . import report, viewport
 
+    report.register()
     bpy.utils.register_class(TOYRTRenderEngine)
     bpy.app.handlers.load_pre.append(_on_load_pre)
     atexit.register(viewport.close_all)  # Blender quitting: no render thread may outlive it

@@ -392,15 +392,17 @@ def export_scene(depsgraph, toyrt, *, report: Callable | None = None,
 
     stats: export_s, meshes, instances, lights, materials, textures, triangles_stored (each mesh
     once), triangles_instanced (= triangles: over all instances), approximated (list of strings).
-    With `report` (a RenderEngine's or an operator's report), one WARNING lists what was
-    approximated."""
+    With `report` (a RenderEngine's or an operator's report), one note lists what was
+    approximated (report.note: a WARNING in the UI, a `TOYRT note:` line in background mode)."""
     t0 = time.perf_counter()
     camera = export_camera(depsgraph, camera_object)  # fail early, before any work
     sync = SceneSync(toyrt, fingerprints=False)
     sync.sync(depsgraph)
     stats = dict(sync.stats, export_s=time.perf_counter() - t0)
     if sync.approximated and report is not None:
-        report({"WARNING"}, "TOYRT approximated: " + "; ".join(sync.approximated))
+        from .report import note  # the add-on's reporting policy: a warning in the UI, a note on farms
+
+        note("approximated: " + "; ".join(sync.approximated), report)
     return sync.scene, camera, stats
 
 

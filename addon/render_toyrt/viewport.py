@@ -19,6 +19,8 @@ import weakref
 
 import numpy as np
 
+from . import report
+
 _sessions = weakref.WeakSet()  # every live session, for close_all()
 
 COARSE_DIVIDER = 4      # the first pass renders 1/4 of the width and height
@@ -82,6 +84,7 @@ class ViewportSession:
         self.passes = 0
         self.restarts = 0
         self.error = None           # why the last render thread stopped early, shown in the view's header
+        self._notes_shown = set()   # the fallback notes this session reported (report.commit_notes)
         self.first_pass_ms = None   # time from a restart to its first image (the coarse pass)
         _sessions.add(self)
 
@@ -99,8 +102,11 @@ class ViewportSession:
                               threads=threads)
         region = context.region
         rays = float(region.width * region.height * s.viewport_samples * (2 + self.cache.stats.get("lights", 0)))
-        # The cost model picks the builder: interactive work (few rays) favours the fast LBVH builds.
-        self.cache.commit(builder=s.builder, threads=threads, expected_rays=rays)
+        # The cost model picks the builder: interactive work (few rays) favours the fast LBVH builds,
+        # whose fallback on SAH (no OpenCL) is a note in the view's header, once per session.
+        if self.cache.commit(builder=s.builder, threads=threads, expected_rays=rays):
+            engine = self._engine()
+            report.commit_notes(self.cache.scene, engine.report if engine is not None else None, self._notes_shown)
         self._stale = True
 
     def draw(self, context, depsgraph) -> None:
@@ -200,7 +206,7 @@ class ViewportSession:
                 count = min(count * 2, MAX_PASS_SAMPLES)
         except Exception as err:  # shown by draw() in the view's header; the thread ends either way
             self.error = str(err)
-            print(f"TOYRT: viewport render failed: {err}", flush=True)
+            report.error(f"viewport render failed: {err}")
 
     def _publish(self, version, image, samples):
         self._latest = (version, image, samples)  # one assignment: view_draw sees old or new, whole
