@@ -53,6 +53,15 @@ class PyScene {
   py::array_t<bool> occluded(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads);
   py::dict bvh_stats(int64_t mesh);
 
+  // The exact geometric queries (py_queries.cpp; the core's are in queries/).
+  py::array_t<uint32_t> count_intersections(py::handle origins, py::handle directions, py::handle tnear,
+                                            py::handle tfar, int threads);
+  py::dict list_intersections(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar,
+                              size_t max_hits, int threads);
+  py::array_t<bool> compute_occupancy(py::handle points, int threads);
+  py::dict compute_closest_points(py::handle points, int threads);
+  py::array_t<float> compute_distance(py::handle points, bool signed_distance, int threads);
+
   size_t mesh_count();
   size_t instance_count();
   size_t triangle_count();

@@ -1,0 +1,102 @@
+// The exact geometric queries of PyScene (py_scene.h): convert, take the shared lock with the GIL
+// released, call the core (queries/), wrap the answer.
+#include "python/convert.h"
+#include "python/py_scene.h"
+#include "queries/point_queries.h"
+#include "queries/ray_queries.h"
+
+#include <cstring>
+#include <mutex>
+
+namespace toyrt::binding {
+namespace {
+
+RayBatch ray_batch(const FloatArray& org, const FloatArray& dir, const PerRay& near, const PerRay& far) {
+  if (org.shape(0) != dir.shape(0))
+    throw py::value_error("origins and directions must hold the same number of rays, got " +
+                          std::to_string(org.shape(0)) + " and " + std::to_string(dir.shape(0)));
+  return {org.data(), dir.data(), near.data, near.stride, far.data, far.stride, size_t(org.shape(0))};
+}
+
+template <class T>
+py::array_t<T> to_array(const std::vector<T>& v) {
+  py::array_t<T> a{py::ssize_t(v.size())};
+  if (!v.empty()) std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(T));
+  return a;
+}
+
+}  // namespace
+
+py::array_t<uint32_t> PyScene::count_intersections(py::handle origins, py::handle directions, py::handle tnear,
+                                                   py::handle tfar, int threads) {
+  const FloatArray org = as_points(origins, "origins"), dir = as_points(directions, "directions");
+  const size_t n = size_t(org.shape(0));
+  const PerRay near = per_ray(tnear, n, "tnear"), far = per_ray(tfar, n, "tfar");
+  const RayBatch batch = ray_batch(org, dir, near, far);
+  py::array_t<uint32_t> counts{py::ssize_t(n)};
+  uint32_t* out = counts.mutable_data();  // taken with the GIL held
+  read([&] { queries::count_intersections(scene_, batch, out, threads); });
+  return counts;
+}
+
+py::dict PyScene::list_intersections(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar,
+                                     size_t max_hits, int threads) {
+  const FloatArray org = as_points(origins, "origins"), dir = as_points(directions, "directions");
+  const size_t n = size_t(org.shape(0));
+  const PerRay near = per_ray(tnear, n, "tnear"), far = per_ray(tfar, n, "tfar");
+  const RayBatch batch = ray_batch(org, dir, near, far);
+  const queries::HitList hits = read([&] { return queries::list_intersections(scene_, batch, max_hits, threads); });
+  py::dict out;
+  out["ray_splits"] = to_array(hits.offsets);
+  out["ray"] = to_array(hits.ray);
+  out["t"] = to_array(hits.t);
+  out["mesh"] = to_array(hits.mesh);
+  out["instance"] = to_array(hits.instance);
+  out["prim"] = to_array(hits.prim);
+  out["u"] = to_array(hits.u);
+  out["v"] = to_array(hits.v);
+  return out;
+}
+
+py::array_t<bool> PyScene::compute_occupancy(py::handle points, int threads) {
+  const FloatArray p = as_points(points, "points");
+  const size_t n = size_t(p.shape(0));
+  py::array_t<bool> inside{py::ssize_t(n)};
+  static_assert(sizeof(bool) == sizeof(uint8_t));
+  uint8_t* out = reinterpret_cast<uint8_t*>(inside.mutable_data());
+  read([&] { queries::compute_occupancy(scene_, p.data(), n, out, threads); });
+  return inside;
+}
+
+py::dict PyScene::compute_closest_points(py::handle points, int threads) {
+  const FloatArray p = as_points(points, "points");
+  const size_t n = size_t(p.shape(0));
+  py::array_t<float> closest({py::ssize_t(n), py::ssize_t(3)}), normal({py::ssize_t(n), py::ssize_t(3)});
+  py::array_t<float> distance(n), u(n), v(n);
+  py::array_t<int32_t> mesh(n), instance(n), prim(n);
+  const queries::ClosestBatch out{closest.mutable_data(),  distance.mutable_data(), mesh.mutable_data(),
+                                  instance.mutable_data(), prim.mutable_data(),     u.mutable_data(),
+                                  v.mutable_data(),        normal.mutable_data()};
+  read([&] { queries::compute_closest_points(scene_, p.data(), n, out, threads); });
+  py::dict d;
+  d["points"] = closest;
+  d["distance"] = distance;
+  d["mesh"] = mesh;
+  d["instance"] = instance;
+  d["prim"] = prim;
+  d["u"] = u;
+  d["v"] = v;
+  d["normal"] = normal;
+  return d;
+}
+
+py::array_t<float> PyScene::compute_distance(py::handle points, bool signed_distance, int threads) {
+  const FloatArray p = as_points(points, "points");
+  const size_t n = size_t(p.shape(0));
+  py::array_t<float> distance(n);
+  float* out = distance.mutable_data();
+  read([&] { queries::compute_distance(scene_, p.data(), n, out, signed_distance, threads); });
+  return distance;
+}
+
+}  // namespace toyrt::binding
