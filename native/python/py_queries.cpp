@@ -7,6 +7,7 @@
 
 #include <cstring>
 #include <mutex>
+#include <stdexcept>
 
 namespace toyrt::binding {
 namespace {
@@ -45,7 +46,12 @@ py::dict PyScene::list_intersections(py::handle origins, py::handle directions, 
   const size_t n = size_t(org.shape(0));
   const PerRay near = per_ray(tnear, n, "tnear"), far = per_ray(tfar, n, "tfar");
   const RayBatch batch = ray_batch(org, dir, near, far);
-  const queries::HitList hits = read([&] { return queries::list_intersections(scene_, batch, max_hits, threads); });
+  queries::HitList hits;
+  try {
+    hits = read([&] { return queries::list_intersections(scene_, batch, max_hits, threads); });
+  } catch (const std::length_error& e) {
+    throw py::value_error(e.what());  // past max_hits: a bad argument, as Python sees it
+  }
   py::dict out;
   out["ray_splits"] = to_array(hits.offsets);
   out["ray"] = to_array(hits.ray);

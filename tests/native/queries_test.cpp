@@ -8,8 +8,8 @@
 #include "queries/ray_queries.h"
 #include "test_scenes.h"
 
-#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include <cmath>
 #include <map>
@@ -36,11 +36,11 @@ MeshData cube(float size = 1.0f, const Vec3& offset = Vec3(0.0f)) {
 // An icosahedron subdivided `levels` times, vertices pushed onto the sphere of `radius`.
 MeshData icosphere(int levels, float radius = 1.0f) {
   const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
-  std::vector<DVec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                          {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  std::vector<Triangle> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+  std::vector<DVec3> v = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                          {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<Triangle> f = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
                              {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                             {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+                             {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   for (int l = 0; l < levels; ++l) {
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
     auto midpoint = [&](uint32_t a, uint32_t b) {
@@ -145,7 +145,8 @@ TEST(ExactCrossing, SharedEdgeIsCrossedByExactlyOneTriangle) {
         const Vec3 target(s, s, 0.0f), dir(tilt, 0.25f * tilt, dz);
         const queries::ExactRay r{DVec3(target - dir), DVec3(dir)};
         queries::Crossing c;
-        const int n = int(queries::exact_crossing(r, p[0], p[1], p[2], c)) + queries::exact_crossing(r, p[0], p[2], p[3], c);
+        const int n =
+            int(queries::exact_crossing(r, p[0], p[1], p[2], c)) + queries::exact_crossing(r, p[0], p[2], p[3], c);
         const bool corner = s == 0.0f || s == 1.0f;  // corners (0,0), (1,1) are on the quad's outline
         if (!corner) EXPECT_EQ(n, 1) << "s=" << s << " dz=" << dz << " tilt=" << tilt;
         EXPECT_LE(n, 1);
@@ -161,11 +162,13 @@ TEST(ExactCrossing, RayInTheTrianglesPlaneNeverCrossesIt) {
 TEST(ExactCrossing, DistanceSignIsExactAtTheOrigin) {
   // The origin exactly on the triangle: t = 0 with sign 0; just off it by one float ulp: t > 0.
   queries::Crossing c;
-  ASSERT_TRUE(queries::exact_crossing({DVec3(0.25, 0.25, 0.0), DVec3(0.0, 0.0, 1.0)}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, c));
+  ASSERT_TRUE(
+      queries::exact_crossing({DVec3(0.25, 0.25, 0.0), DVec3(0.0, 0.0, 1.0)}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, c));
   EXPECT_EQ(c.t_sign, 0);
   EXPECT_EQ(c.t, 0.0);
   const double below = -std::ldexp(1.0, -149);
-  ASSERT_TRUE(queries::exact_crossing({DVec3(0.25, 0.25, below), DVec3(0.0, 0.0, 1.0)}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, c));
+  ASSERT_TRUE(
+      queries::exact_crossing({DVec3(0.25, 0.25, below), DVec3(0.0, 0.0, 1.0)}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, c));
   EXPECT_EQ(c.t_sign, 1);
   EXPECT_GT(c.t, 0.0);
 }
@@ -315,9 +318,9 @@ TEST(ClosestPoints, BvhSearchMatchesBruteForceOnASphere) {
   for (size_t i = 0; i < 3 * n; ++i) pts.push_back(unit(rng) + (i % 3 == 0 ? 1.0f : i % 3 == 1 ? 2.0f : 3.0f));
   std::vector<float> cp(3 * n), dist(n), u(n), v(n), normal(3 * n);
   std::vector<int32_t> mesh(n), inst(n), prim(n);
-  queries::compute_closest_points(c.scene, pts.data(), n,
-                                  {cp.data(), dist.data(), mesh.data(), inst.data(), prim.data(), u.data(), v.data(),
-                                   normal.data()});
+  queries::compute_closest_points(
+      c.scene, pts.data(), n,
+      {cp.data(), dist.data(), mesh.data(), inst.data(), prim.data(), u.data(), v.data(), normal.data()});
   const glm::dmat4 mw(to_world);
   size_t wrong = 0;
   for (size_t i = 0; i < n; ++i) {
