@@ -247,12 +247,16 @@ PYBIND11_MODULE(toyrt, m) {
           "What the last commit did: build_ms, lbvh_compile_ms (OpenCL compilation, first LBVH build of\n"
           "the process only), meshes_built, sah_meshes, lbvh_meshes, warning.")
       .def("intersect", &PyScene::intersect, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0f,
-           py::arg("tfar") = std::numeric_limits<float>::infinity(), py::arg("threads") = 0,
+           py::arg("tfar") = std::numeric_limits<float>::infinity(), py::arg("threads") = 0, py::arg("normals") = false,
+           py::arg("mesh_ids") = false,
            "Nearest hits of rays org + t * dir with tnear <= t < tfar (world units of t: the direction's\n"
            "length). origins, directions: (N, 3); tnear, tfar: numbers or (N,) arrays.\n"
            "Returns a dict of (N,) arrays: t (float32, inf on a miss), prim (int32 triangle index in its\n"
            "mesh, -1 on a miss), instance (int32), u, v (float32; p = (1-u-v) p0 + u p1 + v p2).\n"
-           "Rays with a zero or non-finite direction, a non-finite origin, or tnear > tfar miss.")
+           "Rays with a zero or non-finite direction, a non-finite origin, or tnear > tfar miss.\n"
+           "origins, directions may have any leading shape (..., 3) (an image's (H, W, 3)): the answers\n"
+           "come in that shape. Opt-in: normals=True adds normal (..., 3) float32, the unit geometric\n"
+           "normal in world space (0 on a miss); mesh_ids=True adds mesh (int32, -1 on a miss).")
       .def("occluded", &PyScene::occluded, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0f,
            py::arg("tfar") = std::numeric_limits<float>::infinity(), py::arg("threads") = 0,
            "Whether anything lies on each ray with tnear <= t < tfar; a (N,) bool array. Stops at the first hit.")

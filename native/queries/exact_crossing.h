@@ -46,11 +46,8 @@ struct Crossing {
   int t_sign;
 };
 
-// sign(P(a, b)) of the perturbed ray: the exact sign, then the tie-breaking terms.
-inline int edge_side(const DVec3& dir, const DVec3& a, const DVec3& b) {
-  const int s = triple_sign(dir, a, b);
-  if (s != 0) return s;
-  const DVec3& d = dir;
+// The tie-break of a Plücker product that is exactly zero: the terms of the perturbation.
+[[gnu::noinline, gnu::cold]] inline int tie_side(const DVec3& d, const DVec3& a, const DVec3& b) {
   // [(a - b) x d]: each component written as four products so no difference is rounded.
   const int sx = four_product_sign(a.y, d.z, b.y, d.z, b.z, d.y, a.z, d.y);
   if (sx != 0) return sx;
@@ -59,15 +56,22 @@ inline int edge_side(const DVec3& dir, const DVec3& a, const DVec3& b) {
   return four_product_sign(a.x, d.y, b.x, d.y, b.y, d.x, a.y, d.x);
 }
 
+// sign(P(a, b)) of the perturbed ray, and P(a, b) in double: the filtered sign, else the exact
+// sign, else the tie-breaking terms.
+inline int edge_side(const DVec3& dir, const DVec3& a, const DVec3& b, double& value) {
+  int s = triple_filtered(dir, a, b, value);
+  if (s != 2) return s;
+  s = triple_sign_exact(dir, a, b);
+  return s != 0 ? s : tie_side(dir, a, b);
+}
+
 // Whether the perturbed ray crosses the triangle (p0, p1, p2); on a crossing writes it to `out`.
 // Both faces count.
 inline bool exact_crossing(const ExactRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2, Crossing& out) {
   const DVec3 a = DVec3(p0) - r.org, b = DVec3(p1) - r.org, c = DVec3(p2) - r.org;
-  const int side = edge_side(r.dir, a, b);  // weights p2
-  if (side == 0 || edge_side(r.dir, b, c) != side || edge_side(r.dir, c, a) != side) return false;
-  const DVec3& d = r.dir;
-  const double w2 = glm::dot(d, glm::cross(a, b)), w0 = glm::dot(d, glm::cross(b, c)),
-               w1 = glm::dot(d, glm::cross(c, a));
+  double w0, w1, w2;  // P(b, c), P(c, a), P(a, b): the weights of p0, p1, p2
+  const int side = edge_side(r.dir, a, b, w2);
+  if (side == 0 || edge_side(r.dir, b, c, w0) != side || edge_side(r.dir, c, a, w1) != side) return false;
   const double sum = w0 + w1 + w2;
   const double volume = glm::dot(a, glm::cross(b, c));
   out.t_sign = triple_sign(a, b, c) * side;

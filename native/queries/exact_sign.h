@@ -73,14 +73,8 @@ inline int sign_of(double x) { return (x > 0.0) - (x < 0.0); }
 // of absolute terms), Shewchuk's orient3d bound; 1e-15 is about 9u.
 inline constexpr double kTripleErrorBound = 1e-15;
 
-// sign(x . (y x z)) exactly.
-inline int triple_sign(const DVec3& x, const DVec3& y, const DVec3& z) {
-  const double a = y.y * z.z, b = y.z * z.y, c = y.z * z.x, d = y.x * z.z, e = y.x * z.y, f = y.y * z.x;
-  const double value = x.x * (a - b) + x.y * (c - d) + x.z * (e - f);
-  const double permanent = std::fabs(x.x) * (std::fabs(a) + std::fabs(b)) +
-                           std::fabs(x.y) * (std::fabs(c) + std::fabs(d)) +
-                           std::fabs(x.z) * (std::fabs(e) + std::fabs(f));
-  if (std::fabs(value) > kTripleErrorBound * permanent) return sign_of(value);
+// sign(x . (y x z)) by exact expansion arithmetic: the slow path, kept out of line.
+[[gnu::noinline, gnu::cold]] inline int triple_sign_exact(const DVec3& x, const DVec3& y, const DVec3& z) {
   Expansion<24> sum;
   sum.add_product(y.y, z.z, x.x);
   sum.add_product(-y.z, z.y, x.x);
@@ -91,9 +85,27 @@ inline int triple_sign(const DVec3& x, const DVec3& y, const DVec3& z) {
   return sum.sign();
 }
 
+// x . (y x z) in double, and its sign when the error bound certifies it (else 2: undecided).
+inline int triple_filtered(const DVec3& x, const DVec3& y, const DVec3& z, double& value) {
+  const double a = y.y * z.z, b = y.z * z.y, c = y.z * z.x, d = y.x * z.z, e = y.x * z.y, f = y.y * z.x;
+  value = x.x * (a - b) + x.y * (c - d) + x.z * (e - f);
+  const double permanent = std::fabs(x.x) * (std::fabs(a) + std::fabs(b)) +
+                           std::fabs(x.y) * (std::fabs(c) + std::fabs(d)) +
+                           std::fabs(x.z) * (std::fabs(e) + std::fabs(f));
+  return std::fabs(value) > kTripleErrorBound * permanent ? sign_of(value) : 2;
+}
+
+// sign(x . (y x z)) exactly.
+inline int triple_sign(const DVec3& x, const DVec3& y, const DVec3& z) {
+  double value;
+  const int s = triple_filtered(x, y, z, value);
+  return s != 2 ? s : triple_sign_exact(x, y, z);
+}
+
 // sign(a0 * b0 - a1 * b1 + a2 * b2 - a3 * b3) exactly: a 2x2 determinant of differences written
 // out so that no difference is rounded.
-inline int four_product_sign(double a0, double b0, double a1, double b1, double a2, double b2, double a3, double b3) {
+[[gnu::noinline]] inline int four_product_sign(double a0, double b0, double a1, double b1, double a2, double b2,
+                                               double a3, double b3) {
   Expansion<8> sum;
   sum.add_product(a0, b0);
   sum.add_product(-a1, b1);

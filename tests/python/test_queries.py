@@ -160,3 +160,55 @@ def test_answers_do_not_depend_on_the_thread_count():
     o, d = aligned_rays(v, f, (0.1, 0.1, 0.1))
     assert np.array_equal(s.count_intersections(o, d, threads=1), s.count_intersections(o, d, threads=2))
     assert np.array_equal(s.compute_distance(d, threads=1), s.compute_distance(d, threads=2))
+
+
+def test_image_shaped_rays_come_back_in_their_shape_with_opt_in_normals_and_mesh_ids():
+    s = toyrt.Scene()
+    s.add_mesh(*cube())  # mesh 0, instance 0
+    m = s.add_mesh(*cube(), instance=False)
+    shift = np.eye(4)
+    shift[:3, :3] *= 2.0
+    shift[0, 3] = 5.0
+    s.add_instance(m, shift)  # instance 1: mesh 1, scaled 2x at x = 5
+    s.commit()
+    xs = np.float32([0.5, 6.0, 20.0])
+    o = np.stack(np.meshgrid(xs, np.float32([0.25, 0.75]), indexing="ij"), -1)
+    o = np.concatenate([o, np.full(o.shape[:2] + (1,), -1, np.float32)], -1)  # (3, 2, 3)
+    d = np.broadcast_to(np.float32([0, 0, 1]), o.shape)
+    h = s.intersect(o, d, normals=True, mesh_ids=True)
+    assert h["t"].shape == (3, 2) and h["normal"].shape == (3, 2, 3)
+    assert h["mesh"].tolist() == [[0, 0], [1, 1], [-1, -1]]
+    assert np.allclose(h["normal"][:2], [0, 0, -1])  # the bottom faces' winding: outward, also scaled
+    assert np.all(h["normal"][2] == 0)
+    assert "normal" not in s.intersect(o, d)  # opt-in: the plain query is unchanged
+    assert s.occluded(o, d).shape == (3, 2)
+    assert s.count_intersections(o, d).tolist() == [[2, 2], [2, 2], [0, 0]]
+    assert s.compute_occupancy(o + np.float32([0, 0, 1.5])).shape == (3, 2)
+
+
+def test_open3d_adaptor_speaks_open3d():
+    from toyrt_open3d import RaycastingScene
+
+    v, f = cube()
+    scene = RaycastingScene()
+    assert scene.add_triangles(v, f) == 0
+    rays = np.float32([[[0.5, 0.5, -1, 0, 0, 1], [0.0, 0.0, -1, 1, 1, 1], [5, 5, -1, 0, 0, 1]]])  # (1, 3, 6)
+    ans = scene.cast_rays(rays)
+    assert set(ans) == {"t_hit", "geometry_ids", "primitive_ids", "primitive_uvs", "primitive_normals"}
+    assert ans["t_hit"].shape == (1, 3) and ans["primitive_uvs"].shape == (1, 3, 2)
+    assert ans["geometry_ids"].numpy().tolist() == [[0, 0, RaycastingScene.INVALID_ID]]
+    assert ans["geometry_ids"].dtype == np.uint32
+    assert np.allclose(np.abs(ans["primitive_normals"].numpy()[0, 0]), [0, 0, 1])
+    assert scene.count_intersections(rays).numpy().tolist() == [[2, 0, 0]]
+    lx = scene.list_intersections(rays)
+    assert lx["ray_splits"].numpy().tolist() == [0, 2, 2, 2] and lx["ray_ids"].tolist() == [0, 0]
+    assert set(lx) == {"ray_splits", "ray_ids", "t_hit", "geometry_ids", "primitive_ids", "primitive_uvs",
+                       "primitive_normals"}
+    q = np.float32([[0.5, 0.5, 0.5], [2, 0.5, 0.5]])
+    assert scene.compute_occupancy(q).tolist() == [1.0, 0.0]
+    assert np.allclose(scene.compute_signed_distance(q).numpy(), [-0.5, 1])
+    cp = scene.compute_closest_points(q)
+    assert set(cp) == {"points", "geometry_ids", "primitive_ids", "primitive_uvs", "primitive_normals"}
+    assert np.allclose(cp["points"].numpy()[1], [1, 0.5, 0.5])
+    with pytest.raises(ValueError, match=r"\(\.\.\., 6\)"):
+        scene.cast_rays(np.zeros((2, 3), np.float32))
