@@ -5,7 +5,8 @@
 #pragma once
 
 #include "accel/traverse.h"
-#include "queries/exact_crossing.h"
+#include "accel/wide_traverse.h"
+#include "queries/block_crossing.h"
 #include "scene/scene.h"
 
 namespace toyrt::queries {
@@ -31,21 +32,18 @@ void for_each_crossing_in_instance(const Scene& scene, uint32_t instance_id, con
   }
   const double tnear = ray.tnear, tfar = ray.tfar;
   const ExactRay exact{DVec3(org), DVec3(dir)};
-  const Vec3* vertices = mesh.vertices().data();
-  const Triangle* triangles = mesh.triangles().data();
-  const uint32_t* prim_ids = mesh.bvh().prim_ids.data();
+  const TriangleBlock* blocks = mesh.blocks().data();
   float t_max = ray.tfar;
-  traverse<false>(mesh.bvh(), make_ray_box_data(org, dir), ray.tnear, t_max,
-                  [&](uint32_t first, uint32_t count, float&) {
-                    for (uint32_t k = first; k < first + count; ++k) {
-                      const uint32_t prim = prim_ids[k];
-                      const Triangle& tri = triangles[prim];
-                      Crossing c;
-                      if (!exact_crossing(exact, vertices[tri.x], vertices[tri.y], vertices[tri.z], c)) continue;
-                      if (c.t >= tnear && c.t < tfar) visit(c, prim);
-                    }
-                    return false;  // never shrink the segment: every crossing is wanted
-                  });
+  // The wide BVH and its leaf blocks, as tracing walks them: SIMD box tests, triangles in line.
+  traverse_wide<false>(mesh.wide_bvh(), make_ray_box_data(org, dir), ray.tnear, t_max,
+                       [&](uint32_t first, uint32_t count, float&) {
+                         const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
+                         for (uint32_t k = first; k < end; ++k)
+                           block_crossings(exact, blocks[k], [&](const Crossing& c, uint32_t prim) {
+                             if (c.t >= tnear && c.t < tfar) visit(c, prim);
+                           });
+                         return false;  // never shrink the segment: every crossing is wanted
+                       });
 }
 
 // Calls visit(instance, mesh, prim, crossing) for each crossing of the scene in
