@@ -269,7 +269,7 @@ PYBIND11_MODULE(toyrt, m) {
            "surface split over meshes or instances may leak or double-count at the seam.")
       .def("list_intersections", &PyScene::list_intersections, py::arg("origins"), py::arg("directions"),
            py::arg("tnear") = 0.0f, py::arg("tfar") = std::numeric_limits<float>::infinity(),
-           py::arg("max_hits") = size_t(1) << 27, py::arg("threads") = 0,
+           py::arg("max_hits") = size_t(1) << 24, py::arg("threads") = 0,
            "Every crossing counted by count_intersections, in ray order then t order (ties by instance,\n"
            "prim). Returns a dict: ray_splits (N+1,) int64 (ray i owns entries ray_splits[i]:ray_splits[i+1]),\n"
            "ray (uint32), t, u, v (float32), mesh, instance, prim (int32). More than max_hits crossings in\n"

@@ -1,6 +1,8 @@
 """The exact geometric queries: crossing counts through edges and vertices of closed meshes (known
 answers: one crossing from inside a convex mesh, two along a line through it), the hit lists'
 order, occupancy and distances against closed forms and a float64 brute force, bad input."""
+import warnings
+
 import numpy as np
 import pytest
 import toyrt
@@ -212,3 +214,19 @@ def test_open3d_adaptor_speaks_open3d():
     assert np.allclose(cp["points"].numpy()[1], [1, 0.5, 0.5])
     with pytest.raises(ValueError, match=r"\(\.\.\., 6\)"):
         scene.cast_rays(np.zeros((2, 3), np.float32))
+
+
+def test_lbvh_built_meshes_answer_as_the_sah_ones():
+    v, f = icosphere(3)
+    o, d = aligned_rays(v, f, (0.1, 0.0, -0.1))
+    answers = []
+    for builder in ("sah", "lbvh"):
+        s = toyrt.Scene()
+        s.add_mesh(v, f)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # no OpenCL device: SAH stands in
+            s.commit(builder=builder)
+        answers.append((s.count_intersections(o, d), s.compute_distance(d), s.compute_occupancy(o + 0.9 * d)))
+    for a, b in zip(*answers):
+        assert np.array_equal(a, b)
+    assert np.all(answers[0][0] == 1) and np.all(answers[0][2])
