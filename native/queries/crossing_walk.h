@@ -1,7 +1,8 @@
 // Visits every exact crossing (queries/exact_crossing.h) of one ray with a committed scene: the
-// top-level BVH gathers the instances the ray reaches, each instance's mesh BVH the triangles.
-// Nothing is pruned by distance (every crossing is wanted), and the slab tests are the
-// conservative ones of core/bbox.h, so no box the exact test would cross in is skipped.
+// top-level BVH gathers the instances the ray reaches, each instance's wide BVH (the one tracing
+// walks) its triangle blocks. Nothing is pruned by distance (every crossing is wanted), and the
+// slab tests are the conservative ones of tracing (Ize's widening, core/bbox.h), so no box the
+// exact test would cross in is skipped.
 #pragma once
 
 #include "accel/traverse.h"
