@@ -209,13 +209,42 @@ def look_at(obj, target):
     obj.rotation_euler = (Vector(target) - obj.location).to_track_quat("-Z", "Y").to_euler()
 
 
-def point_light(name, location, power, color=(1, 1, 1), radius=0.0):
+def point_light(name, location, power, color=(1, 1, 1), radius=0.0, soft_falloff=True):
     """A point light of `power` watts; radius 0 (a true point: the closed forms and TOYRT's light)
-    unless given (Blender's default is 0.25 m in 3.4, 0 in 5.0)."""
+    unless given (Blender's default is 0.25 m in 3.4, 0 in 5.0). soft_falloff=False: a true sphere
+    (Blender 4.0+; 3.x has no such switch and ignores it)."""
     light = bpy.data.lights.new(name, "POINT")
     light.energy, light.color, light.shadow_soft_size = power, color, radius
+    if hasattr(light, "use_soft_falloff"):
+        light.use_soft_falloff = soft_falloff
     obj = link(bpy.data.objects.new(name, light))
     obj.location = location
+    return obj
+
+
+def spot_light(name, location, power, spot_size, spot_blend=0.15, radius=0.0, target=(0, 0, 0), scale=(1, 1, 1),
+               soft_falloff=True):
+    """A spot light of `power` watts at `location` pointing at `target`, its cone `spot_size`
+    radians wide (full angle), the object scaled by `scale` (Cycles 4.x follows it)."""
+    light = bpy.data.lights.new(name, "SPOT")
+    light.energy, light.shadow_soft_size = power, radius
+    light.spot_size, light.spot_blend = spot_size, spot_blend
+    if hasattr(light, "use_soft_falloff"):
+        light.use_soft_falloff = soft_falloff
+    obj = link(bpy.data.objects.new(name, light))
+    obj.location = location
+    look_at(obj, target)
+    obj.scale = scale
+    return obj
+
+
+def sun_light(name, strength, direction, angle=0.0, color=(1, 1, 1)):
+    """A sun of `strength` W/m^2 shining along `direction`, its disc `angle` radians across
+    (0: hard shadows; Blender's default is 0.526 degrees)."""
+    light = bpy.data.lights.new(name, "SUN")
+    light.energy, light.angle, light.color = strength, angle, color
+    obj = link(bpy.data.objects.new(name, light))
+    obj.rotation_euler = Vector(direction).to_track_quat("-Z", "Y").to_euler()
     return obj
 
 
@@ -251,6 +280,28 @@ def camera(location, target=None, rotation=(0, 0, 0), lens=50.0, ortho_scale=Non
         look_at(obj, target)
     bpy.context.scene.camera = obj
     return obj
+
+
+def environment_world(image, strength=1.0, rotation=(0.0, 0.0, 0.0)):
+    """The world as an Environment Texture of `image` (equirectangular) into a Background of
+    `strength`, its directions turned by a Mapping node's `rotation` (Euler XYZ, radians)."""
+    world = bpy.data.worlds.new("environment")
+    world.use_nodes = True
+    nodes, links = world.node_tree.nodes, world.node_tree.links
+    background = nodes.get("Background") or nodes.new("ShaderNodeBackground")
+    background.inputs["Strength"].default_value = strength
+    texture = nodes.new("ShaderNodeTexEnvironment")
+    texture.image = image
+    mapping = nodes.new("ShaderNodeMapping")
+    mapping.inputs["Rotation"].default_value = rotation
+    coords = nodes.new("ShaderNodeTexCoord")
+    links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+    links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
+    links.new(texture.outputs["Color"], background.inputs["Color"])
+    output = nodes.get("World Output") or nodes.new("ShaderNodeOutputWorld")
+    links.new(background.outputs["Background"], output.inputs["Surface"])
+    bpy.context.scene.world = world
+    return world
 
 
 def world(color, lights_diffuse=True):

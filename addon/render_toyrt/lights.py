@@ -6,7 +6,9 @@ parameters (`arguments()`), so sync.py sends any spec the same way, `Scene.add_l
 changed). A new light type touches this file and the core only (docs/architecture.md).
 
 Units across Blender versions: the core's area light has Blender 3.x's radiance P / (4 area)
-(docs/render.md); light_power converts 4.x's watts, exposure and unnormalized area lights."""
+(docs/render.md); light_power converts 4.x's watts, exposure and unnormalized area lights. Where
+Cycles changed a light's model between versions (a spot's cone edge, a sun's disc), the spec
+names the running version's model; point and spot lights follow use_soft_falloff (4.0+)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -20,18 +22,31 @@ Vec3 = tuple[float, float, float]
 
 
 @dataclass(frozen=True)
+class Visibility:
+    """Blender's switches of a light object, as the core's add_light keywords."""
+    visible_camera: bool = True
+    visible_specular: bool = True
+    visible_diffuse: bool = True
+    cast_shadow: bool = True
+
+    def arguments(self) -> dict:
+        return dict(visible_camera=self.visible_camera, visible_specular=self.visible_specular,
+                    visible_diffuse=self.visible_diffuse, cast_shadow=self.cast_shadow)
+
+
+@dataclass(frozen=True)
 class PointLightSpec:
     light_type: ClassVar[str] = "POINT"
     position: Vec3
     power: float                        # watts
     color: Vec3
     radius: float                       # metres (0: hard shadows)
-    visible_camera: bool = True
-    visible_specular: bool = True
+    soft_falloff: bool = True           # a disk facing the shading point (Cycles 3.x, 4.x's default)
+    visibility: Visibility = Visibility()
 
     def arguments(self) -> dict:
         return dict(position=self.position, power=self.power, color=self.color, radius=self.radius,
-                    visible_camera=self.visible_camera, visible_specular=self.visible_specular)
+                    soft_falloff=self.soft_falloff, **self.visibility.arguments())
 
 
 @dataclass(frozen=True)
@@ -43,40 +58,105 @@ class AreaLightSpec:
     size_y: float | None
     power: float                            # watts, in Blender 3.x's units (light_power)
     color: Vec3
-    visible_camera: bool = True
-    visible_specular: bool = True
+    visibility: Visibility = Visibility()
 
     def arguments(self) -> dict:
         return dict(matrix=np.array(self.matrix, np.float64), shape=self.shape, size=self.size,
-                    size_y=self.size_y, power=self.power, color=self.color,
-                    visible_camera=self.visible_camera, visible_specular=self.visible_specular)
+                    size_y=self.size_y, power=self.power, color=self.color, **self.visibility.arguments())
 
 
-LightSpec = PointLightSpec | AreaLightSpec
+@dataclass(frozen=True)
+class SpotLightSpec:
+    light_type: ClassVar[str] = "SPOT"
+    matrix: tuple[tuple[float, ...], ...]
+    power: float
+    color: Vec3
+    radius: float
+    soft_falloff: bool
+    spot_size: float                        # radians, the cone's full angle
+    spot_blend: float
+    falloff: str                            # 'SMOOTHSTEP' (Cycles 4.0+) or 'COSINE_SMOOTHSTEP' (3.x)
+    visibility: Visibility = Visibility()
+
+    def arguments(self) -> dict:
+        return dict(matrix=np.array(self.matrix, np.float64), power=self.power, color=self.color,
+                    radius=self.radius, soft_falloff=self.soft_falloff, spot_size=self.spot_size,
+                    spot_blend=self.spot_blend, falloff=self.falloff, **self.visibility.arguments())
+
+
+@dataclass(frozen=True)
+class SunLightSpec:
+    light_type: ClassVar[str] = "SUN"
+    matrix: tuple[tuple[float, ...], ...]
+    strength: float                         # W/m^2
+    color: Vec3
+    angle: float                            # radians, the disc's full angular diameter
+    disc: str                               # 'CONE' (Cycles 4.0+) or 'TANGENT_DISK' (3.x)
+    visibility: Visibility = Visibility()
+
+    def arguments(self) -> dict:
+        return dict(matrix=np.array(self.matrix, np.float64), strength=self.strength, color=self.color,
+                    angle=self.angle, disc=self.disc, **self.visibility.arguments())
+
+
+LightSpec = PointLightSpec | AreaLightSpec | SpotLightSpec | SunLightSpec
+
+
+def light_visibility(obj) -> Visibility:
+    """The light object's ray visibility (Blender 3.0+; all on by default, as in Cycles; TOYRT's
+    specular rays are Cycles' glossy and transmission rays) and its shadow switch (3.x:
+    light.cycles.cast_shadow; 4.x+: light.use_shadow)."""
+    light = obj.data
+    if hasattr(light, "use_shadow"):
+        shadow = bool(light.use_shadow)
+    else:
+        shadow = bool(getattr(getattr(light, "cycles", None), "cast_shadow", True))
+    return Visibility(visible_camera=bool(getattr(obj, "visible_camera", True)),
+                      visible_specular=bool(getattr(obj, "visible_glossy", True)
+                                            and getattr(obj, "visible_transmission", True)),
+                      visible_diffuse=bool(getattr(obj, "visible_diffuse", True)),
+                      cast_shadow=shadow)
+
+
+def _rows(matrix: np.ndarray) -> tuple[tuple[float, ...], ...]:
+    return tuple(tuple(float(v) for v in row) for row in matrix.tolist())
 
 
 def light_spec(obj, matrix: np.ndarray) -> tuple[LightSpec | None, tuple[str, ...]]:
     """An evaluated light object at `matrix` (its instance's world matrix) as a spec, or None
-    for a type the core does not have; and what was approximated."""
+    for a light that emits nothing in Cycles (a portal) or a type the core does not have; and
+    what was approximated."""
     light = obj.data
     notes = []
     color = light_color(light)
     power = light_power(light, matrix)
     if getattr(light, "use_nodes", False):
         notes.append(f"light '{obj.name}': node setup (its colour and power)")
-    # Ray visibility of the light object (Blender 3.0+; all visible by default, as in Cycles):
-    # TOYRT's specular rays are Cycles' glossy and transmission rays.
-    visible = dict(visible_camera=bool(getattr(obj, "visible_camera", True)),
-                   visible_specular=bool(getattr(obj, "visible_glossy", True)
-                                         and getattr(obj, "visible_transmission", True)))
+    visibility = light_visibility(obj)
+    cycles4 = _blender_version() >= (4, 0, 0)
+    # Blender 4.0 added use_soft_falloff (on by default): off makes point and spot lights true
+    # spheres. 3.x has no switch and always renders the soft falloff's disk.
+    soft = bool(getattr(light, "use_soft_falloff", True))
     if light.type == "POINT":
         position = tuple(float(v) for v in matrix[:3, 3])
-        return PointLightSpec(position, power, color, float(light.shadow_soft_size), **visible), tuple(notes)
+        return (PointLightSpec(position, power, color, float(light.shadow_soft_size), soft, visibility),
+                tuple(notes))
     if light.type == "AREA":
+        if getattr(getattr(light, "cycles", None), "is_portal", False):
+            return None, tuple(notes)  # a portal only guides Cycles' world sampling; it emits nothing
         shape = light.shape
         size_y = float(light.size_y) if shape in ("RECTANGLE", "ELLIPSE") else None
-        rows = tuple(tuple(float(v) for v in row) for row in matrix.tolist())
-        return AreaLightSpec(rows, shape, float(light.size), size_y, power, color, **visible), tuple(notes)
+        if float(getattr(light, "spread", np.pi)) < np.pi - 1e-6:
+            notes.append(f"area light '{obj.name}': spread (rendered as 180 degrees)")
+        return (AreaLightSpec(_rows(matrix), shape, float(light.size), size_y, power, color, visibility),
+                tuple(notes))
+    if light.type == "SPOT":
+        return (SpotLightSpec(_rows(matrix), power, color, float(light.shadow_soft_size), soft,
+                              float(light.spot_size), float(light.spot_blend),
+                              "SMOOTHSTEP" if cycles4 else "COSINE_SMOOTHSTEP", visibility), tuple(notes))
+    if light.type == "SUN":
+        return (SunLightSpec(_rows(matrix), power, color, float(light.angle),
+                             "CONE" if cycles4 else "TANGENT_DISK", visibility), tuple(notes))
     notes.append(f"{light.type.lower()} light '{obj.name}' (skipped)")
     return None, tuple(notes)
 

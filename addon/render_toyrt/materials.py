@@ -98,6 +98,21 @@ def image_pixels(image) -> np.ndarray | None:
     return np.ascontiguousarray(buf)
 
 
+def image_data(image) -> tuple[np.ndarray | None, tuple[str, ...]]:
+    """The image's pixels (image_pixels) ready for the core, and what loading it approximated
+    (image_notes). Non-finite floats (HDR files can hold inf or NaN texels) become 0 (NaN, -inf)
+    or float16's largest value (+inf), with a note: the core refuses non-finite texels, and one
+    must not fail a render or poison every pixel that samples it."""
+    pixels = image_pixels(image)
+    notes = image_notes(image, pixels)
+    if pixels is not None and pixels.dtype == np.float32:
+        bad = int(np.count_nonzero(~np.isfinite(pixels)))
+        if bad:
+            np.nan_to_num(pixels, copy=False, nan=0.0, posinf=65504.0, neginf=0.0)
+            notes += (f"image '{image.name}': {bad} non-finite values (NaN and -inf as 0, +inf as 65504)",)
+    return pixels, notes
+
+
 def image_notes(image, pixels: np.ndarray | None) -> tuple[str, ...]:
     """What loading `image` approximated: a missing image (the placeholder), or a colour space
     the core reads as linear."""

@@ -364,10 +364,18 @@ class SceneSync(MaterialSync):
     def _world(self, depsgraph) -> None:
         spec = world_spec(depsgraph.scene)
         self._note(spec.notes)
+        if spec.environment is not None:
+            # Its notes (a missing image) again for every render, as a material's texture's are.
+            env = spec.environment
+            tid = self._texture_id(env.texture, env.image) if not env.texture.placeholder else self._placeholder_id()
         if spec != self.world:
             self.scene.background = spec.background
             if spec.background_lighting is not None:
                 self.scene.background_lighting = spec.background_lighting
+            if spec.environment is None:
+                self.scene.set_environment(-1)
+            else:
+                self.scene.set_environment(tid, strength=env.strength, matrix=np.array(env.matrix))
             self.world = spec
 
     def _note(self, notes) -> None:

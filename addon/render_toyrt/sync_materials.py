@@ -45,8 +45,8 @@ class MaterialSync:
     def _texture_id(self, key: ImageKey, image) -> int:
         tid = self.textures.get(key)
         if tid is None:
-            pixels = None if key.placeholder else materials.image_pixels(image)
-            self.texture_notes[key] = () if key.placeholder else materials.image_notes(image, pixels)
+            pixels, notes = (None, ()) if key.placeholder else materials.image_data(image)
+            self.texture_notes[key] = notes
             tid = self._placeholder_id() if pixels is None else self.scene.add_texture(pixels, srgb=key.srgb)
             self.textures[key] = tid
         # Again for every material that reads it: a final render collects the notes afresh.
@@ -68,7 +68,7 @@ class MaterialSync:
         for key, tid in list(self.textures.items()):
             if key.placeholder or key.name != image.name_full:
                 continue
-            pixels = materials.image_pixels(image)
+            pixels, notes = materials.image_data(image)
             if pixels is None:
                 continue
             if tid == placeholder:
@@ -78,6 +78,6 @@ class MaterialSync:
                         self.scene.set_material(mid, **spec.arguments(tid))
             else:
                 self.scene.set_texture(tid, pixels, srgb=key.srgb)
-            self.texture_notes[key] = materials.image_notes(image, pixels)
+            self.texture_notes[key] = notes
             count += 1
         return count

@@ -1,5 +1,6 @@
 #include "lights/area_light.h"
 
+#include "lights/light_matrix.h"
 #include "lights/spherical_rectangle.h"
 
 #include <algorithm>
@@ -30,10 +31,7 @@ AreaLight AreaLight::make(AreaShape shape, float size, float size_y, const Mat4&
   require(std::isfinite(sx) && std::isfinite(sy) && sx > 0.0f && sy > 0.0f, "size must be positive and finite");
   require(std::isfinite(power) && power >= 0.0f, "power must be finite and >= 0 W");
   require(is_finite(color) && !glm::any(glm::lessThan(color, Vec3(0.0f))), "colour must be finite and >= 0");
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r) require(std::isfinite(m[c][r]), "matrix_world is not finite");
-  require(m[0][3] == 0.0f && m[1][3] == 0.0f && m[2][3] == 0.0f && m[3][3] == 1.0f,
-          "matrix_world must be affine: its last row must be 0 0 0 1");
+  check_light_matrix(m, "area light");
   const Vec3 ax(m[0]), ay(m[1]), az(m[2]);
   const float lx = glm::length(ax), ly = glm::length(ay), lz = glm::length(az);
   require(lx > 0.0f && ly > 0.0f && lz > 0.0f, "matrix_world has a zero scale");

@@ -12,6 +12,8 @@
 #include "core/type_table.h"
 #include "lights/area_light.h"
 #include "lights/point_light.h"
+#include "lights/spot_light.h"
+#include "lights/sun_light.h"
 
 #include <string>
 #include <string_view>
@@ -19,7 +21,7 @@
 
 namespace toyrt {
 
-using Light = std::variant<PointLight, AreaLight>;
+using Light = std::variant<PointLight, AreaLight, SpotLight, SunLight>;
 
 inline LightSample sample_light(const Light& light, const Vec3& p, const Vec2& u, const LightContext& ctx) {
   return std::visit([&](const auto& l) { return sample(l, p, u, ctx); }, light);
@@ -31,7 +33,7 @@ inline float light_importance(const Light& light, const Vec3& p, const Vec3& n) 
   return std::visit([&](const auto& l) { return importance(l, p, n); }, light);
 }
 
-// The light of Blender type `type` ("POINT", "AREA": the kTypes) from its parameters. Throws
+// The light of Blender type `type` ("POINT", "AREA", "SPOT", "SUN": the kTypes) from its parameters. Throws
 // std::invalid_argument for an unknown type (listing the known ones), a bad value or an argument
 // the type does not read.
 inline Light make_light(std::string_view type, const Params& params) {

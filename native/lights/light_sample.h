@@ -11,9 +11,9 @@
 namespace toyrt {
 
 struct LightSample {
-  Vec3 point{0.0f};  // the sampled point on the light
-  Vec3 wi{0.0f};     // unit direction from the shading point to `point`
-  float distance = 0.0f;
+  Vec3 point{0.0f};       // the sampled point on the light
+  Vec3 wi{0.0f};          // unit direction from the shading point to `point`
+  float distance = 0.0f;  // infinite for a light at infinity (a sun): the shadow ray is unbounded
   // Radiance arriving along -wi, W / (m^2 sr) per channel. For a delta light (a point light of
   // radius 0) there is no radiance: this holds its irradiance at normal incidence, I / d^2
   // (W / m^2), and pdf is 1, so the estimate above keeps the same form.
@@ -26,6 +26,7 @@ struct LightSample {
 // A light seen along a given direction (a BSDF-sampled ray): what the ray finds on it.
 struct LightEval {
   Vec3 radiance{0.0f};  // W / (m^2 sr); 0 if the ray misses the light or sees its back
+  // FLT_MAX for a light at infinity (a sun's disc): seen only by rays that leave the scene.
   float distance = kInfinity;
   float pdf = 0.0f;  // the light sampler's solid-angle density for this direction
   bool hit() const { return pdf > 0.0f; }

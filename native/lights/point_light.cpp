@@ -8,7 +8,7 @@
 
 namespace toyrt {
 
-PointLight PointLight::make(const Vec3& position, float power, const Vec3& color, float radius) {
+PointLight PointLight::make(const Vec3& position, float power, const Vec3& color, float radius, bool soft_falloff) {
   if (!is_finite(position)) throw std::invalid_argument("point light: position is not finite");
   if (!std::isfinite(power) || power < 0.0f)
     throw std::invalid_argument("point light: power must be finite and >= 0 W");
@@ -19,6 +19,7 @@ PointLight PointLight::make(const Vec3& position, float power, const Vec3& color
   PointLight light;
   light.position = position;
   light.radius = radius;
+  light.soft_falloff = soft_falloff;
   light.intensity = power * color / (4.0f * kPi);
   light.radiance = radius > 0.0f ? light.intensity / (kPi * radius * radius) : Vec3(0.0f);
   return light;
@@ -31,7 +32,8 @@ PointLight PointLight::from_params(const Params& params) {
   const float power = float(params.non_negative("power", d.power));
   const Vec3 color = params.color("color", d.color);
   const float radius = float(params.non_negative("radius", d.radius));
-  return make(position, power, color, radius);
+  const bool soft_falloff = params.flag("soft_falloff", d.soft_falloff);
+  return make(position, power, color, radius, soft_falloff);
 }
 
 namespace {
@@ -71,6 +73,25 @@ LightSample sample(const PointLight& light, const Vec3& p, const Vec2& u, const 
     s.delta = true;
     return s;
   }
+  if (light.soft_falloff) {
+    // The disk through the centre facing p: a uniform point on it, its density in solid angle
+    // t^2 / (pi R^2 cos_disk); cos_disk = d / t > 0 wherever p is not the centre itself.
+    if (!(d2 > 0.0f)) return s;
+    const float d = std::sqrt(d2);
+    const Vec3 axis = -to_centre / d;  // the disk's normal, towards p
+    const Vec2 q = light.radius * sample_uniform_disk_concentric(u);
+    const Frame frame = Frame::from_normal(axis);
+    s.point = light.position + frame.to_world(Vec3(q, 0.0f));
+    const Vec3 to_point = s.point - p;
+    s.distance = glm::length(to_point);
+    if (!(s.distance > 0.0f)) return s;
+    s.wi = to_point / s.distance;
+    const float cos_disk = -glm::dot(axis, s.wi);
+    if (!(cos_disk > 0.0f)) return s;
+    s.pdf = s.distance * s.distance / (kPi * light.radius * light.radius * cos_disk);
+    s.radiance = light.radiance;
+    return s;
+  }
   const bool inside = d2 <= light.radius * light.radius;
   if (inside) {
     // Radiance L arrives from every direction: sample them all.
@@ -97,6 +118,20 @@ LightEval evaluate(const PointLight& light, const Vec3& p, const Vec3& wi, const
   if (light.radius == 0.0f) return e;
   const Vec3 to_centre = light.position - p;
   const float d2 = glm::dot(to_centre, to_centre);
+  if (light.soft_falloff) {
+    // The disk facing p: the plane through the centre with normal towards p.
+    if (!(d2 > 0.0f)) return e;
+    const float d = std::sqrt(d2);
+    const float cos_disk = glm::dot(to_centre, wi) / d;  // = -dot(disk normal, wi)
+    if (!(cos_disk > 0.0f)) return e;
+    const float t = d / cos_disk;
+    const Vec3 off = p + t * wi - light.position;
+    if (!(glm::dot(off, off) <= light.radius * light.radius)) return e;
+    e.distance = t;
+    e.radiance = light.radiance;
+    e.pdf = t * t / (kPi * light.radius * light.radius * cos_disk);
+    return e;
+  }
   const bool inside = d2 <= light.radius * light.radius;
   const float t = sphere_distance(light, p, wi, inside);
   if (t < 0.0f || (!inside && glm::dot(to_centre, wi) <= 0.0f)) return e;

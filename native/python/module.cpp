@@ -117,7 +117,8 @@ PYBIND11_MODULE(toyrt, m) {
   static const std::string light_doc =
       "Adds a light of Blender type `type` with its parameters as keywords; returns its id. Types:\n" +
       type_docs<Light>() +
-      "visible_camera / visible_specular: whether camera rays / rays through glass see the light itself.\n"
+      "visible_camera / visible_specular: whether camera rays / rays through glass see the light itself;\n"
+      "visible_diffuse: whether it lights diffuse surfaces; cast_shadow: whether surfaces shadow it.\n"
       "An unknown type or keyword raises ValueError naming it; None leaves a parameter at its default.";
   static const std::string material_doc =
       "Adds a material; returns its id. kind and its parameters (other keywords than color, texture and ior\n"
@@ -150,12 +151,15 @@ PYBIND11_MODULE(toyrt, m) {
            "the bottom (Blender's Image.pixels order); srgb: decode from sRGB to linear, as Blender does.")
       .def(
           "add_light",
-          [](PyScene& self, const std::string& type, bool visible_camera, bool visible_specular,
-             const py::kwargs& params) {
-            return self.add_light(type, to_params(params), {visible_camera, visible_specular});
+          [](PyScene& self, const std::string& type, bool visible_camera, bool visible_specular, bool visible_diffuse,
+             bool cast_shadow, const py::kwargs& params) {
+            return self.add_light(type, to_params(params),
+                                  {visible_camera, visible_specular, visible_diffuse, cast_shadow});
           },
           py::arg("type"), py::arg("visible_camera") = LightVisibility{}.camera,
-          py::arg("visible_specular") = LightVisibility{}.specular, light_doc.c_str())
+          py::arg("visible_specular") = LightVisibility{}.specular,
+          py::arg("visible_diffuse") = LightVisibility{}.diffuse, py::arg("cast_shadow") = LightVisibility{}.shadow,
+          light_doc.c_str())
       .def(
           "add_point_light",
           [](PyScene& self, py::handle position, float power, py::handle color, float radius, bool visible_camera,
@@ -193,6 +197,14 @@ PYBIND11_MODULE(toyrt, m) {
           "The same as add_light('AREA', ...).")
       .def_property("background", &PyScene::background, &PyScene::set_background,
                     "Radiance (linear RGB) of rays that leave the scene: the world colour.")
+      .def("set_environment", &PyScene::set_environment, py::arg("texture"), py::arg("strength") = as_tuple(Vec3(1.0f)),
+           py::arg("matrix") = py::none(),
+           "Lights the world with texture `texture` (an equirectangular image added with add_texture), times\n"
+           "strength (linear RGB), as Blender's Environment Texture into a Background node: seen by rays that leave\n"
+           "the scene (instead of `background`) and lighting diffuse surfaces (importance-sampled by the image's\n"
+           "luminance, combined with cosine sampling). matrix: None, or a (3, 3) (or (4, 4): its rotation and scale)\n"
+           "row-major matrix taking world directions into the map's frame (the Mapping node's rotation). The image's\n"
+           "centre column looks along -X, its top row up (+Z). texture=-1 removes the environment.")
       .def_property("background_lighting", &PyScene::background_lighting, &PyScene::set_background_lighting,
                     "Whether the background also lights diffuse surfaces, as Cycles' world does (default True).")
       .def("render", &PyScene::render, py::arg("camera"), py::arg("samples") = RenderSettings{}.samples,

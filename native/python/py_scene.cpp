@@ -89,6 +89,22 @@ void PyScene::set_background_lighting(bool on) {
   write([&] { scene_.set_background_lighting(on); });
 }
 
+void PyScene::set_environment(int64_t texture, py::handle strength, py::handle matrix) {
+  const Vec3 k = to_vec3(strength, "strength");
+  // A (3, 3) rotation/scale, or a (4, 4) matrix whose upper-left 3x3 is used; None: identity.
+  glm::mat3 m(1.0f);
+  if (!matrix.is_none()) {
+    const py::array_t<double> a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(matrix);
+    if (!a || a.ndim() != 2 || a.shape(0) != a.shape(1) || (a.shape(0) != 3 && a.shape(0) != 4))
+      throw py::value_error("matrix must be None, a (3, 3) or a (4, 4) array");
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) m[c][r] = float(a.at(r, c));  // row-major in, GLM columns
+    for (int c = 0; c < 3; ++c)
+      if (!is_finite(m[c])) throw py::value_error("matrix must be finite");
+  }
+  write([&] { scene_.set_environment(texture, k, m); });
+}
+
 bool PyScene::background_lighting() {
   return read([&] { return scene_.world().background_lights_surfaces; });
 }

@@ -40,6 +40,7 @@ class PyScene {
   py::tuple background();
   void set_background_lighting(bool on);
   bool background_lighting();
+  void set_environment(int64_t texture, py::handle strength, py::handle matrix);
 
   bool commit(const std::string& builder, int threads, py::handle expected_rays, py::object should_cancel);
   py::dict last_commit();

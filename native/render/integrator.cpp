@@ -6,6 +6,9 @@
 #include "sampling/sobol_owen.h"
 #include "sampling/warp.h"
 
+#include <cmath>
+#include <limits>
+
 namespace toyrt {
 namespace {
 
@@ -52,20 +55,48 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
   const World& world = scene.world();
   const Vec3 origin = offset_ray_origin(s.p, ng);
   Vec3 sum(0.0f);
-  auto add = [&](const Light& light, float select_probability, uint32_t dim) {
-    const LightSample ls = sample_light(
-        light, s.p, sobol_owen_2d(pixel, sample, vertex_dimension(depth, dim), settings.seed), settings.area_sampling);
+  auto add = [&](size_t index, float select_probability, uint32_t dim) {
+    const LightVisibility v = world.light_visibility[index];
+    if (!v.diffuse) return;
+    const LightSample ls =
+        sample_light(world.lights[index], s.p,
+                     sobol_owen_2d(pixel, sample, vertex_dimension(depth, dim), settings.seed), settings.area_sampling);
     if (!ls.valid()) return;
     const float cos_s = glm::dot(ns, ls.wi);
     if (cos_s <= 0.0f || glm::dot(ng, ls.wi) <= 0.0f) return;  // below the shading or the true surface
-    // The shadow ray ends where the light sample is: t = 1 with an unnormalised direction.
-    const Ray shadow{origin, 0.0f, ls.point - origin, 1.0f};
-    if (scene.occluded(shadow)) return;
+    if (v.shadow) {
+      // The shadow ray ends where the light sample is: t = 1 with an unnormalised direction; a
+      // light at infinity (the sun) leaves the scene along wi.
+      const Ray shadow =
+          std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
+      if (scene.occluded(shadow)) return;
+    }
     sum += f * ls.radiance * (cos_s / (ls.pdf * select_probability));
   };
-  // The world as a light: a constant background seen over the hemisphere. A cosine-distributed
-  // direction makes the estimate f L cos / pdf = albedo L when nothing blocks it.
-  if (world.background_lights_surfaces && world.background != Vec3(0.0f)) {
+  // The world as a light. An environment map: one sample from the map's distribution and one
+  // cosine-distributed, combined by the power heuristic, so a bright sun in the map and a
+  // uniform sky are both found with little noise. A constant background: the cosine-distributed
+  // direction alone makes the estimate f L cos / pdf = albedo L when nothing blocks it, exactly.
+  if (world.background_lights_surfaces && world.environment.active()) {
+    const Environment& env = world.environment;
+    const Texture& image = scene.textures()[size_t(env.texture)];
+    const EnvironmentSample es = sample_environment(
+        env, image, sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 2), settings.seed));
+    if (es.pdf > 0.0f) {
+      const float cos_s = glm::dot(ns, es.wi);
+      if (cos_s > 0.0f && glm::dot(ng, es.wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, es.wi, kInfinity})) {
+        const float pc = cos_s * kInvPi;
+        sum += f * es.radiance * (cos_s * es.pdf / (es.pdf * es.pdf + pc * pc));
+      }
+    }
+    const Vec3 local = sample_cosine_hemisphere(
+        sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 1), settings.seed));
+    const Vec3 wi = Frame::from_normal(ns).to_world(local);
+    if (glm::dot(ng, wi) > 0.0f && local.z > 0.0f && !scene.occluded(Ray{origin, 0.0f, wi, kInfinity})) {
+      const float pc = local.z * kInvPi, pe = environment_pdf(env, wi);
+      sum += f * environment_radiance(env, image, wi) * (local.z * pc / (pe * pe + pc * pc));
+    }
+  } else if (world.background_lights_surfaces && world.background != Vec3(0.0f)) {
     const Vec3 local = sample_cosine_hemisphere(
         sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 1), settings.seed));
     const Vec3 wi = Frame::from_normal(ns).to_world(local);
@@ -74,31 +105,33 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
   }
   const std::vector<Light>& lights = world.lights;
   if (settings.light_sampling != LightSampling::One || lights.size() == 1) {
-    for (size_t j = 0; j < lights.size(); ++j) add(lights[j], 1.0f, 1 + uint32_t(j));
+    for (size_t j = 0; j < lights.size(); ++j) add(j, 1.0f, 1 + uint32_t(j));
   } else {
     const LightSelector selector(lights);
     const LightSelection pick =
         selector.select(s.p, ns, sobol_owen_1d(pixel, sample, vertex_dimension(depth, 0), settings.seed));
-    if (pick.found()) add(lights[size_t(pick.index)], pick.probability, 1);
+    if (pick.found()) add(size_t(pick.index), pick.probability, 1);
   }
   return sum;
 }
 
-// The nearest light a camera (depth 0) or specular ray sees before distance `limit` (in units of
-// the unit direction), if it is visible to that kind of ray: its radiance, or nothing.
-bool visible_light(const World& world, const Vec3& org, const Vec3& unit_dir, float from, float limit, bool camera,
-                   AreaSampling area_sampling, Vec3& radiance) {
-  bool seen = false;
+// The radiance of the lights a camera (depth 0) or specular ray passes before distance `limit`
+// (in units of the unit direction), of those visible to that kind of ray. Lights are not
+// surfaces: as in Cycles, a ray that sees one goes on, so what is behind a light (another light,
+// a surface, the world) adds to it. A light at infinity (a sun, at FLT_MAX) is part of the world:
+// seen by a ray that leaves the scene (`escaped`), whatever the camera's clip end.
+Vec3 visible_lights(const World& world, const Vec3& org, const Vec3& unit_dir, float from, float limit, bool escaped,
+                    bool camera, AreaSampling area_sampling) {
+  constexpr float kAtInfinity = std::numeric_limits<float>::max();
+  Vec3 radiance(0.0f);
   for (size_t j = 0; j < world.lights.size(); ++j) {
     const LightVisibility v = world.light_visibility[j];
     if (!(camera ? v.camera : v.specular)) continue;
     const LightEval e = evaluate_light(world.lights[j], org, unit_dir, area_sampling);
-    if (!e.hit() || !(e.distance >= from) || !(e.distance < limit)) continue;
-    limit = e.distance;
-    radiance = e.radiance;
-    seen = true;
+    if (!e.hit()) continue;
+    if (e.distance == kAtInfinity ? escaped : (e.distance >= from && e.distance < limit)) radiance += e.radiance;
   }
-  return seen;
+  return radiance;
 }
 
 // The radiance arriving along `ray`, whose first vertex is path vertex `depth` (0: the camera
@@ -112,17 +145,17 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
   for (int depth = first_depth;; ++depth) {
     const Hit hit = scene.intersect(ray);
     if (!world.lights.empty()) {
-      // A light nearer than the surface (or than nothing): the ray sees the light and ends there.
       const float length = glm::length(ray.dir);
-      Vec3 seen(0.0f);
-      if (visible_light(world, ray.org, ray.dir / length, ray.tnear * length, std::min(hit.t, ray.tfar) * length,
-                        depth == 0, settings.area_sampling, seen)) {
-        radiance += throughput * seen;
-        break;
-      }
+      radiance += throughput * visible_lights(world, ray.org, ray.dir / length, ray.tnear * length,
+                                              std::min(hit.t, ray.tfar) * length, !hit.found(), depth == 0,
+                                              settings.area_sampling);
     }
     if (!hit.found()) {
-      radiance += throughput * world.background;
+      const Environment& env = world.environment;
+      const Vec3 seen = env.active()
+                            ? environment_radiance(env, scene.textures()[size_t(env.texture)], glm::normalize(ray.dir))
+                            : world.background;
+      radiance += throughput * seen;
       break;
     }
     const SurfaceHit s = surface_at(scene, hit);

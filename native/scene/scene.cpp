@@ -119,6 +119,9 @@ void Scene::set_texture(int64_t texture, Texture replacement) {
   if (texture < 0 || size_t(texture) >= textures_.size())
     throw std::invalid_argument("unknown texture id " + std::to_string(texture));
   textures_[size_t(texture)] = std::move(replacement);
+  // The environment's sampling grid was made from the old pixels.
+  const Environment& env = world_.environment;
+  if (env.texture == texture) set_environment(texture, env.strength, env.to_map);
 }
 
 uint32_t Scene::add_light(const Light& light, LightVisibility visibility) {
@@ -136,6 +139,15 @@ void Scene::set_background(const Vec3& radiance) {
   if (!is_finite(radiance) || glm::any(glm::lessThan(radiance, Vec3(0.0f))))
     throw std::invalid_argument("background must be finite and >= 0");
   world_.background = radiance;
+}
+
+void Scene::set_environment(int64_t texture, const Vec3& strength, const glm::mat3& to_map) {
+  if (texture < 0) {
+    world_.environment = Environment{};
+    return;
+  }
+  if (size_t(texture) >= textures_.size()) throw std::invalid_argument("unknown texture id " + std::to_string(texture));
+  world_.environment = make_environment(int32_t(texture), textures_[size_t(texture)], strength, to_map);
 }
 
 void Scene::check_committed() const {

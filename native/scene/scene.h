@@ -100,6 +100,11 @@ class Scene {
   void clear_lights();                        // lights are re-sent as a whole on an edit: they are few and cheap
   void set_background(const Vec3& radiance);  // finite and >= 0
   void set_background_lighting(bool on) { world_.background_lights_surfaces = on; }
+  // The world's Environment Texture: texture `texture` (an equirectangular image) times strength,
+  // looked up along to_map * direction (scene/environment.h); it replaces the background colour
+  // for rays that leave the scene. texture -1 removes it. Throws std::invalid_argument for an
+  // unknown texture, a bad strength or a singular mapping.
+  void set_environment(int64_t texture, const Vec3& strength, const glm::mat3& to_map);
 
   // Builds what changed since the last commit: new meshes' BVHs (each with the builder
   // options.builder names, "auto" deciding per mesh) and the top level. With should_cancel, the

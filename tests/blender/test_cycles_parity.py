@@ -111,6 +111,73 @@ def scene_glass(p):
     kit.world(p["world"], lights_diffuse=p["world_lights_diffuse"])
 
 
+def scene_sun(p):
+    kit.plane("floor", 8.0, kit.diffuse("white", (0.8, 0.8, 0.8)))
+    kit.box("occluder", 0.6, (0.0, 0.0, 0.6), kit.diffuse("grey", (0.5, 0.5, 0.5)))
+    kit.sun_light("sun", p["strength"], p["direction"], angle=p["angle"])
+    camera(p["camera"], (0, 0, 0))
+    kit.world((0, 0, 0))
+
+
+def scene_spot(p):
+    kit.plane("floor", 8.0, kit.diffuse("white", (0.8, 0.8, 0.8)))
+    kit.box("occluder", 0.5, (0.3, 0.2, 0.25), kit.diffuse("grey", (0.5, 0.5, 0.5)))
+    kit.spot_light("spot", p["light"], p["power"], p["spot_size"], p["spot_blend"], radius=p["radius"],
+                   scale=p["scale"])
+    camera(p["camera"], (0, 0, 0))
+    kit.world((0, 0, 0))
+
+
+def scene_near_point(p):
+    # A 1 m light just above a floor and a box: where Cycles' soft falloff (a disk facing the
+    # shading point) and a sphere differ most (docs/render.md).
+    kit.plane("floor", 8.0, kit.diffuse("white", (0.8, 0.8, 0.8)))
+    kit.box("occluder", 0.6, (0.9, 0.0, 0.3), kit.diffuse("grey", (0.5, 0.5, 0.5)))
+    kit.point_light("lamp", p["light"], p["power"], radius=p["radius"], soft_falloff=p["soft_falloff"])
+    camera(p["camera"], (0, 0, 0))
+    kit.world((0, 0, 0))
+
+
+def sky_image(width, height, sun_elevation, sun_azimuth, sun_radiance):
+    """An equirectangular float sky (rows from the bottom): a bluish gradient above the horizon, a
+    dim brown ground below, and a small bright sun (a Gaussian a few texels wide)."""
+    v = (np.arange(height) + 0.5) / height
+    u = (np.arange(width) + 0.5) / width
+    elevation = (v - 0.5) * np.pi
+    azimuth = (0.5 - u) * 2 * np.pi
+    el, az = np.meshgrid(elevation, azimuth, indexing="ij")
+    up = np.clip(np.sin(el), 0, 1)[..., None]
+    sky = np.where(el[..., None] > 0, (0.25 + 0.5 * up) * np.array([0.45, 0.6, 1.0]), np.array([0.12, 0.09, 0.06]))
+    d = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], -1)
+    s = np.array([np.cos(sun_elevation) * np.cos(sun_azimuth), np.cos(sun_elevation) * np.sin(sun_azimuth),
+                  np.sin(sun_elevation)])
+    angle = np.arccos(np.clip(d @ s, -1, 1))
+    sky = sky + sun_radiance * np.exp(-0.5 * (angle / np.radians(2.0)) ** 2)[..., None] * np.array([1.0, 0.9, 0.75])
+    rgba = np.concatenate([sky, np.ones((height, width, 1))], axis=2).astype(np.float32)
+    return kit.image("sky", rgba, float_buffer=True)
+
+
+def scene_hdri(p):
+    kit.plane("floor", 8.0, kit.diffuse("white", (0.8, 0.8, 0.8)))
+    kit.box("occluder", 0.8, (0.0, 0.0, 0.4), kit.diffuse("red", (0.7, 0.2, 0.1)))
+    kit.environment_world(sky_image(128, 64, *p["sun"]), p["strength"], p["rotation"])
+    camera(p["camera"], (0, 0, 0.3))
+
+
+# A real file: five 1 m point lights of 100 W a metre above a torus, from Debian's assimp-testmodels
+# (Blender 2.50; the Makefile installs it). Its own camera, lights and grey world.
+TORUS_FILE = Path("/usr/share/assimp/models/BLEND/TorusLightsCams_250_compressed.blend")
+
+
+def scene_torus_file(p):
+    with bpy.data.libraries.load(str(TORUS_FILE)) as (src, dst):
+        dst.objects = list(src.objects)
+    for obj in dst.objects:
+        kit.link(obj)
+    bpy.context.scene.camera = bpy.data.objects["Camera"]
+    kit.world((0.05087609,) * 3)
+
+
 SCENES_SPEC = [
     ("point", scene_point, dict(light=(1.0, 1.2, 2.5), power=150.0, radius=0.0, camera=(0.0, -6.0, 4.5)), 0),
     ("three_rgb_points", scene_rgb, dict(lights=[((-1.5, -1.0, 2.0), 60.0, (1.0, 0.1, 0.1)),
@@ -130,6 +197,27 @@ SCENES_SPEC = [
                                                      hide_light_from_specular=True, world_lights_diffuse=False,
                                                      float_texture=True,
                                                      camera=(0.0, -5.0, 2.5)), 8),
+    ("sun_hard_shadow", scene_sun, dict(strength=3.0, direction=(-0.4, 0.5, -1.0), angle=0.0,
+                                        camera=(0.0, -6.0, 4.5)), 0),
+    ("sun_soft_shadow", scene_sun, dict(strength=3.0, direction=(-0.4, 0.5, -1.0), angle=0.35,
+                                        camera=(0.0, -6.0, 4.5)), 0),
+    ("spot", scene_spot, dict(light=(1.0, -1.0, 3.0), power=400.0, spot_size=0.9, spot_blend=0.3, radius=0.0,
+                              scale=(1.0, 1.0, 1.0), camera=(0.0, -6.0, 4.5)), 0),
+    # A round spot scaled along one axis: Cycles 4.x widens its cone there, 3.x does not.
+    ("spot_soft_scaled", scene_spot, dict(light=(-1.0, -1.0, 2.5), power=400.0, spot_size=0.8, spot_blend=0.15,
+                                          radius=0.3, scale=(1.8, 1.0, 1.0), camera=(0.0, -6.0, 4.5)), 0),
+    ("point_near_soft_falloff", scene_near_point, dict(light=(0.0, 0.0, 1.2), power=150.0, radius=1.0,
+                                                       soft_falloff=True, camera=(0.0, -6.0, 4.5)), 0),
+    ("point_near_sphere", scene_near_point, dict(light=(0.0, 0.0, 1.2), power=150.0, radius=1.0,
+                                                 soft_falloff=False, camera=(0.0, -6.0, 4.5)), 0),
+    # An HDRI world with a small bright sun, turned by a Mapping node; seen by the camera above the
+    # horizon and lighting the floor and the box.
+    ("hdri_sky", scene_hdri, dict(sun=(0.6, 0.8, 60.0), strength=1.5, rotation=(0.0, 0.0, 0.7),
+                                  camera=(0.0, -6.0, 2.0)), 0),
+    # Cycles 4.x/5.x renders this file's torus 2.6 % darker than 3.4 does, with no difference on
+    # simpler scenes with the same lights (docs/parity-blender-5.0.md): measured and reported
+    # there, asserted on 3.4 only until the cause is found.
+    ("torus_file", scene_torus_file, dict(file=TORUS_FILE.name, asserted_before=(4, 0, 0)), 0),
     # Cycles' defaults: the light is seen through and in the glass (camera, glossy and transmission
     # rays see it), and the world lights the floor, as in TOYRT.
     ("glass_sphere_visible_light", scene_glass, dict(light=(1.0, -1.0, 3.0), power=120.0, ior=1.45, uv_repeat=4.0,
@@ -237,12 +325,14 @@ def main():
         assert img.shape == ref.shape, f"{name}: TOYRT {img.shape} vs Cycles {ref.shape}"
         mean_rel, frac, bias = compare(img, ref)
         ok = mean_rel <= MEAN_LIMIT and frac <= PIXEL_LIMIT
+        asserted = tuple(bpy.app.version) < tuple(params.get("asserted_before", (99, 0, 0)))
         save_png(out_dir / f"{name}-toyrt.png", img)
         save_png(out_dir / f"{name}-cycles.png", ref)
         np.save(out_dir / f"{name}-toyrt.npy", img)
         np.save(out_dir / f"{name}-cycles.npy", ref)
+        verdict = "ok" if ok else "FAIL" if asserted else "gap (reported)"
         print(f"  mean |diff| / mean = {mean_rel * 100:.3f} % (signed {bias * 100:+.3f} %), "
-              f"pixels > {PIXEL_FAIL}: {frac * 100:.3f} %  -> {'ok' if ok else 'FAIL'}", flush=True)
+              f"pixels > {PIXEL_FAIL}: {frac * 100:.3f} %  -> {verdict}", flush=True)
         print(f"  TOYRT {toyrt_spp} spp: {toyrt_s:.2f} s render (+{t1 - t0:.3f} s export+commit); "
               f"Cycles {cycles_spp} spp: {cycles_s:.2f} s{' (cached)' if cached else ''}; "
               f"export: {stats['meshes']} meshes, {stats['instances']} instances, {stats['lights']} lights, "
@@ -251,8 +341,8 @@ def main():
             print(f"  warning: {warnings}", flush=True)
         results.append(dict(name=name, mean_rel=mean_rel, frac=frac, bias=bias, ok=ok, toyrt_s=toyrt_s,
                             export_s=t1 - t0, cycles_s=cycles_s, mean_ref=float(ref[..., :3].mean()),
-                            toyrt_spp=toyrt_spp, cycles_spp=cycles_spp))
-        if not ok:
+                            toyrt_spp=toyrt_spp, cycles_spp=cycles_spp, asserted=asserted))
+        if not ok and asserted:
             failures.append(name)
     write_doc(results)
     return results, failures
@@ -285,7 +375,8 @@ def write_doc(results):
     for r in results:
         lines.append(f"| {r['name']} | {r['mean_rel'] * 100:.3f} % | {r['bias'] * 100:+.3f} % | "
                      f"{r['frac'] * 100:.3f} % | "
-                     f"{'pass' if r['ok'] else 'FAIL'} | {r['toyrt_s']:.2f} s ({r['toyrt_spp']} spp) | "
+                     f"{'pass' if r['ok'] else 'FAIL' if r['asserted'] else 'gap (reported)'} | "
+                     f"{r['toyrt_s']:.2f} s ({r['toyrt_spp']} spp) | "
                      f"{r['cycles_s']:.2f} s ({r['cycles_spp']} spp) |")
     lines += [
         "",
@@ -293,12 +384,25 @@ def write_doc(results):
         "scene sync; a cached reference keeps the time of the run that made it).",
         "",
         "Notes:",
-        ("- The point lights have radius 0: Cycles 3.4 renders a point light of radius R as a disk facing the "
-         "shading point, TOYRT as a sphere (they differ by about R^2/d^2; see docs/render.md)."
+        ("- Point and spot lights of radius R: Cycles 3.4 renders them as a disk facing the shading point "
+         "(Blender 4.0's soft falloff, on by default), and so does TOYRT (docs/render.md); point_near_sphere "
+         "asks for a sphere, which 3.4 cannot make, so both render the disk. The sun is 3.4's tangent-disk "
+         "disc, the spot 3.4's cosine-times-smoothstep edge, which ignores the object's scale "
+         "(spot_soft_scaled). torus_file is TorusLightsCams_250_compressed.blend from Debian's "
+         "assimp-testmodels: five 1 m lights of 100 W a metre above a torus; it rendered 24 % brighter "
+         "when TOYRT made every round light a sphere."
          if bpy.app.version < (4, 0, 0) else
          "- Area lights: Cycles 4.x and later give an area light of power P the radiance P / (pi A), 3.4 "
-         "P / (4 A); the exporter scales the power by 4 / pi on 4.x (docs/blender.md). Point lights of radius R "
-         "are spheres here, as in TOYRT."),
+         "P / (4 A); the exporter scales the power by 4 / pi on 4.x (docs/blender.md). Point and spot lights of "
+         "radius R follow use_soft_falloff: a disk facing the shading point (on, the default) or a sphere "
+         "(point_near_sphere). Sun discs have uniform radiance over their cone; spot edges are a smoothstep "
+         "in the object's scaled frame (spot_soft_scaled widens along its scaled axis).\n"
+         "- torus_file (TorusLightsCams_250_compressed.blend, Debian's assimp-testmodels) is reported, not "
+         "asserted: Cycles 5.0 renders its torus 2.6 % darker than Cycles 3.4 with the same five 1 m lights "
+         "(world black: 0.02490 against 0.02557), TOYRT renders both versions alike (as 3.4, within 0.1 %). "
+         "Simple cases with the same lights agree between the two Cycles versions to 0.01 % (a floor under a "
+         "1 m light at 0.5-2 m, inside its radius too; a sphere lit from 0.6 m), so the cause is not the light "
+         "model; not found yet."),
         "- Lights are seen by camera rays and through glass (Blender's per-object ray visibility, which the "
         "exporter passes on): glass_sphere_visible_light keeps Cycles' defaults and passes at 4x the samples "
         "(the light's image through the sphere is the noisiest part of both renders); glass_sphere and "
@@ -326,6 +430,8 @@ if __name__ == "__main__":
         traceback.print_exc()
         print("parity: 0 passed, 1 failed (error)", flush=True)
         sys.exit(1)
-    print(f"parity: {len(results) - len(failures)} passed, {len(failures)} failed"
-          + (f" ({', '.join(failures)})" if failures else ""), flush=True)
+    gaps = [r["name"] for r in results if not r["ok"] and not r["asserted"]]
+    print(f"parity: {sum(r['ok'] for r in results)} passed, {len(failures)} failed"
+          + (f" ({', '.join(failures)})" if failures else "")
+          + (f"; reported, not asserted: {', '.join(gaps)}" if gaps else ""), flush=True)
     sys.exit(1 if failures else 0)

@@ -8,6 +8,7 @@
 #include "lights/spherical_rectangle.h"
 #include "sampling/rng.h"
 
+#include "light_estimates.h"
 #include "statistics.h"
 
 #include <gtest/gtest.h>
@@ -20,43 +21,9 @@
 
 using namespace toyrt;
 using toyrt::testing::chi_square_quantile;
+using namespace toyrt::testing;
 
 namespace {
-
-constexpr double kPiD = 3.14159265358979323846;
-
-Vec2 rand2(uint32_t i, uint32_t seed) { return {random_float(i, 0, 0, seed), random_float(i, 0, 1, seed)}; }
-
-// Mean and standard error of n samples of an estimator.
-struct Estimate {
-  double mean = 0.0, standard_error = 0.0;
-};
-Estimate monte_carlo(int n, const std::function<double(uint32_t)>& sample) {
-  double sum = 0.0, sum2 = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const double x = sample(uint32_t(i));
-    sum += x;
-    sum2 += x * x;
-  }
-  const double mean = sum / n, variance = std::max(0.0, sum2 / n - mean * mean);
-  return {mean, std::sqrt(variance / n)};
-}
-
-// The estimate agrees with the exact value within 4 standard errors (a 6e-5 chance of failing a
-// correct estimator, and the inputs are fixed), plus float rounding.
-void expect_converges(const Estimate& e, double exact, const char* what) {
-  EXPECT_NEAR(e.mean, exact, 4.0 * e.standard_error + 1e-5 * std::fabs(exact))
-      << what << ": standard error " << e.standard_error;
-}
-
-// Direct irradiance at p with normal n (red channel) from one light sample; `sampling` is the
-// render's estimator for rectangular area lights.
-double irradiance_sample(const Light& light, const Vec3& p, const Vec3& n, const Vec2& u,
-                         AreaSampling sampling = AreaSampling::SolidAngle) {
-  const LightSample s = sample_light(light, p, u, sampling);
-  if (!s.valid()) return 0.0;
-  return double(s.radiance.x) * std::max(0.0f, glm::dot(n, s.wi)) / s.pdf;
-}
 
 // Point at height h under a corner of a parallel a x b rectangle of radiance L, receiver facing it:
 // E = pi L F with the configuration factor of Howell's catalogue (differential element to a
@@ -136,7 +103,7 @@ TEST(SphereLight, RadianceEmitsThePowerOfThePointLight) {
 TEST(SphereLight, IrradianceEqualsPointLightWhileAboveTheHorizon) {
   // A uniform sphere entirely above the receiver's tangent plane gives exactly I cos / d^2.
   const float power = 100.0f, radius = 0.3f;
-  const Light light = PointLight::make(Vec3(0, 0, 1), power, Vec3(1.0f), radius);
+  const Light light = PointLight::make(Vec3(0, 0, 1), power, Vec3(1.0f), radius, /*soft_falloff=*/false);
   const double intensity = power / (4.0 * kPiD);
   const double theta_max = std::asin(radius / 1.0);
   for (double tilt : {0.0, 0.5, 1.2}) {
@@ -151,7 +118,7 @@ TEST(SphereLight, IrradianceEqualsPointLightWhileAboveTheHorizon) {
 TEST(SphereLight, ConeSamplesLieOnTheVisibleCapWithConstantPdf) {
   const Vec3 centre(0.5f, -1.0f, 2.0f);
   const float radius = 0.4f;
-  const PointLight light = PointLight::make(centre, 10.0f, Vec3(1.0f), radius);
+  const PointLight light = PointLight::make(centre, 10.0f, Vec3(1.0f), radius, /*soft_falloff=*/false);
   for (Vec3 p : {Vec3(0.0f), Vec3(0.5f, -1.0f, 1.5f), Vec3(30.0f, 2.0f, -4.0f)}) {
     const double d = glm::length(DVec3(centre - p));
     const double expected_pdf = 1.0 / (2.0 * kPiD * (1.0 - std::sqrt(1.0 - radius * radius / (d * d))));
@@ -173,7 +140,7 @@ TEST(SphereLight, ConeSamplesLieOnTheVisibleCapWithConstantPdf) {
 }
 
 TEST(SphereLight, InsideTheSphereIrradianceIsPiL) {
-  const Light light = PointLight::make(Vec3(0), 50.0f, Vec3(1.0f), 1.0f);
+  const Light light = PointLight::make(Vec3(0), 50.0f, Vec3(1.0f), 1.0f, /*soft_falloff=*/false);
   const double radiance = std::get<PointLight>(light).radiance.x;
   const Vec3 n = glm::normalize(Vec3(0.3f, -1.0f, 0.2f));
   const Estimate e = monte_carlo(

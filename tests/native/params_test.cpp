@@ -74,7 +74,8 @@ TEST(Params, BadValueNamesTheTypeTheArgumentAndTheRequirement) {
 }
 
 TEST(Params, UnknownTypeListsTheKnownOnes) {
-  EXPECT_EQ(refusal([] { make_light("SUN", {}); }), "unknown light type 'SUN': expected 'POINT' or 'AREA'");
+  EXPECT_EQ(refusal([] { make_light("HEMI", {}); }),
+            "unknown light type 'HEMI': expected 'POINT', 'AREA', 'SPOT' or 'SUN'");
   EXPECT_EQ(refusal([] { make_material("metal", {}); }),
             "unknown material kind 'metal': expected 'diffuse', 'refraction' or 'glass'");
 }

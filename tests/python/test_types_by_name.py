@@ -37,8 +37,8 @@ def test_add_light_area_renders_the_same_image_as_add_area_light():
 
 
 def test_unknown_light_type_lists_the_known_ones():
-    with pytest.raises(ValueError, match="unknown light type 'SUN': expected 'POINT' or 'AREA'"):
-        toyrt.Scene().add_light("SUN", angle=0.1)
+    with pytest.raises(ValueError, match="unknown light type 'HEMI': expected 'POINT', 'AREA', 'SPOT' or 'SUN'"):
+        toyrt.Scene().add_light("HEMI", angle=0.1)
 
 
 def test_unknown_keyword_is_named():

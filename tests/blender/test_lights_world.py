@@ -1,0 +1,135 @@
+# Runs inside Blender:  blender -b --python-exit-code 1 --python tests/blender/test_lights_world.py
+# (`make test` runs it, also under the bpy module: tests/blender/run_with_bpy.py).
+#
+# Blender's lights and worlds through F12, against closed forms and for bad input (issue 13):
+#   a sun over a floor             the pixel is albedo / pi x strength x cos (no noise: a delta sun)
+#   a portal area light            exported as nothing (it emits nothing in Cycles)
+#   a light with shadows off       its occluder casts no shadow (3.x cycles.cast_shadow, 4.x+ use_shadow)
+#   an Environment Texture world   a missing image: the render finishes, one note names it, the sky
+#                                  is the magenta placeholder; inf and NaN texels: a note, a finite
+#                                  image; a 1 x 1 image: a uniform world (the floor's albedo x L)
+import math
+import os
+import sys
+import tempfile
+
+import bpy
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]
+import kit  # noqa: E402
+from harness import check, render_still, run_script  # noqa: E402
+
+TMP = tempfile.mkdtemp(prefix="toyrt-test-lights-world-")
+
+
+def scene_with_floor(albedo=0.8):
+    scene = kit.clear_scene()
+    kit.output(scene, 16, 16)
+    kit.float_exr(scene)
+    kit.toyrt(scene, samples=4, seed=0)
+    kit.plane("floor", 40.0, kit.diffuse("floor", (albedo,) * 3))
+    kit.camera((0, 0, 10), ortho_scale=4.0, clip=(0.1, 100.0))
+    kit.world((0, 0, 0))
+    return scene
+
+
+def render(name):
+    path = os.path.join(TMP, name + ".exr")
+    result, log = render_still(path)
+    return result, kit.read_image(path) if os.path.exists(path) else None, log
+
+
+def notes_of_export():
+    """What the scene sync approximated or fell back on (the notes F12 reports), from a one-shot sync."""
+    import render_toyrt
+    from render_toyrt import sync
+    notes = []
+    _, _, stats = sync.export_scene(bpy.context.evaluated_depsgraph_get(), render_toyrt.native(),
+                                    report=lambda kind, msg: notes.append(msg))
+    return stats, " ".join(notes) + " " + " ".join(stats["approximated"])
+
+
+def test_sun_over_a_floor_gives_strength_cos_over_pi():
+    scene_with_floor(0.8)
+    tilt = 0.5
+    kit.sun_light("sun", 3.0, (math.sin(tilt), 0.0, -math.cos(tilt)), angle=0.0)
+    result, px, _ = render("sun")
+    expected = 0.8 / math.pi * 3.0 * math.cos(tilt)
+    got = float(px[..., 0].mean()) if px is not None else float("nan")
+    check(result == {"FINISHED"} and abs(got - expected) <= 1e-4 * expected,
+          f"a sun of 3 W/m^2 at {tilt} rad: pixel {got:.5f}, closed form {expected:.5f}")
+
+
+def test_portal_is_not_a_light():
+    scene_with_floor()
+    panel = kit.area_light("portal", (0, 0, 3), 500.0, 2.0)
+    panel.data.cycles.is_portal = True
+    stats, _ = notes_of_export()
+    result, px, _ = render("portal")
+    check(stats["lights"] == 0 and px is not None and not px[..., :3].any(),
+          f"a portal exports no light ({stats['lights']}) and lights nothing")
+
+
+def test_shadow_switch_removes_the_shadow():
+    scene_with_floor()
+    kit.box("blocker", 2.0, (0, 0, 3), kit.diffuse("grey"))
+    kit.camera((0, 0, 1.5), ortho_scale=1.0, clip=(0.1, 100.0))  # below the blocker, seeing the floor
+    sun = kit.sun_light("sun", 2.0, (0.0, 0.0, -1.0), angle=0.0)
+    _, shadowed, _ = render("shadowed")
+    if hasattr(sun.data, "use_shadow"):
+        sun.data.use_shadow = False   # 4.x+
+    else:
+        sun.data.cycles.cast_shadow = False
+    _, unshadowed, _ = render("unshadowed")
+    lit = 0.8 / math.pi * 2.0
+    check(shadowed is not None and shadowed[8, 8, 0] == 0.0 and abs(unshadowed[8, 8, 0] - lit) <= 1e-4 * lit,
+          f"under the blocker: {shadowed[8, 8, 0]:.4f} with shadows, {unshadowed[8, 8, 0]:.4f} without (lit {lit:.4f})")
+
+
+def environment(pixels, name):
+    rgba = np.concatenate([pixels, np.ones(pixels.shape[:2] + (1,), np.float32)], axis=2)
+    return kit.environment_world(kit.image(name, rgba, float_buffer=True))
+
+
+def test_missing_environment_image_is_magenta_with_one_note():
+    scene_with_floor()
+    image = bpy.data.images.new("gone_sky", 4, 2, float_buffer=True)
+    image.source = "FILE"
+    image.filepath = os.path.join(TMP, "no-such-dir", "sky.exr")
+    kit.environment_world(image)
+    kit.camera((0, 0, 0), rotation=(math.pi, 0, 0), ortho_scale=1.0)   # looking straight up at the sky
+    _, notes = notes_of_export()
+    result, px, _ = render("missing_sky")
+    r, g, b = px[..., :3].reshape(-1, 3).mean(0) if px is not None else (0, 0, 0)
+    check(result == {"FINISHED"} and "gone_sky" in notes and "magenta" in notes and g == 0.0 and r > 0.5,
+          f"a missing HDRI: the render finishes, the note names it, the sky is magenta ({r:.2f} {g:.2f} {b:.2f})")
+
+
+def test_non_finite_texels_are_noted_and_the_image_stays_finite():
+    scene_with_floor()
+    sky = np.full((8, 16, 3), 0.5, np.float32)
+    sky[6, 3] = np.inf
+    sky[2, 9] = np.nan
+    environment(sky, "bad_sky")
+    _, notes = notes_of_export()
+    result, px, _ = render("bad_sky")
+    check(result == {"FINISHED"} and "non-finite" in notes and px is not None and np.isfinite(px).all(),
+          f"inf and NaN texels: a note ({'non-finite' in notes}) and a finite image")
+
+
+def test_one_pixel_environment_is_a_uniform_world():
+    scene_with_floor(0.5)
+    environment(np.full((1, 1, 3), 0.6, np.float32), "one_pixel")
+    kit.toyrt(bpy.context.scene, samples=64, seed=0)
+    result, px, _ = render("one_pixel")
+    got = float(px[..., 0].mean()) if px is not None else float("nan")
+    check(result == {"FINISHED"} and abs(got - 0.3) <= 0.01 * 0.3,
+          f"a 1 x 1 environment of 0.6 lights a floor of albedo 0.5 with {got:.4f} (0.3)")
+
+
+PARTS = [test_sun_over_a_floor_gives_strength_cos_over_pi, test_portal_is_not_a_light,
+         test_shadow_switch_removes_the_shadow, test_missing_environment_image_is_magenta_with_one_note,
+         test_non_finite_texels_are_noted_and_the_image_stays_finite, test_one_pixel_environment_is_a_uniform_world]
+run_script(PARTS, "lights and world", TMP)

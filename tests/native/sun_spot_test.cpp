@@ -1,0 +1,217 @@
+// Blender's sun and spot lights and the point light's soft falloff against closed forms: a
+// delta sun's S cos, a cone sun's S for a facing surface, a tangent-disk sun's
+// S 2 (sqrt(1 + T^2) - 1) / T^2, a disk facing the receiver's I / (d^2 + R^2) on its axis, a
+// spot's cone edge in both of Cycles' falloffs (and its elliptic cone under non-uniform scale);
+// evaluate() agreeing with sample() on the density and radiance of the same direction.
+#include "lights/light.h"
+
+#include "light_estimates.h"
+
+#include <gtest/gtest.h>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+using namespace toyrt;
+using namespace toyrt::testing;
+
+namespace {
+
+// A light object at `position` whose local -Z points along `down` (Blender's orientation).
+Mat4 aimed(const Vec3& position, const Vec3& down, const Vec3& scale = Vec3(1.0f)) {
+  const Vec3 z = -glm::normalize(down);
+  const Vec3 helper = std::fabs(z.z) < 0.9f ? Vec3(0, 0, 1) : Vec3(1, 0, 0);
+  const Vec3 x = glm::normalize(glm::cross(helper, z)), y = glm::cross(z, x);
+  Mat4 m(1.0f);
+  m[0] = glm::vec4(x * scale.x, 0.0f);
+  m[1] = glm::vec4(y * scale.y, 0.0f);
+  m[2] = glm::vec4(z * scale.z, 0.0f);
+  m[3] = glm::vec4(position, 1.0f);
+  return m;
+}
+
+SunLight sun(float strength, float angle, SunDisc disc, const Vec3& down = Vec3(0, 0, -1)) {
+  SunLight::Settings s;
+  s.matrix = aimed(Vec3(0.0f), down);
+  s.strength = strength;
+  s.angle = angle;
+  s.disc = disc;
+  return SunLight::make(s);
+}
+
+double smoothstep(double x) { return x <= 0 ? 0 : x >= 1 ? 1 : x * x * (3 - 2 * x); }
+
+}  // namespace
+
+TEST(SunLight, DeltaSunGivesStrengthTimesCosine) {
+  for (float tilt : {0.0f, 0.4f, 1.3f}) {
+    const Light light = sun(3.0f, 0.0f, SunDisc::Cone, Vec3(std::sin(tilt), 0.0f, -std::cos(tilt)));
+    const LightSample s = sample_light(light, Vec3(5, 1, 0), Vec2(0.3f), {});
+    EXPECT_TRUE(s.delta);
+    EXPECT_TRUE(std::isinf(s.distance));
+    EXPECT_NEAR(irradiance_sample(light, Vec3(5, 1, 0), Vec3(0, 0, 1), Vec2(0.3f)), 3.0 * std::cos(tilt), 1e-5);
+    // A delta direction cannot be seen.
+    EXPECT_FALSE(evaluate_light(light, Vec3(0.0f), s.wi, {}).hit());
+  }
+}
+
+TEST(SunLight, ConeDiscGivesAFacingSurfaceExactlyTheStrength) {
+  const float angle = 0.3f;  // a large disc, so the cosine over it matters
+  const Light light = sun(2.0f, angle, SunDisc::Cone);
+  const Estimate e =
+      monte_carlo(20000, [&](uint32_t i) { return irradiance_sample(light, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 11)); });
+  expect_converges(e, 2.0, "cone sun");
+}
+
+TEST(SunLight, TangentDiskSunGivesItsClosedForm) {
+  // Directions through a uniform disk of radius T = tan h at unit distance, each sample S cos:
+  // E = S mean(1 / sqrt(1 + rho^2)) = S 2 (sqrt(1 + T^2) - 1) / T^2 for a facing surface.
+  const float angle = 0.5f;
+  const double t = std::tan(0.25);
+  const Light light = sun(1.0f, angle, SunDisc::TangentDisk);
+  const Estimate e =
+      monte_carlo(20000, [&](uint32_t i) { return irradiance_sample(light, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 12)); });
+  expect_converges(e, 2.0 * (std::sqrt(1.0 + t * t) - 1.0) / (t * t), "tangent-disk sun");
+}
+
+TEST(SunLight, EvaluateAgreesWithSampleInsideTheDiscAndSeesNothingOutside) {
+  for (SunDisc disc : {SunDisc::Cone, SunDisc::TangentDisk}) {
+    const Light light = sun(1.5f, 0.2f, disc, glm::normalize(Vec3(0.3f, 0.1f, -1.0f)));
+    for (uint32_t i = 0; i < 64; ++i) {
+      const LightSample s = sample_light(light, Vec3(1, 2, 3), rand2(i, 13), {});
+      ASSERT_TRUE(s.valid());
+      const LightEval e = evaluate_light(light, Vec3(-4, 0, 1), s.wi, {});
+      ASSERT_TRUE(e.hit());
+      EXPECT_NEAR(e.pdf, s.pdf, 1e-4f * s.pdf);
+      EXPECT_NEAR(e.radiance.x, s.radiance.x, 1e-4f * s.radiance.x);
+      EXPECT_EQ(e.distance, std::numeric_limits<float>::max());  // behind any surface
+    }
+    EXPECT_FALSE(evaluate_light(light, Vec3(0.0f), Vec3(0, 0, 1), {}).hit());  // 17 degrees off a 5.7 degree disc
+  }
+}
+
+TEST(SunLight, ImportanceIsZeroOnlyWhenTheWholeDiscIsBelowTheHorizon) {
+  const float angle = 0.2f;  // half-angle 0.1 rad
+  // The sun 0.05 rad below the horizon of the receiver: part of its disc is still above.
+  const Light low = sun(1.0f, angle, SunDisc::Cone, Vec3(std::cos(0.05f), 0.0f, std::sin(0.05f)));
+  EXPECT_GT(light_importance(low, Vec3(0.0f), Vec3(0, 0, 1)), 0.0f);
+  const Light set = sun(1.0f, angle, SunDisc::Cone, Vec3(std::cos(0.15f), 0.0f, std::sin(0.15f)));
+  EXPECT_EQ(light_importance(set, Vec3(0.0f), Vec3(0, 0, 1)), 0.0f);
+}
+
+TEST(SunLight, RefusesBadSettings) {
+  EXPECT_THROW(sun(-1.0f, 0.0f, SunDisc::Cone), std::invalid_argument);
+  EXPECT_THROW(sun(1.0f, -0.1f, SunDisc::Cone), std::invalid_argument);
+  EXPECT_THROW(sun(1.0f, 4.0f, SunDisc::Cone), std::invalid_argument);
+  EXPECT_THROW(sun(NAN, 0.0f, SunDisc::Cone), std::invalid_argument);
+  EXPECT_THROW(make_light("SUN", Params({{"disc", std::string("ROUND")}})), std::invalid_argument);
+}
+
+TEST(SoftFalloff, DiskFacingTheReceiverGivesIntensityOverDistanceSquaredPlusRadiusSquared) {
+  // A Lambertian disk of radiance I / (pi R^2) facing a receiver on its axis at distance d:
+  // E = pi L R^2 / (d^2 + R^2) = I / (d^2 + R^2); half the sphere's I / d^2 at d = R.
+  const float power = 100.0f;
+  const double intensity = power / (4.0 * kPiD);
+  for (float radius : {0.1f, 1.0f}) {
+    for (float d : {1.0f, 3.0f}) {
+      const Light light = PointLight::make(Vec3(0, 0, d), power, Vec3(1.0f), radius);
+      const Estimate e = monte_carlo(
+          20000, [&](uint32_t i) { return irradiance_sample(light, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 14)); });
+      expect_converges(e, intensity / (double(d) * d + double(radius) * radius), "soft falloff disk");
+    }
+  }
+}
+
+TEST(SoftFalloff, EvaluateAgreesWithSampleOnTheDisk) {
+  const Light light = PointLight::make(Vec3(0.5f, -1.0f, 2.0f), 50.0f, Vec3(1.0f), 0.4f);
+  for (Vec3 p : {Vec3(0.0f), Vec3(0.6f, -1.1f, 1.9f), Vec3(20.0f, 3.0f, -1.0f)}) {
+    for (uint32_t i = 0; i < 64; ++i) {
+      const LightSample s = sample_light(light, p, rand2(i, 15), {});
+      ASSERT_TRUE(s.valid());
+      EXPECT_NEAR(glm::length(s.point - Vec3(0.5f, -1.0f, 2.0f)), 0.0f, 0.4001f);
+      const LightEval e = evaluate_light(light, p, s.wi, {});
+      ASSERT_TRUE(e.hit());
+      EXPECT_NEAR(e.distance, s.distance, 1e-4f * s.distance);
+      EXPECT_NEAR(e.pdf, s.pdf, 2e-3f * s.pdf);
+    }
+  }
+}
+
+TEST(SpotLight, DeltaSpotFollowsBothCyclesFalloffs) {
+  // A spot 2 m above the origin pointing down, 60 degree cone, blend 0.4; receivers on the
+  // floor at angles from the axis inside, within and outside the soft edge.
+  const float size = 60.0f * float(kPiD) / 180.0f, blend = 0.4f, power = 80.0f;
+  const double cos_half = std::cos(0.5 * size), width = (1.0 - cos_half) * blend;
+  for (SpotFalloff falloff : {SpotFalloff::Smoothstep, SpotFalloff::CosineSmoothstep}) {
+    SpotLight::Settings s;
+    s.matrix = aimed(Vec3(0, 0, 2), Vec3(0, 0, -1));
+    s.power = power;
+    s.spot_size = size;
+    s.spot_blend = blend;
+    s.falloff = falloff;
+    const Light light = SpotLight::make(s);
+    for (double degrees : {0.0, 10.0, 25.0, 28.0, 29.9, 31.0, 50.0}) {
+      const double a = degrees * kPiD / 180.0;
+      const Vec3 p(float(2.0 * std::tan(a)), 0.0f, 0.0f);
+      const double d2 = 4.0 / (std::cos(a) * std::cos(a));
+      const double c = std::cos(a);
+      double factor = c > cos_half ? smoothstep((c - cos_half) / width) : 0.0;
+      if (falloff == SpotFalloff::CosineSmoothstep) factor *= c;
+      const double exact = power / (4.0 * kPiD) * factor * c / d2;  // receiver cosine = c
+      EXPECT_NEAR(irradiance_sample(light, p, Vec3(0, 0, 1), Vec2(0.5f)), exact, 1e-4 * power / (4.0 * kPiD) / 4.0)
+          << spot_falloff_name(falloff) << " at " << degrees << " degrees";
+    }
+  }
+}
+
+TEST(SpotLight, NonUniformScaleWidensTheConeAlongTheScaledAxisInCycles4Only) {
+  // Scale 2 along the light's local x: Cycles 4.x tests the cosine in the object's frame, so the
+  // cone's tangent doubles along x; Cycles 3.x ignores the scale.
+  const float size = 40.0f * float(kPiD) / 180.0f;
+  const double tan_half = std::tan(0.5 * size);
+  for (SpotFalloff falloff : {SpotFalloff::Smoothstep, SpotFalloff::CosineSmoothstep}) {
+    SpotLight::Settings s;
+    s.matrix = aimed(Vec3(0, 0, 1), Vec3(0, 0, -1), Vec3(2.0f, 1.0f, 1.0f));
+    s.spot_size = size;
+    s.spot_blend = 0.0f;
+    s.falloff = falloff;
+    const SpotLight light = SpotLight::make(s);
+    const Vec3 x_axis = glm::normalize(Vec3(s.matrix[0]));
+    const Vec3 y_axis = glm::normalize(Vec3(s.matrix[1]));
+    const float off = float(1.5 * tan_half);  // outside the unscaled cone, inside the doubled one
+    const bool lit_x = light.attenuation(glm::normalize(off * x_axis - Vec3(0, 0, 1))) > 0.0f;
+    const bool lit_y = light.attenuation(glm::normalize(off * y_axis - Vec3(0, 0, 1))) > 0.0f;
+    EXPECT_EQ(lit_x, falloff == SpotFalloff::Smoothstep) << spot_falloff_name(falloff);
+    EXPECT_FALSE(lit_y) << spot_falloff_name(falloff);
+  }
+}
+
+TEST(SpotLight, RoundSpotEvaluateAgreesWithSampleAndImportanceNeverHidesLight) {
+  SpotLight::Settings s;
+  s.matrix = aimed(Vec3(0, 0, 2), Vec3(0, 0, -1));
+  s.radius = 0.5f;
+  s.spot_size = 0.5f;
+  const Light light = SpotLight::make(s);
+  for (Vec3 p : {Vec3(0.0f), Vec3(0.6f, 0.0f, 0.0f), Vec3(1.5f, 0.0f, 0.0f)}) {
+    bool any = false;
+    for (uint32_t i = 0; i < 256; ++i) {
+      const LightSample ls = sample_light(light, p, rand2(i, 16), {});
+      if (!ls.valid()) continue;
+      any = true;
+      const LightEval e = evaluate_light(light, p, ls.wi, {});
+      ASSERT_TRUE(e.hit());
+      EXPECT_NEAR(e.radiance.x, ls.radiance.x, 2e-3f * ls.radiance.x + 1e-7f);
+    }
+    if (any) EXPECT_GT(light_importance(light, p, Vec3(0, 0, 1)), 0.0f);
+  }
+}
+
+TEST(SpotLight, RefusesBadSettings) {
+  EXPECT_THROW(make_light("SPOT", Params({{"spot_size", 0.0}})), std::invalid_argument);
+  EXPECT_THROW(make_light("SPOT", Params({{"spot_size", 4.0}})), std::invalid_argument);
+  EXPECT_THROW(make_light("SPOT", Params({{"spot_blend", 1.5}})), std::invalid_argument);
+  EXPECT_THROW(make_light("SPOT", Params({{"falloff", std::string("LINEAR")}})), std::invalid_argument);
+  EXPECT_THROW(make_light("SPOT", Params({{"matrix", Mat4(0.0f)}})), std::invalid_argument);
+}
