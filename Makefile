@@ -160,6 +160,8 @@ $(BENCH_STAMP): requirements-bench.txt $(VENV_STAMP)
 
 bench: addon $(BENCH_STAMP)
 	$(VENV)/bin/python bench/run.py --build $(BUILD) --blender $(BLENDER) $(if $(BENCH_QUICK),--quick)
+	@# The exact queries against Open3D and trimesh: wrong answers on aligned sets, speed -> docs/queries-bench.md
+	$(VENV)/bin/python bench/queries_bench.py --build $(BUILD) $(if $(BENCH_QUICK),--quick)
 
 # ---- robustness: fuzzing and sanitizers (docs/robustness.md) ----------------------------------------
 # Both use their own build directories beside $(BUILD): a clang build for libFuzzer

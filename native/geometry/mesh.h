@@ -33,6 +33,9 @@ class Mesh {
   const std::vector<Vec3>& vertices() const { return vertices_; }
   const std::vector<Triangle>& triangles() const { return triangles_; }
   const Bvh& bvh() const { return bvh_; }
+  // The traced form (wide nodes, leaf triangles in blocks): for queries that walk it themselves.
+  const WideBvh& wide_bvh() const { return wide_; }
+  const std::vector<TriangleBlock>& blocks() const { return blocks_; }
   const BBox& bounds() const { return bounds_; }
   // Bytes held by this mesh (input arrays, BVH and leaf triangles).
   size_t memory_bytes() const;

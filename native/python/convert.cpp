@@ -35,6 +35,27 @@ FloatArray as_points(py::handle obj, const char* name) {
   return FloatArray::ensure(a);
 }
 
+FloatArray as_point_grid(py::handle obj, const char* name, std::vector<py::ssize_t>& leading) {
+  const py::array a = try_array(obj);
+  if (!a) throw py::type_error(std::string(name) + " must be an array of shape (N, 3) or (..., 3)");
+  if (!is_numeric(a))
+    throw py::type_error(std::string(name) + " must hold numbers, not dtype " + std::string(py::str(a.dtype())));
+  if (a.ndim() < 2 || a.shape(a.ndim() - 1) != 3)
+    throw py::value_error(std::string(name) + " must have shape (N, 3) or (..., 3), got " + shape_of(a));
+  leading.assign(a.shape(), a.shape() + a.ndim() - 1);
+  if (a.ndim() == 2) return FloatArray::ensure(a);
+  return FloatArray::ensure(a.attr("reshape")(-1, 3));
+}
+
+py::array shaped(const py::array& a, const std::vector<py::ssize_t>& leading) {
+  if (leading.size() == 1) return a;
+  py::tuple shape(leading.size() + size_t(a.ndim() - 1));
+  size_t i = 0;
+  for (py::ssize_t s : leading) shape[i++] = py::int_(s);
+  for (py::ssize_t k = 1; k < a.ndim(); ++k) shape[i++] = py::int_(a.shape(k));
+  return a.attr("reshape")(shape);
+}
+
 std::vector<Vec3> to_vec3s(const FloatArray& a) {
   std::vector<Vec3> out(size_t(a.shape(0)));
   if (!out.empty()) std::memcpy(out.data(), a.data(), out.size() * sizeof(Vec3));

@@ -32,6 +32,11 @@ std::string shape_of(const py::array& a);
 // Any array-like of numbers as a C-contiguous float32 array of shape (N, 3).
 FloatArray as_points(py::handle obj, const char* name);
 std::vector<Vec3> to_vec3s(const FloatArray& a);
+// Query points or ray origins/directions of any leading shape (..., 3), an image's (H, W, 3) for
+// instance: flattened to a float32 (N, 3); `leading` receives the leading shape for the answers.
+FloatArray as_point_grid(py::handle obj, const char* name, std::vector<py::ssize_t>& leading);
+// `a` (N, ...) reshaped to leading + its trailing dimensions: answers in the queries' shape.
+py::array shaped(const py::array& a, const std::vector<py::ssize_t>& leading);
 // (M, 3) integer vertex indices; negative or beyond 32 bits refused by triangle.
 std::vector<Triangle> to_triangles(py::handle obj);
 // The one matrix converter: a (4, 4) row-major matrix (Blender's matrix_world layout) as GLM's

@@ -263,15 +263,49 @@ PYBIND11_MODULE(toyrt, m) {
           "What the last commit did: build_ms, lbvh_compile_ms (OpenCL compilation, first LBVH build of\n"
           "the process only), meshes_built, sah_meshes, lbvh_meshes, warning.")
       .def("intersect", &PyScene::intersect, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0f,
-           py::arg("tfar") = std::numeric_limits<float>::infinity(), py::arg("threads") = 0,
+           py::arg("tfar") = std::numeric_limits<float>::infinity(), py::arg("threads") = 0, py::arg("normals") = false,
+           py::arg("mesh_ids") = false,
            "Nearest hits of rays org + t * dir with tnear <= t < tfar (world units of t: the direction's\n"
            "length). origins, directions: (N, 3); tnear, tfar: numbers or (N,) arrays.\n"
            "Returns a dict of (N,) arrays: t (float32, inf on a miss), prim (int32 triangle index in its\n"
            "mesh, -1 on a miss), instance (int32), u, v (float32; p = (1-u-v) p0 + u p1 + v p2).\n"
-           "Rays with a zero or non-finite direction, a non-finite origin, or tnear > tfar miss.")
+           "Rays with a zero or non-finite direction, a non-finite origin, or tnear > tfar miss.\n"
+           "origins, directions may have any leading shape (..., 3) (an image's (H, W, 3)): the answers\n"
+           "come in that shape. Opt-in: normals=True adds normal (..., 3) float32, the unit geometric\n"
+           "normal in world space (0 on a miss); mesh_ids=True adds mesh (int32, -1 on a miss).")
       .def("occluded", &PyScene::occluded, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0f,
            py::arg("tfar") = std::numeric_limits<float>::infinity(), py::arg("threads") = 0,
            "Whether anything lies on each ray with tnear <= t < tfar; a (N,) bool array. Stops at the first hit.")
+      .def("count_intersections", &PyScene::count_intersections, py::arg("origins"), py::arg("directions"),
+           py::arg("tnear") = 0.0f, py::arg("tfar") = std::numeric_limits<float>::infinity(), py::arg("threads") = 0,
+           "Number of surface crossings of each ray on tnear <= t < tfar: (N,) uint32. Exact: a ray through a\n"
+           "shared edge or vertex of a mesh crosses it once, a ray grazing a silhouette 0 or 2 times, a ray in\n"
+           "a triangle's plane never crosses that triangle (one tie-break for all: docs/queries.md), so a\n"
+           "line through a closed mesh counts an even number. Per mesh under one transform: a closed\n"
+           "surface split over meshes or instances may leak or double-count at the seam.")
+      .def("list_intersections", &PyScene::list_intersections, py::arg("origins"), py::arg("directions"),
+           py::arg("tnear") = 0.0f, py::arg("tfar") = std::numeric_limits<float>::infinity(),
+           py::arg("max_hits") = size_t(1) << 24, py::arg("threads") = 0,
+           "Every crossing counted by count_intersections, in ray order then t order (ties by instance,\n"
+           "prim). Returns a dict: ray_splits (N+1,) int64 (ray i owns entries ray_splits[i]:ray_splits[i+1]),\n"
+           "ray (uint32), t, u, v (float32), mesh, instance, prim (int32). More than max_hits crossings in\n"
+           "all raise ValueError before anything of that size is allocated (28 bytes per crossing).")
+      .def("compute_occupancy", &PyScene::compute_occupancy, py::arg("points"), py::arg("threads") = 0,
+           "Whether each point (N, 3) is inside a closed mesh: (N,) bool. Exact, by the parity of the ray\n"
+           "along +x (the count_intersections rule); a point exactly on a triangle is inside; an open mesh\n"
+           "gets the parity of that one ray; only instances whose box holds the point count; the union of\n"
+           "the instances' solids. Non-finite points raise ValueError.")
+      .def("compute_closest_points", &PyScene::compute_closest_points, py::arg("points"), py::arg("threads") = 0,
+           "The nearest surface point to each point (N, 3), in double precision, rounded once: a dict of\n"
+           "points (N, 3), distance (N,), mesh, instance, prim (int32), u, v (closest = (1-u-v) p0 + u p1 +\n"
+           "v p2) and normal (N, 3; unit geometric normal in world space). No geometry: distance inf, ids -1.")
+      .def("compute_distance", &PyScene::compute_distance, py::arg("points"), py::arg("signed") = false,
+           py::arg("threads") = 0, "Distance from each point (N, 3) to the nearest surface: (N,) float32.")
+      .def(
+          "compute_signed_distance",
+          [](PyScene& s, py::handle points, int threads) { return s.compute_distance(points, true, threads); },
+          py::arg("points"), py::arg("threads") = 0,
+          "compute_distance, negative where compute_occupancy says inside (0 exactly on the surface).")
       .def("bvh_stats", &PyScene::bvh_stats, py::arg("mesh") = -1,
            "Node count, leaf count, depth and SAH cost of a mesh's BVH, or of the top level for mesh=-1.")
       .def_property_readonly("mesh_count", &PyScene::mesh_count)

@@ -235,17 +235,26 @@ py::array_t<float> PyScene::render(const py::dict& camera_settings, int samples,
 }
 
 namespace {
-std::pair<FloatArray, FloatArray> rays(py::handle origins, py::handle directions) {
-  FloatArray org = as_points(origins, "origins"), dir = as_points(directions, "directions");
-  if (org.shape(0) != dir.shape(0))
+struct Rays {
+  FloatArray org, dir;
+  std::vector<py::ssize_t> leading;  // the rays' shape without the trailing 3
+};
+Rays rays(py::handle origins, py::handle directions) {
+  Rays r;
+  std::vector<py::ssize_t> dir_leading;
+  r.org = as_point_grid(origins, "origins", r.leading);
+  r.dir = as_point_grid(directions, "directions", dir_leading);
+  if (r.org.shape(0) != r.dir.shape(0) || r.leading != dir_leading)
     throw py::value_error("origins and directions must hold the same number of rays, got " +
-                          std::to_string(org.shape(0)) + " and " + std::to_string(dir.shape(0)));
-  return {org, dir};
+                          std::to_string(r.org.shape(0)) + " and " + std::to_string(r.dir.shape(0)));
+  return r;
 }
 }  // namespace
 
-py::dict PyScene::intersect(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads) {
-  auto [org, dir] = rays(origins, directions);
+py::dict PyScene::intersect(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads,
+                            bool normals, bool mesh_ids) {
+  const Rays r = rays(origins, directions);
+  const FloatArray &org = r.org, &dir = r.dir;
   const size_t n = size_t(org.shape(0));
   const PerRay near = per_ray(tnear, n, "tnear"), far = per_ray(tfar, n, "tfar");
   py::array_t<float> t(n), u(n), v(n);
@@ -253,34 +262,41 @@ py::dict PyScene::intersect(py::handle origins, py::handle directions, py::handl
   const RayBatch batch{org.data(), dir.data(), near.data, near.stride, far.data, far.stride, n};
   const HitBatch hits{t.mutable_data(), u.mutable_data(), v.mutable_data(), prim.mutable_data(),
                       instance.mutable_data()};
+  // Opt-in fields, filled from the hits under the same lock: the plain query stays as fast.
+  py::array_t<float> normal(normals ? std::vector<py::ssize_t>{py::ssize_t(n), 3} : std::vector<py::ssize_t>{0, 3});
+  py::array_t<int32_t> mesh(mesh_ids ? n : 0);
+  float* normal_out = normal.mutable_data();
+  int32_t* mesh_out = mesh.mutable_data();
   {
     py::gil_scoped_release release;
     std::shared_lock lock(mutex_);
     scene_.intersect(batch, hits, threads);
+    if (normals || mesh_ids) hit_extras(hits, n, normals ? normal_out : nullptr, mesh_ids ? mesh_out : nullptr);
   }
   py::dict out;
-  out["t"] = t;
-  out["prim"] = prim;
-  out["instance"] = instance;
-  out["u"] = u;
-  out["v"] = v;
+  out["t"] = shaped(t, r.leading);
+  out["prim"] = shaped(prim, r.leading);
+  out["instance"] = shaped(instance, r.leading);
+  out["u"] = shaped(u, r.leading);
+  out["v"] = shaped(v, r.leading);
+  if (normals) out["normal"] = shaped(normal, r.leading);
+  if (mesh_ids) out["mesh"] = shaped(mesh, r.leading);
   return out;
 }
 
-py::array_t<bool> PyScene::occluded(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar,
-                                    int threads) {
-  auto [org, dir] = rays(origins, directions);
-  const size_t n = size_t(org.shape(0));
+py::array PyScene::occluded(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads) {
+  const Rays r = rays(origins, directions);
+  const size_t n = size_t(r.org.shape(0));
   const PerRay near = per_ray(tnear, n, "tnear"), far = per_ray(tfar, n, "tfar");
   py::array_t<bool> blocked(n);
   static_assert(sizeof(bool) == sizeof(uint8_t));
-  const RayBatch batch{org.data(), dir.data(), near.data, near.stride, far.data, far.stride, n};
+  const RayBatch batch{r.org.data(), r.dir.data(), near.data, near.stride, far.data, far.stride, n};
   {
     py::gil_scoped_release release;
     std::shared_lock lock(mutex_);
     scene_.occluded(batch, reinterpret_cast<uint8_t*>(blocked.mutable_data()), threads);
   }
-  return blocked;
+  return shaped(blocked, r.leading);
 }
 
 py::dict PyScene::bvh_stats(int64_t mesh) {

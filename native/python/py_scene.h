@@ -50,9 +50,21 @@ class PyScene {
                             int split_depth);
   py::dict last_render() { return last_render_; }
 
-  py::dict intersect(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads);
-  py::array_t<bool> occluded(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads);
+  // Ray arrays of any leading shape (..., 3): answers come in that shape. normals / mesh_ids add
+  // "normal" (unit geometric normal in world space, 0 on a miss) and "mesh" (-1 on a miss).
+  py::dict intersect(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads,
+                     bool normals, bool mesh_ids);
+  py::array occluded(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar, int threads);
   py::dict bvh_stats(int64_t mesh);
+
+  // The exact geometric queries (py_queries.cpp; the core's are in queries/).
+  py::array count_intersections(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar,
+                                int threads);
+  py::dict list_intersections(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar,
+                              size_t max_hits, int threads);
+  py::array compute_occupancy(py::handle points, int threads);
+  py::dict compute_closest_points(py::handle points, int threads);
+  py::array compute_distance(py::handle points, bool signed_distance, int threads);
 
   size_t mesh_count();
   size_t instance_count();
@@ -62,6 +74,8 @@ class PyScene {
   double build_ms();
 
  private:
+  // intersect's opt-in fields from its hits (py_queries.cpp); called under the shared lock.
+  void hit_extras(const HitBatch& hits, size_t count, float* normal, int32_t* mesh) const;
   // Runs an edit under the exclusive lock with the GIL released while it waits: a render or
   // commit holding the lock takes the GIL to poll its callbacks, so waiting with it would deadlock.
   template <class F>

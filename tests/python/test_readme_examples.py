@@ -30,6 +30,17 @@ def test_ray_api_example_matches_its_comments():
     assert starts.shape == (2, 3) and (starts[:, 2] > 0).all() and (starts[:, 2] < 1e-3).all()
 
 
+def test_exact_queries_example_matches_its_comments():
+    env = run_example("### Exact geometric queries")
+    assert env["counts"].tolist() == [2, 0]
+    hits = env["hits"]
+    assert hits["ray_splits"].tolist() == [0, 2, 2] and hits["t"].tolist() == [1, 2]
+    p, cube = env["p"], env["cube"]
+    assert cube.compute_occupancy(p).tolist() == [True, True, False]
+    assert cube.compute_signed_distance(p).tolist() == [-0.5, 0, 1]
+    assert env["near"]["points"].shape == (3, 3)
+
+
 def test_render_example_runs():
     env = run_example("## Python render API", replace=[("samples=16", "samples=2")])
     image = env["image"]
