@@ -1,0 +1,51 @@
+"""Where the add-on's native module `toyrt` comes from, and what the user is told when it cannot load.
+
+The add-on ships in two forms (docs/install.md), with the module in a different place in each:
+  - the legacy add-on (the zip for Blender 3.4-4.1, and `make setup`): the module sits in this
+    folder and imports as `render_toyrt.toyrt`;
+  - the extension (Blender 4.2+): the module comes from the wheel listed in blender_manifest.toml,
+    which Blender installs into the extension's site-packages, and imports as `toyrt`.
+Trying the folder first keeps a developer's fresh build ahead of any wheel. A module built for
+another Python (a 3.11 .so under Blender 5.1+'s 3.13) fails with "No module named"; the message then
+names both Pythons, since that is the failure users of other engines meet most.
+"""
+import glob
+import os
+import re
+import sys
+import types
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def load() -> types.ModuleType:
+    """The native module, from this folder or from site-packages; ImportError saying why not."""
+    failures = []
+    try:
+        from . import toyrt  # the legacy add-on: the .so beside this file
+        return toyrt
+    except ImportError as err:
+        failures.append(f"in {HERE}: {err}")
+    try:
+        import toyrt  # the extension: its wheel, installed by Blender into site-packages
+        return toyrt
+    except ImportError as err:
+        failures.append(f"from site-packages: {err}")
+    raise ImportError(explain(failures))
+
+
+def explain(failures: list[str]) -> str:
+    """One message for the console and the UI: what was tried, and the likely fix."""
+    running = f"{sys.version_info.major}.{sys.version_info.minor}"
+    found = sorted(os.path.basename(p) for p in glob.glob(os.path.join(HERE, "toyrt*.so")))
+    built_for = {f"{m[1]}.{m[2]}" for f in found if (m := re.search(r"cpython-(\d)(\d+)", f))}
+    if built_for and running not in built_for:
+        hint = (f"the module in the add-on ({', '.join(found)}) is built for Python {', '.join(sorted(built_for))}, "
+                f"but this Blender runs Python {running}: install the TOYRT extension for Blender 4.2+ "
+                "(render_toyrt-*-linux_x64.zip), or the legacy zip made for this Blender's Python")
+    elif found:
+        hint = f"the module in the add-on ({', '.join(found)}) does not load on this system"
+    else:
+        hint = (f"no native module for Python {running} was found: install TOYRT from its release zip "
+                "(docs/install.md), or build it with `make setup` in the TOYRT repository")
+    return f"TOYRT: cannot import the native module: {hint} ({'; '.join(failures)})"
