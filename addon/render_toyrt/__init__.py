@@ -41,9 +41,10 @@ def native() -> types.ModuleType:
 
 
 def _other_copy() -> str:
-    """The file of another enabled copy of TOYRT (the legacy add-on beside the extension, or the
+    """The module name and folder of another enabled copy of TOYRT (the legacy add-on beside the extension, or the
     reverse), or "". Both would register the engine "TOYRT" and scene.toyrt, and disabling one
     would unregister the other's engine."""
+    import os
     import sys
 
     import bpy
@@ -51,7 +52,8 @@ def _other_copy() -> str:
     for cls in bpy.types.RenderEngine.__subclasses__():
         package = cls.__module__.rpartition(".")[0]
         if getattr(cls, "bl_idname", None) == "TOYRT" and cls.is_registered and package != __name__:
-            return getattr(sys.modules.get(package), "__file__", None) or package
+            where = getattr(sys.modules.get(package), "__file__", None)
+            return f"{package} ({os.path.dirname(where)})" if where else package
     return ""
 
 

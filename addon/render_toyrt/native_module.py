@@ -5,7 +5,10 @@ The add-on ships in two forms (docs/install.md), with the module in a different 
     folder and imports as `render_toyrt.toyrt`;
   - the extension (Blender 4.2+): the module comes from the wheel listed in blender_manifest.toml,
     which Blender installs into the extension's site-packages, and imports as `toyrt`.
-Trying the folder first keeps a developer's fresh build ahead of any wheel. A module built for
+Trying the folder first keeps a developer's fresh build ahead of any wheel. A module that another
+copy of the add-on already imported in this Blender session (the extension, then the legacy add-on
+enabled after it) is reused: pybind11 refuses to register the same types twice, and the failed
+second load leaves the heap corrupt (an abort at exit). A module built for
 another Python (a 3.11 .so under Blender 5.1+'s 3.13) fails with "No module named"; the message then
 names both Pythons, since that is the failure users of other engines meet most.
 """
@@ -20,6 +23,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 def load() -> types.ModuleType:
     """The native module, from this folder or from site-packages; ImportError saying why not."""
+    loaded = already_loaded()
+    if loaded is not None:
+        return loaded
     failures = []
     try:
         from . import toyrt  # the legacy add-on: the .so beside this file
@@ -32,6 +38,14 @@ def load() -> types.ModuleType:
     except ImportError as err:
         failures.append(f"from site-packages: {err}")
     raise ImportError(explain(failures))
+
+
+def already_loaded() -> types.ModuleType | None:
+    """A native toyrt module imported in this process under any name (`toyrt`, `<package>.toyrt`)."""
+    for name, module in list(sys.modules.items()):
+        if (name == "toyrt" or name.endswith(".toyrt")) and getattr(module, "__file__", "").endswith(".so"):
+            return module
+    return None
 
 
 def explain(failures: list[str]) -> str:
