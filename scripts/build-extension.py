@@ -5,10 +5,11 @@
     blender_manifest.toml, built and then validated by Blender's own extension tool
     (blender_ext.py, from the bpy package: Debian's Blender 3.4 has no `--command extension`),
     one zip per platform (--split-platforms): dist/render_toyrt-<version>-linux_x64.zip;
-  - the legacy add-on for Blender 3.4-4.1: the add-on folder with the Python 3.11 module and its
-    bundled libraries (toyrt.libs/, found through the module's RPATH $ORIGIN/toyrt.libs) taken out
-    of the cp311 wheel, without the manifest (Blender 4.2+ would take a zip holding one for an
-    extension): dist/render_toyrt-<version>-legacy-py311.zip.
+  - the legacy add-on for Blender 3.4-4.1: the add-on folder with the Python 3.11 package `toyrt`
+    (its modules per CPU level, native/python/toyrt/) and their bundled libraries (toyrt.libs/,
+    found through the modules' RPATH $ORIGIN/../toyrt.libs) taken out of the cp311 wheel, without
+    the manifest (Blender 4.2+ would take a zip holding one for an extension):
+    dist/render_toyrt-<version>-legacy-py311.zip.
 
     .venv/bin/python scripts/build-extension.py --dist dist
 """
@@ -91,7 +92,7 @@ def build_legacy(wheels: list[Path], dist: Path, version: str) -> Path:
             if path.is_file() and path.name != "blender_manifest.toml" and not IGNORE(str(path.parent), rel.parts):
                 z.write(path, f"{ADDON}/{rel}")
         for name in wheel.namelist():
-            if name.startswith("toyrt.") and not name.endswith("/"):   # toyrt.cpython-311-*.so, toyrt.libs/*
+            if name.startswith(("toyrt/", "toyrt.libs/")) and not name.endswith("/"):
                 info = zipfile.ZipInfo(f"{ADDON}/{name}", wheel.getinfo(name).date_time)
                 info.external_attr = 0o755 << 16
                 z.writestr(info, wheel.read(name), zipfile.ZIP_DEFLATED)

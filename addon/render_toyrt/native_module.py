@@ -2,7 +2,8 @@
 
 The add-on ships in two forms (docs/install.md), with the module in a different place in each:
   - the legacy add-on (the zip for Blender 3.4-4.1, and `make setup`): the module sits in this
-    folder and imports as `render_toyrt.toyrt`;
+    folder and imports as `render_toyrt.toyrt` (`make setup`: one toyrt*.so; the zip: the wheel's
+    package toyrt/, a module per CPU level, native/python/toyrt/__init__.py);
   - the extension (Blender 4.2+): the module comes from the wheel listed in blender_manifest.toml,
     which Blender installs into the extension's site-packages, and imports as `toyrt`.
 Trying the folder first keeps a developer's fresh build ahead of any wheel. A module that another
@@ -41,9 +42,10 @@ def load() -> types.ModuleType:
 
 
 def already_loaded() -> types.ModuleType | None:
-    """A native toyrt module imported in this process under any name (`toyrt`, `<package>.toyrt`)."""
+    """A native toyrt module (or the wheels' package of them) imported in this process under any
+    name (`toyrt`, `<package>.toyrt`); a failed import leaves nothing in sys.modules."""
     for name, module in list(sys.modules.items()):
-        if (name == "toyrt" or name.endswith(".toyrt")) and getattr(module, "__file__", "").endswith(".so"):
+        if (name == "toyrt" or name.endswith(".toyrt")) and hasattr(module, "Scene"):
             return module
     return None
 
@@ -51,7 +53,8 @@ def already_loaded() -> types.ModuleType | None:
 def explain(failures: list[str]) -> str:
     """One message for the console and the UI: what was tried, and the likely fix."""
     running = f"{sys.version_info.major}.{sys.version_info.minor}"
-    found = sorted(os.path.basename(p) for p in glob.glob(os.path.join(HERE, "toyrt*.so")))
+    found = sorted(os.path.basename(p) for pattern in ("toyrt*.so", os.path.join("toyrt", "_core_*.so"))
+                   for p in glob.glob(os.path.join(HERE, pattern)))
     built_for = {f"{m[1]}.{m[2]}" for f in found if (m := re.search(r"cpython-(\d)(\d+)", f))}
     if built_for and running not in built_for:
         hint = (f"the module in the add-on ({', '.join(found)}) is built for Python {', '.join(sorted(built_for))}, "
