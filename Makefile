@@ -157,12 +157,16 @@ test-bpy:
 # 2.x on 3.13) running the ray-API tests; the extension zip in bpy 5.0.1 (3.11) and 5.3.0 (3.13)
 # through Blender's extension API, and the legacy zip in Debian's Blender 3.4, each rendering a
 # closed form; the bad inputs on the way (tests/package/).
+# The CPU levels of the wheels' dispatch (native/python/toyrt/) this CPU runs, each forced once in the
+# 3.13 venv (the best one is also what the other runs pick).
+CPU_LEVELS = $(shell grep -qw sse4_2 /proc/cpuinfo && echo v2) $(shell grep -qw avx2 /proc/cpuinfo && echo v3) \
+	$(shell grep -qw avx512bw /proc/cpuinfo && echo v4)
 EXT_ZIP    = $(DIST)/render_toyrt-$(VERSION)-linux_x64.zip
 LEGACY_ZIP = $(DIST)/render_toyrt-$(VERSION)-legacy-py311.zip
 test-package: package
 	tests/package/fresh_venv.sh $(SYS_PY) 1 $(DIST)/toyrt-$(VERSION)-cp311-*.whl
 	tests/package/fresh_venv.sh $(SYS_PY) 2 $(DIST)/toyrt-$(VERSION)-cp311-*.whl
-	tests/package/fresh_venv.sh $(PY313) 2 $(DIST)/toyrt-$(VERSION)-cp313-*.whl
+	tests/package/fresh_venv.sh $(PY313) 2 $(DIST)/toyrt-$(VERSION)-cp313-*.whl $(CPU_LEVELS)
 	$(VENV)/bin/python tests/package/install_extension.py $(EXT_ZIP) $(LEGACY_ZIP)
 	$(VENV313)/bin/python tests/package/install_extension.py $(EXT_ZIP) $(LEGACY_ZIP)
 	$(SYS_PY) tests/package/install_legacy.py $(LEGACY_ZIP) --blender $(BLENDER)

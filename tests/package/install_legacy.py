@@ -58,8 +58,10 @@ def inside_blender():
         mod = addon_utils.enable("render_toyrt", default_set=True, handle_error=lambda err: print(err))
         check(mod is not None and mod.load_error == "", "it enables, and its native module loads")
         toyrt = mod.native()
-        check(Path(toyrt.__file__).parent == home / "scripts" / "addons" / "render_toyrt",
-              f"the module is the zip's, inside the add-on folder ({toyrt.__file__})")
+        # The wheel's package toyrt/ inside the add-on, with the module of the CPU level it picked.
+        core = Path(toyrt._core.__file__)
+        check(core.parent == home / "scripts" / "addons" / "render_toyrt" / "toyrt",
+              f"the module is the zip's, inside the add-on folder ({core}, CPU level {toyrt.cpu_level})")
         with open("/proc/self/maps") as f:
             tbb = {line.split()[-1] for line in f if "libtbb" in line}
         # Debian's Blender links the system's TBB itself: the module's own copy loads beside it.
