@@ -116,7 +116,7 @@ test-quick: native venv
 # Every C++ file we wrote (not the generated ones in build*/) and every Python file: one style each
 # (.clang-format, ruff.toml), checked, never rewritten, by `make test`.
 CXX_SOURCES = $(shell git ls-files '*.cpp' '*.h' 2>/dev/null || find native tests bench -name '*.cpp' -o -name '*.h')
-PY_SOURCES  := addon scenes tests bench scripts
+PY_SOURCES  := addon scenes tests bench scripts native/python
 
 lint: venv
 	@clang-format-14 --dry-run --Werror $(CXX_SOURCES) && echo "lint: clang-format: $(words $(CXX_SOURCES)) C++ files formatted"
