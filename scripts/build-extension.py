@@ -5,11 +5,12 @@
     blender_manifest.toml, built and then validated by Blender's own extension tool
     (blender_ext.py, from the bpy package: Debian's Blender 3.4 has no `--command extension`),
     one zip per platform (--split-platforms): dist/render_toyrt-<version>-linux_x64.zip;
-  - the legacy add-on for Blender 3.4-4.1: the add-on folder with the Python 3.11 package `toyrt`
-    (its modules per CPU level, native/python/toyrt/) and their bundled libraries (toyrt.libs/,
-    found through the modules' RPATH $ORIGIN/../toyrt.libs) taken out of the cp311 wheel, without
-    the manifest (Blender 4.2+ would take a zip holding one for an extension):
-    dist/render_toyrt-<version>-legacy-py311.zip.
+  - the legacy add-on for Blender 3.4-4.1: the add-on folder with the package `toyrt` (its modules
+    per CPU level, native/python/toyrt/) and their bundled libraries (toyrt.libs/, found through the
+    modules' RPATH $ORIGIN/../toyrt.libs) taken out of the cp310 and cp311 wheels (blender.org's
+    3.4-4.0 run Python 3.10, 4.1 and Debian's 3.4 run 3.11; each Python imports the modules named
+    for it, so both sit in one folder), without the manifest (Blender 4.2+ would take a zip holding
+    one for an extension): dist/render_toyrt-<version>-legacy-linux_x64.zip.
 
     .venv/bin/python scripts/build-extension.py --dist dist
 """
@@ -58,7 +59,9 @@ def manifest_version(manifest: Path) -> str:
 
 
 def build_extension(wheels: list[Path], dist: Path, work: Path) -> list[Path]:
-    """The extension zip(s), validated; the manifest gets the wheels of this build."""
+    """The extension zip(s), validated; the manifest gets the wheels of this build (3.11 and newer:
+    Blender 4.2, the first with extensions, runs 3.11)."""
+    wheels = [w for w in wheels if "-cp310-" not in w.name]
     stage = work / "extension" / ADDON
     shutil.copytree(REPO / "addon" / ADDON, stage, ignore=IGNORE)
     (stage / "wheels").mkdir()
@@ -80,23 +83,29 @@ def build_extension(wheels: list[Path], dist: Path, work: Path) -> list[Path]:
 
 
 def build_legacy(wheels: list[Path], dist: Path, version: str) -> Path:
-    """The legacy add-on zip, with the cp311 module of the wheel and its libraries inside."""
-    cp311 = [w for w in wheels if "-cp311-" in w.name]
-    if len(cp311) != 1:
-        sys.exit(f"build-extension: the legacy zip needs one cp311 wheel, found {[w.name for w in cp311]}")
-    out = dist / f"{ADDON}-{version}-legacy-py311.zip"
+    """The legacy add-on zip, with the cp310 and cp311 modules of the wheels and their libraries."""
+    legacy = [w for w in wheels if "-cp310-" in w.name or "-cp311-" in w.name]
+    if not any("-cp311-" in w.name for w in legacy):
+        sys.exit(f"build-extension: the legacy zip needs the cp311 wheel, found {[w.name for w in wheels]}")
+    out = dist / f"{ADDON}-{version}-legacy-linux_x64.zip"
     source = REPO / "addon" / ADDON
-    with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as z, zipfile.ZipFile(cp311[0]) as wheel:
+    written = set()
+    with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as z:
         for path in sorted(source.rglob("*")):
             rel = path.relative_to(source)
             if path.is_file() and path.name != "blender_manifest.toml" and not IGNORE(str(path.parent), rel.parts):
                 z.write(path, f"{ADDON}/{rel}")
-        for name in wheel.namelist():
-            if name.startswith(("toyrt/", "toyrt.libs/")) and not name.endswith("/"):
-                info = zipfile.ZipInfo(f"{ADDON}/{name}", wheel.getinfo(name).date_time)
-                info.external_attr = 0o755 << 16
-                z.writestr(info, wheel.read(name), zipfile.ZIP_DEFLATED)
-    print(f"legacy add-on: {out} ({out.stat().st_size // 1024} KB)")
+        for wheel_path in legacy:
+            with zipfile.ZipFile(wheel_path) as wheel:
+                for name in wheel.namelist():
+                    # toyrt/__init__.py and the bundled libraries are the same in every wheel: once.
+                    if name.startswith(("toyrt/", "toyrt.libs/")) and not name.endswith("/") and name not in written:
+                        info = zipfile.ZipInfo(f"{ADDON}/{name}", wheel.getinfo(name).date_time)
+                        info.external_attr = 0o755 << 16
+                        z.writestr(info, wheel.read(name), zipfile.ZIP_DEFLATED)
+                        written.add(name)
+    pythons = ", ".join(sorted(w.name.split("-")[2].replace("cp3", "3.") for w in legacy))
+    print(f"legacy add-on: {out} ({out.stat().st_size // 1024} KB; Python {pythons})")
     return out
 
 

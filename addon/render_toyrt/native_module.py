@@ -56,12 +56,13 @@ def explain(failures: list[str]) -> str:
     found = sorted(os.path.basename(p) for pattern in ("toyrt*.so", os.path.join("toyrt", "_core_*.so"))
                    for p in glob.glob(os.path.join(HERE, pattern)))
     built_for = {f"{m[1]}.{m[2]}" for f in found if (m := re.search(r"cpython-(\d)(\d+)", f))}
+    files = found[0] + (f" and {len(found) - 1} more" if len(found) > 1 else "") if found else ""
     if built_for and running not in built_for:
-        hint = (f"the module in the add-on ({', '.join(found)}) is built for Python {', '.join(sorted(built_for))}, "
+        hint = (f"the module in the add-on ({files}) is built for Python {', '.join(sorted(built_for))}, "
                 f"but this Blender runs Python {running}: install the TOYRT extension for Blender 4.2+ "
                 "(render_toyrt-*-linux_x64.zip), or the legacy zip made for this Blender's Python")
     elif found:
-        hint = f"the module in the add-on ({', '.join(found)}) does not load on this system"
+        hint = f"the module in the add-on ({files}) does not load on this system"
     else:
         hint = (f"no native module for Python {running} was found: install TOYRT from its release zip "
                 "(docs/install.md), or build it with `make setup` in the TOYRT repository")

@@ -5,9 +5,9 @@ user folder (BLENDER_USER_RESOURCES), the extension zip through Blender's own ex
 installed by Blender, not by us (`make test-package`, docs/install.md):
 
     .venv-3.13/bin/python tests/package/install_extension.py dist/render_toyrt-0.1.0-linux_x64.zip \
-        dist/render_toyrt-0.1.0-legacy-py311.zip
+        dist/render_toyrt-0.1.0-legacy-linux_x64.zip
 
-With the bad inputs: the legacy zip (a module for Python 3.11) on 3.13 (a message naming both
+With the bad inputs: the legacy zip (modules for Python 3.10 and 3.11) on 3.13 (a message naming both
 Pythons, a render that fails cleanly), the extension installed twice, the legacy add-on enabled
 beside it (refused with a message; the extension keeps rendering), then the legacy add-on alone.
 """
@@ -100,7 +100,7 @@ def the_legacy_addon_beside_it_is_refused():
 
 
 def the_legacy_addon_for_another_python_says_so():
-    """Blender 5.1+ (Python 3.13) given the legacy zip, whose module is for 3.11. Run first, while no
+    """Blender 5.1+ (Python 3.13) given the legacy zip, whose modules are for 3.10 and 3.11. Run first, while no
     wheel is installed: nothing else could supply a module."""
     if PYTHON == "3.11":
         print("  skipped: the legacy zip's module is for this Python (the last part checks that it loads)")
@@ -110,7 +110,7 @@ def the_legacy_addon_for_another_python_says_so():
         mod = addon_utils.enable("render_toyrt", default_set=True, handle_error=lambda err: print(err))
     check(mod is not None and toyrt_engines() == ["render_toyrt.engine"], "the add-on itself enables")
     # A clear message at enable time, kept for the TOYRT panel and printed on the console ...
-    check("built for Python 3.11" in mod.load_error and f"runs Python {PYTHON}" in mod.load_error
+    check("built for Python 3.10, 3.11" in mod.load_error and f"runs Python {PYTHON}" in mod.load_error
           and "extension" in mod.load_error, f"the load error names both Pythons: {mod.load_error[:150]}...")
     check(mod.load_error in out[0], "and is printed on the console")
     # ... and a render that fails with it instead of crashing.
@@ -121,7 +121,7 @@ def the_legacy_addon_for_another_python_says_so():
             raised = ""
         except RuntimeError as err:
             raised = str(err)
-    check("built for Python 3.11" in raised + out[0], "a render reports the same error and Blender goes on")
+    check("built for Python 3.10, 3.11" in raised + out[0], "a render reports the same error and Blender goes on")
     addon_utils.disable("render_toyrt", default_set=True)
     check(toyrt_engines() == [], "the legacy add-on disabled")
 

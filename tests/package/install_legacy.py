@@ -2,7 +2,7 @@
 (Preferences > Add-ons > Install: `bpy.ops.preferences.addon_install`), into empty user folders,
 and renders the closed-form scene with it (`make test-package`, docs/install.md):
 
-    /usr/bin/python3 tests/package/install_legacy.py dist/render_toyrt-0.1.0-legacy-py311.zip [--blender blender]
+    /usr/bin/python3 tests/package/install_legacy.py dist/render_toyrt-0.1.0-legacy-linux_x64.zip [--blender blender]
 
 Run with a plain Python, this starts `blender -b` on itself with BLENDER_USER_SCRIPTS and
 BLENDER_USER_CONFIG pointing at a new temporary folder (an empty BLENDER_USER_CONFIG alone would
@@ -62,6 +62,8 @@ def inside_blender():
         core = Path(toyrt._core.__file__)
         check(core.parent == home / "scripts" / "addons" / "render_toyrt" / "toyrt",
               f"the module is the zip's, inside the add-on folder ({core}, CPU level {toyrt.cpu_level})")
+        check(list(core.parent.glob(f"_core_{toyrt.cpu_level}.cpython-310-*.so")),
+              "beside the modules for Python 3.10 (blender.org's Blender 3.4-4.0)")
         with open("/proc/self/maps") as f:
             tbb = {line.split()[-1] for line in f if "libtbb" in line}
         # Debian's Blender links the system's TBB itself: the module's own copy loads beside it.
