@@ -5,6 +5,8 @@
 #   make test         lint, C++ tests (ctest), Python tests (pytest), Blender tests (tests/blender), fuzz, sanitize
 #   make test-quick   lint, C++ and Python tests only (about a minute once built: the loop while coding)
 #   make lint         clang-format check of the C++ and ruff over the Python;  make format: apply clang-format
+#   make package      wheels for Python 3.10, 3.11 and 3.13, the Blender extension and the legacy add-on zip -> dist/
+#   make test-package installs them where users are (fresh venvs, bpy 5.0.1 and 5.3.0, Blender 3.4) and renders
 #   make demo         renders the seed's Cornell box with TOYRT -> out/demo_0001.png
 #   make bench-trace  ray-tracing benchmark against Embree -> docs/bench-trace.md
 #   make bench-lbvh   builders (LBVH, SAH, Embree) from 10K to 4M triangles -> docs/lbvh-bench.md, lbvh.png
@@ -34,17 +36,29 @@ APT_PACKAGES := cmake g++ make libglm-dev pybind11-dev python3-dev python3-numpy
 # The stamp's name carries a hash of the list, so adding a package re-runs the check.
 APT_STAMP   := $(BUILD)/.stamp-apt-$(firstword $(shell printf '%s' '$(APT_PACKAGES)' | md5sum))
 VENV_STAMP  := $(VENV)/.stamp-requirements
+# The other Pythons the wheels are built and tested for, from pyenv, each with its own venv:
+# 3.13 (Blender 5.1+; with bpy 5.3) and 3.10 (blender.org's Blender 3.4-4.0: the legacy zip).
+PYENV_ROOT  ?= $(shell pyenv root 2>/dev/null || echo $(HOME)/.pyenv)
+PY313       ?= $(PYENV_ROOT)/versions/3.13.0/bin/python
+PY310       ?= $(PYENV_ROOT)/versions/3.10.13/bin/python
+VENV313     := $(VENV)-3.13
+VENV310     := $(VENV)-3.10
+PKG_STAMP   := $(VENV)/.stamp-package-requirements
+VENV313_STAMP := $(VENV313)/.stamp-requirements
+VENV310_STAMP := $(VENV310)/.stamp-requirements
+DIST        := dist
+VERSION     := $(shell sed -n 's/^project(toyrt LANGUAGES CXX VERSION \([0-9.]*\))/\1/p' CMakeLists.txt)
 
 BLENDER_TESTS := $(sort $(wildcard tests/blender/test_*.py))
 
 .PHONY: bench help setup apt venv configure native addon test test-native test-python test-blender test-bpy bench-blender \
-	demo bench-trace bench-lbvh clean distclean fuzz sanitize lint format test-quick
+	demo bench-trace bench-lbvh clean distclean fuzz sanitize lint format test-quick venv-package package test-package
 
 help:
-	@sed -n '2,15p' Makefile | sed 's/^# \{0,1\}//'
+	@sed -n '2,17p' Makefile | sed 's/^# \{0,1\}//'
 
 # ---- setup ------------------------------------------------------------------------------------------
-setup: apt venv native addon
+setup: apt venv venv-package native addon
 
 apt: $(APT_STAMP)
 $(APT_STAMP):
@@ -62,6 +76,22 @@ $(VENV_STAMP): requirements-test.txt | $(APT_STAMP)
 	$(VENV)/bin/python -m pip install -q -r requirements-test.txt
 	@touch $@
 
+# The packaging tools in both venvs (requirements-package.txt), and bpy 5.3 in the 3.13 one.
+venv-package: $(PKG_STAMP) $(VENV313_STAMP) $(VENV310_STAMP)
+$(PKG_STAMP): requirements-package.txt $(VENV_STAMP)
+	$(VENV)/bin/python -m pip install -q -r requirements-package.txt
+	@touch $@
+$(VENV313_STAMP): requirements-package.txt requirements-test-3.13.txt
+	@[ -x $(PY313) ] || { echo "venv: no CPython 3.13 at $(PY313) (pyenv install 3.13.0, or make PY313=...)" >&2; exit 1; }
+	@[ -x $(VENV313)/bin/python ] || { echo "venv: creating $(VENV313)"; $(PY313) -m venv $(VENV313); }
+	$(VENV313)/bin/python -m pip install -q -r requirements-package.txt -r requirements-test-3.13.txt
+	@touch $@
+$(VENV310_STAMP): requirements-package.txt
+	@[ -x $(PY310) ] || { echo "venv: no CPython 3.10 at $(PY310) (pyenv install 3.10.13, or make PY310=...)" >&2; exit 1; }
+	@[ -x $(VENV310)/bin/python ] || { echo "venv: creating $(VENV310)"; $(PY310) -m venv $(VENV310); }
+	$(VENV310)/bin/python -m pip install -q -r requirements-package.txt
+	@touch $@
+
 configure: $(BUILD)/CMakeCache.txt
 $(BUILD)/CMakeCache.txt: | $(APT_STAMP)
 	@# A failed configure leaves a CMakeCache.txt behind: remove it so the next run configures again.
@@ -77,9 +107,19 @@ native: $(BUILD)/CMakeCache.txt
 addon: native
 	@BLENDER=$(BLENDER) BUILD_DIR=$(BUILD) scripts/install-addon.sh
 
+# The release files (docs/install.md): a portable wheel per Python, repaired by auditwheel
+# (scripts/build-wheel.sh; incremental in build/wheel/), then the extension zip, built and
+# validated by Blender's own tool, and the legacy zip (scripts/build-extension.py).
+package: venv-package
+	@rm -f $(DIST)/toyrt-*.whl $(DIST)/render_toyrt-*.zip
+	@JOBS=$(JOBS) scripts/build-wheel.sh $(VENV)/bin/python $(DIST)
+	@JOBS=$(JOBS) scripts/build-wheel.sh $(VENV313)/bin/python $(DIST)
+	@JOBS=$(JOBS) scripts/build-wheel.sh $(VENV310)/bin/python $(DIST)
+	@$(VENV)/bin/python scripts/build-extension.py --dist $(DIST)
+
 # ---- tests ------------------------------------------------------------------------------------------
 test: setup
-	@$(MAKE) --no-print-directory lint test-native test-python test-blender test-bpy fuzz sanitize
+	@$(MAKE) --no-print-directory lint test-native test-python test-blender test-bpy test-package fuzz sanitize
 
 test-quick: native venv
 	@$(MAKE) --no-print-directory lint test-native test-python
@@ -87,7 +127,7 @@ test-quick: native venv
 # Every C++ file we wrote (not the generated ones in build*/) and every Python file: one style each
 # (.clang-format, ruff.toml), checked, never rewritten, by `make test`.
 CXX_SOURCES = $(shell git ls-files '*.cpp' '*.h' 2>/dev/null || find native tests bench -name '*.cpp' -o -name '*.h')
-PY_SOURCES  := addon scenes tests bench scripts
+PY_SOURCES  := addon scenes tests bench scripts native/python
 
 lint: venv
 	@clang-format-14 --dry-run --Werror $(CXX_SOURCES) && echo "lint: clang-format: $(words $(CXX_SOURCES)) C++ files formatted"
@@ -123,6 +163,25 @@ test-bpy:
 		$(VENV)/bin/python tests/blender/run_with_bpy.py $$t --build $(BUILD) || { echo "FAILED (bpy): $$t" >&2; echo "bpy: $$passed passed, 1 failed"; exit 1; }; \
 		passed=$$((passed + 1)); \
 	done; echo "bpy: $$passed passed, 0 failed"
+
+# The release files installed where users are: each wheel in a fresh venv (numpy 1.x and 2.x on 3.11,
+# 2.x on 3.13, 1.x on 3.10 as blender.org's 3.4-4.0 bundle) running the ray-API tests; the extension
+# zip in bpy 5.0.1 (3.11) and 5.3.0 (3.13) through Blender's extension API, and the legacy zip in
+# Debian's Blender 3.4, each rendering a closed form; the bad inputs on the way (tests/package/).
+# The CPU levels of the wheels' dispatch (native/python/toyrt/) this CPU runs, each forced once in the
+# 3.13 venv (the best one is also what the other runs pick).
+CPU_LEVELS = $(shell grep -qw sse4_2 /proc/cpuinfo && echo v2) $(shell grep -qw avx2 /proc/cpuinfo && echo v3) \
+	$(shell grep -qw avx512bw /proc/cpuinfo && echo v4)
+EXT_ZIP    = $(DIST)/render_toyrt-$(VERSION)-linux_x64.zip
+LEGACY_ZIP = $(DIST)/render_toyrt-$(VERSION)-legacy-linux_x64.zip
+test-package: package
+	tests/package/fresh_venv.sh $(SYS_PY) 1 $(DIST)/toyrt-$(VERSION)-cp311-*.whl
+	tests/package/fresh_venv.sh $(SYS_PY) 2 $(DIST)/toyrt-$(VERSION)-cp311-*.whl
+	tests/package/fresh_venv.sh $(PY313) 2 $(DIST)/toyrt-$(VERSION)-cp313-*.whl $(CPU_LEVELS)
+	tests/package/fresh_venv.sh $(PY310) 1 $(DIST)/toyrt-$(VERSION)-cp310-*.whl
+	$(VENV)/bin/python tests/package/install_extension.py $(EXT_ZIP) $(LEGACY_ZIP)
+	$(VENV313)/bin/python tests/package/install_extension.py $(EXT_ZIP) $(LEGACY_ZIP)
+	$(SYS_PY) tests/package/install_legacy.py $(LEGACY_ZIP) --blender $(BLENDER)
 
 # ---- the rest ---------------------------------------------------------------------------------------
 demo: setup
@@ -203,4 +262,4 @@ clean:
 	rm -rf $(BUILD) $(FUZZ_BUILD) $(SAN_BUILD)
 
 distclean: clean
-	rm -rf $(VENV)
+	rm -rf $(VENV) $(VENV313) $(VENV310) $(DIST)

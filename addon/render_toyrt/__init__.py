@@ -1,9 +1,9 @@
 # TOYRT add-on for Blender: a render engine with a fast, exact native core.
 #
-# Installs as a legacy add-on (bl_info, a package in scripts/addons) and as a 4.2+ extension
-# (blender_manifest.toml). `make setup` copies this folder there together with the native module
-# built from native/ (toyrt.cpython-311-x86_64-linux-gnu.so), so the module sits beside this file
-# and imports as `render_toyrt.toyrt`; it is built for Debian's Python 3.11, Blender 3.4's.
+# Installs as a legacy add-on (bl_info, a package in scripts/addons: the zip for Blender 3.4-4.1
+# and `make setup`, with the native module built from native/ beside this file) and as a 4.2+
+# extension (blender_manifest.toml, the module from its wheel); native_module.py finds it in either.
+# Blender ignores bl_info in an extension (addon_utils removes it), so one folder serves both.
 #
 # The parts: properties.py (settings at scene.toyrt), ui.py (panels), sync.py (the one walker of
 # the depsgraph and the one writer of the native scene) over the converters that return plain
@@ -22,39 +22,61 @@ bl_info = {
 }
 
 _native = None  # the imported native module, once native() has succeeded
+load_error = ""  # why the module did not load at register(), for the TOYRT panel; "" when it did
 
 
 def native() -> types.ModuleType:
-    """Return the native `toyrt` module shipped in this add-on's folder, importing it on first use.
+    """Return the native `toyrt` module (native_module.py: beside this file, or from the
+    extension's wheel), importing it on first use.
 
-    Raises ImportError with a hint when the module is missing or cannot be loaded (for example
-    built for another Python), so callers fail with a message rather than an obscure error.
+    Raises ImportError saying what was tried and the likely fix (for example a module built for
+    another Python), so callers fail with a message rather than an obscure error.
     """
     global _native
     if _native is None:
-        try:
-            from . import toyrt  # the extension module beside this file
-        except ImportError as err:
-            raise ImportError(
-                f"TOYRT: cannot import the native module from {__path__[0]} ({err}); "
-                "build and install it with `make setup` in the TOYRT repository"
-            ) from err
-        _native = toyrt
+        from . import native_module
+
+        _native = native_module.load()
     return _native
+
+
+def _other_copy() -> str:
+    """The module name and folder of another enabled copy of TOYRT (the legacy add-on beside the extension, or the
+    reverse), or "". Both would register the engine "TOYRT" and scene.toyrt, and disabling one
+    would unregister the other's engine."""
+    import os
+    import sys
+
+    import bpy
+
+    for cls in bpy.types.RenderEngine.__subclasses__():
+        package = cls.__module__.rpartition(".")[0]
+        if getattr(cls, "bl_idname", None) == "TOYRT" and cls.is_registered and package != __name__:
+            where = getattr(sys.modules.get(package), "__file__", None)
+            return f"{package} ({os.path.dirname(where)})" if where else package
+    return ""
 
 
 def register() -> None:
     from . import engine, properties, ui
 
+    other = _other_copy()
+    if other:
+        # Raised before anything is registered: Blender shows it where the add-on is enabled.
+        raise RuntimeError(f"TOYRT is already enabled from {other}: disable or remove that copy first "
+                           "(Preferences > Add-ons), then enable this one")
     properties.register()
     engine.register()
     ui.register()
     # Load the native module now so a broken install shows up at once, but never let it stop
     # Blender or the add-on from loading: the engine reports the error when asked to render.
+    global load_error
     try:
         native()
+        load_error = ""
     except Exception as err:  # ImportError above, or anything the module's own init raises
-        print(err if isinstance(err, ImportError) else f"TOYRT: loading the native module failed: {err!r}")
+        load_error = str(err) if isinstance(err, ImportError) else f"TOYRT: loading the native module failed: {err!r}"
+        print(load_error, flush=True)
 
 
 def unregister() -> None:

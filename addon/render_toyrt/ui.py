@@ -1,4 +1,7 @@
 """The TOYRT panel in Render Properties, and Blender's standard panels opened to TOYRT."""
+import sys
+import textwrap
+
 import bpy
 
 # Blender's own panels that work unchanged with TOYRT (as Blender's custom-engine example does).
@@ -27,6 +30,11 @@ class RENDER_PT_toyrt(bpy.types.Panel):
         layout = self.layout
         layout.use_property_split = True
         settings = context.scene.toyrt
+        # A native module that did not load (wrong Python, missing file) is said here, not only in
+        # the console, where a user who installed from the UI would never look.
+        problem = sys.modules[__package__].load_error
+        for i, line in enumerate(textwrap.wrap(problem, 70)):
+            layout.label(text=line, icon="ERROR" if i == 0 else "BLANK1")
         layout.prop(settings, "samples")
         layout.prop(settings, "viewport_samples")
         layout.prop(settings, "area_light_sampling")

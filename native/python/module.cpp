@@ -69,7 +69,13 @@ Params material_params(py::handle color, int64_t texture, float ior, const py::k
 
 }  // namespace
 
-PYBIND11_MODULE(toyrt, m) {
+// The wheels build this module once per CPU level under another name (toyrt._core_v3, ...; see
+// native/CMakeLists.txt), which Python finds through the name of its init function.
+#ifndef TOYRT_MODULE_NAME
+#define TOYRT_MODULE_NAME toyrt
+#endif
+
+PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
   m.doc() = "TOYRT's native core: watertight triangles, SAH BVH, two-level scenes, batch ray queries.";
   m.attr("__version__") = "0.1.0";
   m.attr("defaults") = core_defaults();
