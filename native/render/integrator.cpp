@@ -55,11 +55,80 @@ int32_t material_of(const Scene& scene, const Hit& hit) {
   return sh.material_ids.empty() ? 0 : sh.material_ids[size_t(hit.prim)];
 }
 
+// What the out-of-line lighting functions below share with direct_lighting: the point's shadow
+// ray origin, its normals, its diffuse BSDF value and its path vertex.
+struct DiffusePoint {
+  Vec3 origin, ng, ns, f;
+  int depth;
+};
+
+// The environment map as a light: one sample from the map's distribution and one
+// cosine-distributed, combined by the power heuristic, so a bright sun in the map and a uniform
+// sky are both found with little noise.
+[[gnu::noinline]] Vec3 environment_lighting(const Scene& scene, const DiffusePoint& at, uint32_t pixel, uint32_t sample,
+                                            const IntegratorSettings& settings) {
+  const Environment& env = scene.world().environment;
+  const Texture& image = scene.textures()[size_t(env.texture)];
+  Vec3 sum(0.0f);
+  const EnvironmentSample es = sample_environment(
+      env, image, sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 2), settings.seed));
+  if (es.pdf > 0.0f) {
+    const float cos_s = glm::dot(at.ns, es.wi);
+    if (cos_s > 0.0f && glm::dot(at.ng, es.wi) > 0.0f && !scene.occluded(Ray{at.origin, 0.0f, es.wi, kInfinity})) {
+      const float pc = cos_s * kInvPi;
+      sum += at.f * es.radiance * (cos_s * es.pdf / (es.pdf * es.pdf + pc * pc));
+    }
+  }
+  const Vec3 local = sample_cosine_hemisphere(
+      sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 1), settings.seed));
+  const Vec3 wi = Frame::from_normal(at.ns).to_world(local);
+  if (glm::dot(at.ng, wi) > 0.0f && local.z > 0.0f && !scene.occluded(Ray{at.origin, 0.0f, wi, kInfinity})) {
+    const float pc = local.z * kInvPi, pe = environment_pdf(env, wi);
+    sum += at.f * environment_radiance(env, image, wi) * (local.z * pc / (pe * pe + pc * pc));
+  }
+  return sum;
+}
+
+// Emissive triangles: one sample from their power distribution, whatever their number.
+[[gnu::noinline]] Vec3 emitter_lighting(const Scene& scene, const DiffusePoint& at, const Vec3& p, uint32_t pixel,
+                                        uint32_t sample, const IntegratorSettings& settings) {
+  const LightSample ls = sample_emitters(
+      scene.emitters(), p, sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 3), settings.seed));
+  if (!ls.valid()) return Vec3(0.0f);
+  const float cos_s = glm::dot(at.ns, ls.wi);
+  if (cos_s <= 0.0f || glm::dot(at.ng, ls.wi) <= 0.0f ||
+      scene.occluded(Ray{at.origin, 0.0f, ls.point - at.origin, 1.0f}))
+    return Vec3(0.0f);
+  return at.f * ls.radiance * (cos_s / ls.pdf);
+}
+
+// Emitters, or sides of them, that shadow rays do not sample (Blender's emission sampling None,
+// Front, Back) still light diffuse surfaces in Cycles: its last bounce collects the emission its
+// BSDF-sampled ray finds (with full weight where light sampling has no density). One cosine ray
+// does the same, counting only what the emitter sampling leaves out, so the two estimators split
+// the emitters between them; only scenes with such emitters pay for it.
+[[gnu::noinline]] Vec3 unsampled_emission_lighting(const Scene& scene, const DiffusePoint& at, uint32_t pixel,
+                                                   uint32_t sample, const IntegratorSettings& settings) {
+  const Vec3 local = sample_cosine_hemisphere(
+      sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 4), settings.seed));
+  const Vec3 wi = Frame::from_normal(at.ns).to_world(local);
+  if (glm::dot(at.ng, wi) <= 0.0f || local.z <= 0.0f) return Vec3(0.0f);
+  const Hit hit = scene.intersect(Ray{at.origin, 0.0f, wi, kInfinity});
+  const int32_t m = hit.found() ? material_of(scene, hit) : -1;
+  if (m < 0 || size_t(m) >= scene.emission().size()) return Vec3(0.0f);
+  const MaterialEmission& e = scene.emission()[size_t(m)];
+  const bool front = glm::dot(surface_at(scene, hit).ng, wi) < 0.0f;
+  const uint8_t side = uint8_t(front ? EmitterSides::Front : EmitterSides::Back);
+  if (!e.emits() || (e.sampled && (uint8_t(e.sides) & side))) return Vec3(0.0f);
+  return at.f * e.radiance * kPi;  // f L cos / (cos / pi)
+}
+
 // Light arriving at a diffuse point: one sample per light, or one light chosen by contribution.
 Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f, int depth,
                      uint32_t pixel, uint32_t sample, const IntegratorSettings& settings) {
   const World& world = scene.world();
   const Vec3 origin = offset_ray_origin(s.p, ng);
+  const DiffusePoint at{origin, ng, ns, f, depth};
   Vec3 sum(0.0f);
   auto add = [&](size_t index, float select_probability, uint32_t dim) {
     const LightVisibility v = world.light_visibility[index];
@@ -79,68 +148,21 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     }
     sum += f * ls.radiance * (cos_s / (ls.pdf * select_probability));
   };
-  // The world as a light. An environment map: one sample from the map's distribution and one
-  // cosine-distributed, combined by the power heuristic, so a bright sun in the map and a
-  // uniform sky are both found with little noise. A constant background: the cosine-distributed
-  // direction alone makes the estimate f L cos / pdf = albedo L when nothing blocks it, exactly.
-  if (world.background_lights_surfaces && world.environment.active()) {
-    const Environment& env = world.environment;
-    const Texture& image = scene.textures()[size_t(env.texture)];
-    const EnvironmentSample es = sample_environment(
-        env, image, sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 2), settings.seed));
-    if (es.pdf > 0.0f) {
-      const float cos_s = glm::dot(ns, es.wi);
-      if (cos_s > 0.0f && glm::dot(ng, es.wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, es.wi, kInfinity})) {
-        const float pc = cos_s * kInvPi;
-        sum += f * es.radiance * (cos_s * es.pdf / (es.pdf * es.pdf + pc * pc));
-      }
-    }
-    const Vec3 local = sample_cosine_hemisphere(
-        sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 1), settings.seed));
-    const Vec3 wi = Frame::from_normal(ns).to_world(local);
-    if (glm::dot(ng, wi) > 0.0f && local.z > 0.0f && !scene.occluded(Ray{origin, 0.0f, wi, kInfinity})) {
-      const float pc = local.z * kInvPi, pe = environment_pdf(env, wi);
-      sum += f * environment_radiance(env, image, wi) * (local.z * pc / (pe * pe + pc * pc));
-    }
-  } else if (world.background_lights_surfaces && world.background != Vec3(0.0f)) {
+  // The world, emissive meshes: each in a function of its own, out of line, so a scene of lamps
+  // and a constant world runs the same small loop as before they existed.
+  if (world.background_lights_surfaces && world.environment.active())
+    sum += environment_lighting(scene, at, pixel, sample, settings);
+  else if (world.background_lights_surfaces && world.background != Vec3(0.0f)) {
+    // A constant background: a cosine-distributed direction makes the estimate f L cos / pdf =
+    // albedo L when nothing blocks it, exactly.
     const Vec3 local = sample_cosine_hemisphere(
         sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 1), settings.seed));
     const Vec3 wi = Frame::from_normal(ns).to_world(local);
     if (glm::dot(ng, wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, wi, kInfinity}))
       sum += f * world.background * kPi;  // f = albedo / pi
   }
-  // Emissive triangles: one sample from their power distribution, whatever their number.
-  if (!scene.emitters().empty()) {
-    const LightSample ls =
-        sample_emitters(scene.emitters(), s.p,
-                        sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 3), settings.seed));
-    if (ls.valid()) {
-      const float cos_s = glm::dot(ns, ls.wi);
-      if (cos_s > 0.0f && glm::dot(ng, ls.wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, ls.point - origin, 1.0f}))
-        sum += f * ls.radiance * (cos_s / ls.pdf);
-    }
-  }
-  // Emitters, or sides of them, that shadow rays do not sample (Blender's emission sampling None,
-  // Front, Back) still light diffuse surfaces in Cycles: its last bounce collects the emission
-  // its BSDF-sampled ray finds (with full weight where light sampling has no density). One
-  // cosine ray does the same, counting only what the emitter sampling leaves out, so the two
-  // estimators split the emitters between them; only scenes with such emitters pay for it.
-  if (scene.any_unsampled_emission()) {
-    const Vec3 local = sample_cosine_hemisphere(
-        sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 4), settings.seed));
-    const Vec3 wi = Frame::from_normal(ns).to_world(local);
-    if (glm::dot(ng, wi) > 0.0f && local.z > 0.0f) {
-      const Hit hit = scene.intersect(Ray{origin, 0.0f, wi, kInfinity});
-      const int32_t m = hit.found() ? material_of(scene, hit) : -1;
-      if (m >= 0 && size_t(m) < scene.emission().size()) {
-        const MaterialEmission& e = scene.emission()[size_t(m)];
-        const bool front = glm::dot(surface_at(scene, hit).ng, wi) < 0.0f;
-        const uint8_t side = uint8_t(front ? EmitterSides::Front : EmitterSides::Back);
-        if (e.emits() && (!e.sampled || !(uint8_t(e.sides) & side)))
-          sum += f * e.radiance * kPi;  // f L cos / (cos / pi)
-      }
-    }
-  }
+  if (!scene.emitters().empty()) sum += emitter_lighting(scene, at, s.p, pixel, sample, settings);
+  if (scene.any_unsampled_emission()) sum += unsampled_emission_lighting(scene, at, pixel, sample, settings);
   const std::vector<Light>& lights = world.lights;
   if (settings.light_sampling != LightSampling::One || lights.size() == 1) {
     for (size_t j = 0; j < lights.size(); ++j) add(j, 1.0f, 1 + uint32_t(j));
