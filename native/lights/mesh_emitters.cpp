@@ -1,6 +1,7 @@
 #include "lights/mesh_emitters.h"
 
 #include "geometry/offset_ray.h"
+#include "lights/spherical_triangle.h"
 
 #include <algorithm>
 #include <cmath>
@@ -41,6 +42,28 @@ LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const V
   if (!(width > 0.0f)) return s;
   const float ux = std::clamp((u.x - lo) / width, 0.0f, 0.99999994f);
   const EmissiveTriangle& t = emitters.triangles[i];
+  // Which side p sees, from its height over the triangle's plane.
+  const float height = glm::dot(p - t.p0, t.normal);
+  const uint8_t side = height > 0.0f ? uint8_t(EmitterSides::Front) : uint8_t(EmitterSides::Back);
+  if (height == 0.0f || !(uint8_t(t.sides) & side)) return s;
+  // Close to a triangle (its longest edge longer than p's distance from its plane, Cycles'
+  // rule) its solid angle is sampled; far away its area, where the two densities agree.
+  const Vec3 e3 = t.e2 - t.e1;
+  const float longest2 = std::max({glm::dot(t.e1, t.e1), glm::dot(t.e2, t.e2), glm::dot(e3, e3)});
+  if (longest2 > height * height) {
+    const SphericalTriangle st = SphericalTriangle::make(p, t.p0, t.p0 + t.e1, t.p0 + t.e2);
+    if (st.solid_angle > SphericalTriangle::kMinSolidAngle) {
+      s.wi = st.sample(Vec2(ux, u.y));
+      const float cos_light = -glm::dot(t.normal, s.wi);
+      if (!(std::fabs(cos_light) > 0.0f) || (cos_light > 0.0f) != (height > 0.0f)) return s;
+      s.distance = std::fabs(height) / std::fabs(cos_light);
+      s.point = p + s.distance * s.wi;
+      s.pdf = width / float(st.solid_angle);
+      s.radiance = t.radiance;
+      s.point = offset_ray_origin(s.point, cos_light > 0.0f ? t.normal : -t.normal);
+      return s;
+    }
+  }
   const Vec2 b = sample_uniform_triangle(Vec2(ux, u.y));
   s.point = t.p0 + b.x * t.e1 + b.y * t.e2;
   const Vec3 to_point = s.point - p;
@@ -49,8 +72,7 @@ LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const V
   s.distance = std::sqrt(d2);
   s.wi = to_point / s.distance;
   const float cos_light = -glm::dot(t.normal, s.wi);  // > 0: p sees the front
-  const uint8_t side = cos_light > 0.0f ? uint8_t(EmitterSides::Front) : uint8_t(EmitterSides::Back);
-  if (cos_light == 0.0f || !(uint8_t(t.sides) & side)) return s;
+  if (cos_light == 0.0f || (cos_light > 0.0f) != (height > 0.0f)) return s;
   s.pdf = width * d2 / (t.area * std::fabs(cos_light));
   s.radiance = t.radiance;
   // The shadow ray ends at `point`: moved off the triangle towards p, so the emitter's own

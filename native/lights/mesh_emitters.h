@@ -4,8 +4,10 @@
 // Emission surface of strength 1 and colour c sees c).
 //
 // Sampling: one triangle chosen with probability proportional to its power (area x mean
-// radiance) from a CDF (binary search, so millions of triangles cost a log2 of them), a uniform
-// point on it; the density in solid angle is P(triangle) d^2 / (area |cos_light|). A triangle
+// radiance) from a CDF (binary search, so millions of triangles cost a log2 of them); then, close
+// to it (its longest edge longer than the point's height over its plane, Cycles' rule), a
+// direction uniform in its solid angle (lights/spherical_triangle.h: density P(triangle) / Omega),
+// else a uniform point on it (density P(triangle) d^2 / (area |cos_light|)). A triangle
 // whose material is not sampled as a light (Blender's emission sampling None) is left out: it
 // is seen by rays that hit it, and lights nothing. Sides: Blender 4.x's emission sampling Front
 // or Back samples only towards that side (Cycles' then lights nothing on the other side by NEE).

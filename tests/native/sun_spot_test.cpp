@@ -4,6 +4,8 @@
 // spot's cone edge in both of Cycles' falloffs (and its elliptic cone under non-uniform scale);
 // evaluate() agreeing with sample() on the density and radiance of the same direction.
 #include "lights/light.h"
+#include "lights/mesh_emitters.h"
+#include "lights/spherical_triangle.h"
 
 #include "light_estimates.h"
 
@@ -214,4 +216,88 @@ TEST(SpotLight, RefusesBadSettings) {
   EXPECT_THROW(make_light("SPOT", Params({{"spot_blend", 1.5}})), std::invalid_argument);
   EXPECT_THROW(make_light("SPOT", Params({{"falloff", std::string("LINEAR")}})), std::invalid_argument);
   EXPECT_THROW(make_light("SPOT", Params({{"matrix", Mat4(0.0f)}})), std::invalid_argument);
+}
+
+namespace {
+
+// Van Oosterom and Strackee (1983): tan(Omega / 2) = |a . (b x c)| / (|a||b||c| + (a.b)|c| + (a.c)|b| + (b.c)|a|).
+double solid_angle_vos(const DVec3& a, const DVec3& b, const DVec3& c) {
+  const double la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
+  const double num = std::fabs(glm::dot(a, glm::cross(b, c)));
+  const double den = la * lb * lc + glm::dot(a, b) * lc + glm::dot(a, c) * lb + glm::dot(b, c) * la;
+  double omega = 2.0 * std::atan2(num, den);
+  return omega < 0.0 ? omega + 2.0 * kPiD : omega;
+}
+
+// The barycentrics where the ray from p along d meets the triangle's plane.
+DVec3 barycentrics(const DVec3& p, const DVec3& d, const DVec3& v0, const DVec3& v1, const DVec3& v2) {
+  const DVec3 e1 = v1 - v0, e2 = v2 - v0, n = glm::cross(e1, e2);
+  const double t = glm::dot(n, v0 - p) / glm::dot(n, d);
+  const DVec3 q = p + t * d - v0;
+  const double d11 = glm::dot(e1, e1), d12 = glm::dot(e1, e2), d22 = glm::dot(e2, e2);
+  const double q1 = glm::dot(q, e1), q2 = glm::dot(q, e2), det = d11 * d22 - d12 * d12;
+  const double b1 = (d22 * q1 - d12 * q2) / det, b2 = (d11 * q2 - d12 * q1) / det;
+  return DVec3(1.0 - b1 - b2, b1, b2);
+}
+
+}  // namespace
+
+TEST(SphericalTriangle, SolidAngleAndSamplesAreTheTrianglesAndUniform) {
+  const Vec3 p(0.1f, -0.2f, 0.0f);
+  const Vec3 tris[][3] = {{Vec3(-1, -1, 0.3f), Vec3(1.5f, -0.5f, 0.4f), Vec3(0, 1, 0.2f)},  // close and wide
+                          {Vec3(2, 0, 1), Vec3(2.2f, 0.1f, 1.1f), Vec3(2.1f, 0.3f, 0.9f)},  // small, further
+                          {Vec3(-5, -5, 0.01f), Vec3(5, -5, 0.01f), Vec3(0, 5, 0.01f)}};  // nearly the whole hemisphere
+  for (const auto& v : tris) {
+    const SphericalTriangle st = SphericalTriangle::make(p, v[0], v[1], v[2]);
+    const DVec3 o(p), a = DVec3(v[0]) - o, b = DVec3(v[1]) - o, c = DVec3(v[2]) - o;
+    EXPECT_NEAR(st.solid_angle, solid_angle_vos(a, b, c), 1e-9 + 1e-7 * st.solid_angle);
+    // Samples hit the triangle, and fall into its four midpoint sub-triangles as their solid angles say.
+    const DVec3 ab = 0.5 * (a + b), bc = 0.5 * (b + c), ca = 0.5 * (c + a);
+    const DVec3 sub[4][3] = {{a, ab, ca}, {ab, b, bc}, {ca, bc, c}, {ab, bc, ca}};
+    int count[4] = {0, 0, 0, 0};
+    const int n = 40000;
+    for (int i = 0; i < n; ++i) {
+      const DVec3 d(st.sample(rand2(uint32_t(i), 31)));
+      const DVec3 w = barycentrics(DVec3(0.0), d, a, b, c);
+      ASSERT_GE(w.x, -1e-4);
+      ASSERT_GE(w.y, -1e-4);
+      ASSERT_GE(w.z, -1e-4);
+      for (int k = 0; k < 4; ++k) {
+        const DVec3 s = barycentrics(DVec3(0.0), d, sub[k][0], sub[k][1], sub[k][2]);
+        if (s.x >= 0 && s.y >= 0 && s.z >= 0) {
+          ++count[k];
+          break;
+        }
+      }
+    }
+    for (int k = 0; k < 4; ++k) {
+      const double expected = solid_angle_vos(sub[k][0], sub[k][1], sub[k][2]) / st.solid_angle;
+      EXPECT_NEAR(count[k] / double(n), expected, 5.0 * std::sqrt(expected * (1 - expected) / n) + 1e-3) << k;
+    }
+  }
+}
+
+TEST(SphericalTriangle, AFloorPointBesideAGlowingTriangleGetsItsIrradianceWithLittleNoise) {
+  // A floor point 1 mm from an emitting triangle's edge (a glowing object resting on the floor):
+  // solid-angle sampling has bounded weights, area sampling spikes as 1 / r^2.
+  MeshEmitters emitters;
+  EmissiveTriangle t;
+  t.p0 = Vec3(0.001f, -0.5f, 0.0f);
+  t.e1 = Vec3(0.0f, 1.0f, 0.0f);
+  t.e2 = Vec3(0.0f, 0.5f, 0.5f);
+  t.normal = glm::normalize(glm::cross(t.e1, t.e2));
+  if (t.normal.x > 0.0f) t.normal = -t.normal;  // facing the point at the origin side
+  t.area = 0.5f * glm::length(glm::cross(t.e1, t.e2));
+  t.radiance = Vec3(1.0f);
+  emitters.add(t);
+  emitters.finish();
+  const Vec3 n = glm::normalize(Vec3(-0.2f, 0.0f, 1.0f));
+  const Estimate e = monte_carlo(20000, [&](uint32_t i) {
+    const LightSample s = sample_emitters(emitters, Vec3(0.0f), rand2(i, 32));
+    return s.valid() ? double(s.radiance.x) * std::max(0.0f, glm::dot(n, s.wi)) / s.pdf : 0.0;
+  });
+  // Each sample is L cos_receiver / (1 / Omega) <= L Omega: a relative standard error of well
+  // under a per cent from 20,000 samples (area sampling's: 46 %, measured with numpy).
+  EXPECT_GT(e.mean, 0.0);
+  EXPECT_LT(e.standard_error / e.mean, 0.01);
 }
