@@ -31,6 +31,33 @@ void MeshEmitters::finish() {
   if (!cdf.empty()) cdf.back() = 1.0f;
 }
 
+namespace {
+
+// Cycles' rule for sampling a triangle by its solid angle: p is close to it, its longest edge
+// longer than p's distance from its plane.
+bool close_to(const EmissiveTriangle& t, float height) {
+  const Vec3 e3 = t.e2 - t.e1;
+  const float longest2 = std::max({glm::dot(t.e1, t.e1), glm::dot(t.e2, t.e2), glm::dot(e3, e3)});
+  return longest2 > height * height;
+}
+
+}  // namespace
+
+float emitter_pdf(const MeshEmitters& emitters, const Vec3& p, const EmissiveTriangle& t, const Vec3& wi,
+                  float distance) {
+  if (emitters.total_power <= 0.0 || !(t.area > 0.0f)) return 0.0f;
+  const float height = glm::dot(p - t.p0, t.normal);
+  const uint8_t side = height > 0.0f ? uint8_t(EmitterSides::Front) : uint8_t(EmitterSides::Back);
+  if (height == 0.0f || !(uint8_t(t.sides) & side)) return 0.0f;
+  const float chosen = float(double(t.area) * mean(t.radiance) / emitters.total_power);
+  if (close_to(t, height)) {
+    const SphericalTriangle st = SphericalTriangle::make(p, t.p0, t.p0 + t.e1, t.p0 + t.e2);
+    if (st.solid_angle > SphericalTriangle::kMinSolidAngle) return chosen / float(st.solid_angle);
+  }
+  const float cos_light = std::fabs(glm::dot(t.normal, wi));
+  return cos_light > 0.0f ? chosen * distance * distance / (t.area * cos_light) : 0.0f;
+}
+
 LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const Vec2& u) {
   LightSample s;
   const size_t n = emitters.triangles.size();
@@ -46,11 +73,8 @@ LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const V
   const float height = glm::dot(p - t.p0, t.normal);
   const uint8_t side = height > 0.0f ? uint8_t(EmitterSides::Front) : uint8_t(EmitterSides::Back);
   if (height == 0.0f || !(uint8_t(t.sides) & side)) return s;
-  // Close to a triangle (its longest edge longer than p's distance from its plane, Cycles'
-  // rule) its solid angle is sampled; far away its area, where the two densities agree.
-  const Vec3 e3 = t.e2 - t.e1;
-  const float longest2 = std::max({glm::dot(t.e1, t.e1), glm::dot(t.e2, t.e2), glm::dot(e3, e3)});
-  if (longest2 > height * height) {
+  // Close to a triangle its solid angle is sampled; far away its area, where the two agree.
+  if (close_to(t, height)) {
     const SphericalTriangle st = SphericalTriangle::make(p, t.p0, t.p0 + t.e1, t.p0 + t.e2);
     if (st.solid_angle > SphericalTriangle::kMinSolidAngle) {
       s.wi = st.sample(Vec2(ux, u.y));

@@ -50,4 +50,11 @@ struct MeshEmitters {
 // the triangle). No sample when the chosen triangle faces away on a side it does not emit to.
 LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const Vec2& u);
 
+// The solid-angle density sample_emitters() gives the direction wi from p when it meets emissive
+// triangle t (world space, as gathered) at `distance`: P(t) = its power / the total, times its
+// own density (1 / Omega close to it, d^2 / (area |cos|) further away); 0 where t's side facing p
+// is not sampled. For multiple importance sampling against rays that hit emitters.
+float emitter_pdf(const MeshEmitters& emitters, const Vec3& p, const EmissiveTriangle& t, const Vec3& wi,
+                  float distance);
+
 }  // namespace toyrt

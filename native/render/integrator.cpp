@@ -89,38 +89,58 @@ struct DiffusePoint {
   return sum;
 }
 
-// Emissive triangles: one sample from their power distribution, whatever their number.
-[[gnu::noinline]] Vec3 emitter_lighting(const Scene& scene, const DiffusePoint& at, const Vec3& p, uint32_t pixel,
-                                        uint32_t sample, const IntegratorSettings& settings) {
-  const LightSample ls = sample_emitters(
-      scene.emitters(), p, sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 3), settings.seed));
-  if (!ls.valid()) return Vec3(0.0f);
-  const float cos_s = glm::dot(at.ns, ls.wi);
-  if (cos_s <= 0.0f || glm::dot(at.ng, ls.wi) <= 0.0f ||
-      scene.occluded(Ray{at.origin, 0.0f, ls.point - at.origin, 1.0f}))
-    return Vec3(0.0f);
-  return at.f * ls.radiance * (cos_s / ls.pdf);
+// The emissive triangle a hit found, in world space as the scene gathers them (scene_emitters.cpp).
+EmissiveTriangle emissive_triangle_at(const Scene& scene, const Hit& hit, const MaterialEmission& e) {
+  const Instance& inst = scene.instance(uint32_t(hit.instance));
+  const Mesh& mesh = scene.mesh(inst.mesh);
+  const Triangle& tri = mesh.triangles()[size_t(hit.prim)];
+  const auto world = [&](uint32_t v) { return Vec3(inst.to_world * glm::vec4(mesh.vertices()[v], 1.0f)); };
+  EmissiveTriangle t;
+  t.p0 = world(tri.x);
+  t.e1 = world(tri.y) - t.p0;
+  t.e2 = world(tri.z) - t.p0;
+  const Vec3 n = glm::cross(t.e1, t.e2);
+  t.area = 0.5f * glm::length(n);
+  t.normal = t.area > 0.0f ? n / (2.0f * t.area) : Vec3(0.0f);
+  t.radiance = e.radiance;
+  t.sides = e.sampled ? e.sides : EmitterSides(0);
+  return t;
 }
 
-// Emitters, or sides of them, that shadow rays do not sample (Blender's emission sampling None,
-// Front, Back) still light diffuse surfaces in Cycles: its last bounce collects the emission its
-// BSDF-sampled ray finds (with full weight where light sampling has no density). One cosine ray
-// does the same, counting only what the emitter sampling leaves out, so the two estimators split
-// the emitters between them; only scenes with such emitters pay for it.
-[[gnu::noinline]] Vec3 unsampled_emission_lighting(const Scene& scene, const DiffusePoint& at, uint32_t pixel,
-                                                   uint32_t sample, const IntegratorSettings& settings) {
+// Emissive meshes, by two strategies combined with the power heuristic, as Cycles combines its
+// light sampling with the BSDF-sampled ray of the last bounce: a shadow ray to one emissive
+// triangle chosen by power (sample_emitters), and one cosine ray that collects the emission it
+// hits. The cosine ray wins beside a large emitter (a floor under a glowing ball, which the
+// power-chosen triangle rarely finds well) and is the only strategy for emitters, or sides of
+// them, that shadow rays do not sample (emission sampling None, Front, Back).
+[[gnu::noinline]] Vec3 emission_lighting(const Scene& scene, const DiffusePoint& at, const Vec3& p, uint32_t pixel,
+                                         uint32_t sample, const IntegratorSettings& settings) {
+  const MeshEmitters& emitters = scene.emitters();
+  Vec3 sum(0.0f);
+  if (!emitters.empty()) {
+    const LightSample ls = sample_emitters(
+        emitters, p, sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 3), settings.seed));
+    if (ls.valid()) {
+      const float cos_s = glm::dot(at.ns, ls.wi);
+      if (cos_s > 0.0f && glm::dot(at.ng, ls.wi) > 0.0f &&
+          !scene.occluded(Ray{at.origin, 0.0f, ls.point - at.origin, 1.0f})) {
+        const float pb = cos_s * kInvPi;
+        sum += at.f * ls.radiance * (cos_s * ls.pdf / (ls.pdf * ls.pdf + pb * pb));
+      }
+    }
+  }
   const Vec3 local = sample_cosine_hemisphere(
       sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 4), settings.seed));
   const Vec3 wi = Frame::from_normal(at.ns).to_world(local);
-  if (glm::dot(at.ng, wi) <= 0.0f || local.z <= 0.0f) return Vec3(0.0f);
+  if (glm::dot(at.ng, wi) <= 0.0f || local.z <= 0.0f) return sum;
   const Hit hit = scene.intersect(Ray{at.origin, 0.0f, wi, kInfinity});
   const int32_t m = hit.found() ? material_of(scene, hit) : -1;
-  if (m < 0 || size_t(m) >= scene.emission().size()) return Vec3(0.0f);
+  if (m < 0 || size_t(m) >= scene.emission().size() || !scene.emission()[size_t(m)].emits()) return sum;
   const MaterialEmission& e = scene.emission()[size_t(m)];
-  const bool front = glm::dot(surface_at(scene, hit).ng, wi) < 0.0f;
-  const uint8_t side = uint8_t(front ? EmitterSides::Front : EmitterSides::Back);
-  if (!e.emits() || (e.sampled && (uint8_t(e.sides) & side))) return Vec3(0.0f);
-  return at.f * e.radiance * kPi;  // f L cos / (cos / pi)
+  const EmissiveTriangle t = emissive_triangle_at(scene, hit, e);
+  const float pl = emitter_pdf(emitters, p, t, wi, glm::dot(t.p0 + hit.u * t.e1 + hit.v * t.e2 - p, wi));
+  const float pb = local.z * kInvPi;
+  return sum + at.f * e.radiance * (local.z * pb / (pl * pl + pb * pb));  // f L cos / pb x the weight
 }
 
 // Light arriving at a diffuse point: one sample per light, or one light chosen by contribution.
@@ -161,8 +181,7 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     if (glm::dot(ng, wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, wi, kInfinity}))
       sum += f * world.background * kPi;  // f = albedo / pi
   }
-  if (!scene.emitters().empty()) sum += emitter_lighting(scene, at, s.p, pixel, sample, settings);
-  if (scene.any_unsampled_emission()) sum += unsampled_emission_lighting(scene, at, pixel, sample, settings);
+  if (scene.any_emission()) sum += emission_lighting(scene, at, s.p, pixel, sample, settings);
   const std::vector<Light>& lights = world.lights;
   if (settings.light_sampling != LightSampling::One || lights.size() == 1) {
     for (size_t j = 0; j < lights.size(); ++j) add(j, 1.0f, 1 + uint32_t(j));

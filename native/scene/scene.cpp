@@ -106,7 +106,6 @@ uint32_t Scene::add_material(const Material& material, const MaterialEmission& e
   emission_.push_back(emission);
   if (emission.emits()) {
     any_emission_ = true;
-    any_unsampled_emission_ = any_unsampled_emission_ || !emission.sampled || emission.sides != EmitterSides::Both;
     committed_ = false;
   }
   return uint32_t(materials_.size() - 1);
@@ -122,9 +121,6 @@ void Scene::set_material(int64_t material, const Material& replacement, const Ma
     emission_[size_t(material)] = emission;
     any_emission_ =
         std::any_of(emission_.begin(), emission_.end(), [](const MaterialEmission& e) { return e.emits(); });
-    any_unsampled_emission_ = std::any_of(emission_.begin(), emission_.end(), [](const MaterialEmission& e) {
-      return e.emits() && (!e.sampled || e.sides != EmitterSides::Both);
-    });
     committed_ = false;  // the emissive triangles are gathered again
   }
 }

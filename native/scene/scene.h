@@ -148,8 +148,6 @@ class Scene {
   const std::vector<Texture>& textures() const { return textures_; }
   const std::vector<MaterialEmission>& emission() const { return emission_; }  // parallel to materials()
   bool any_emission() const { return any_emission_; }
-  // Emitters (or sides of them) that shadow rays do not sample: emission sampling None, Front, Back.
-  bool any_unsampled_emission() const { return any_unsampled_emission_; }
   const MeshEmitters& emitters() const { return emitters_; }  // the sampled emissive triangles, by commit()
   const World& world() const { return world_; }
   // Triangles stored (each mesh counted once) and placed (each instance counting its mesh).
@@ -171,7 +169,6 @@ class Scene {
   std::vector<Material> materials_;
   std::vector<MaterialEmission> emission_;  // parallel to materials_
   bool any_emission_ = false;
-  bool any_unsampled_emission_ = false;
   MeshEmitters emitters_;
   std::vector<Texture> textures_;
   World world_;

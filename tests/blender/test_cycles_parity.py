@@ -227,13 +227,12 @@ SCENES_SPEC = [
                                                  soft_falloff=False, camera=(0.0, -6.0, 4.5)), 0),
     # Emissive meshes: sampled as lights, seen directly and (second scene) through glass; and an
     # emitter Cycles does not sample (emission sampling None), which lights nothing.
-    ("emitters", scene_emitters, dict(strength=6.0, sampling=None, glass=False, camera=(0.5, -5.5, 3.0),
-                                      sample_factor=4), 0),
+    ("emitters", scene_emitters, dict(strength=6.0, sampling=None, glass=False, camera=(0.5, -5.5, 3.0)), 0),
     ("emitters_through_glass", scene_emitters, dict(strength=6.0, sampling=None, glass=True,
-                                                    camera=(0.5, -5.5, 3.0), sample_factor=4), 8),
+                                                    camera=(0.5, -5.5, 3.0)), 8),
     # Not sampled as a light, Cycles' emitter still lights the floor through the BSDF-sampled ray
-    # of the last bounce (emission is collected before the path ends); TOYRT traces one cosine
-    # ray per diffuse hit for such emitters only.
+    # of the last bounce (emission is collected before the path ends); so does TOYRT's cosine ray
+    # (combined with emitter sampling by MIS where both apply). Noisier: 8x the samples.
     ("emitter_not_sampled", scene_emitters, dict(strength=6.0, sampling="NONE", glass=False,
                                                  camera=(0.5, -5.5, 3.0), sample_factor=8), 0),
     # An HDRI world with a small bright sun, turned by a Mapping node; seen by the camera above the
