@@ -182,6 +182,7 @@ test-package: package
 	$(VENV)/bin/python tests/package/install_extension.py $(EXT_ZIP) $(LEGACY_ZIP)
 	$(VENV313)/bin/python tests/package/install_extension.py $(EXT_ZIP) $(LEGACY_ZIP)
 	$(SYS_PY) tests/package/install_legacy.py $(LEGACY_ZIP) --blender $(BLENDER)
+	tests/package/numpy2_guard.sh $(BUILD)/python
 
 # ---- the rest ---------------------------------------------------------------------------------------
 demo: setup

@@ -76,6 +76,19 @@ Params material_params(py::handle color, int64_t texture, float ior, const py::k
 #endif
 
 PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
+#if PYBIND11_VERSION_MAJOR < 2 || (PYBIND11_VERSION_MAJOR == 2 && PYBIND11_VERSION_MINOR < 12)
+  // A pybind11 older than 2.12 (Debian 12's 2.10) predates numpy 2's C API and reads numpy 2
+  // arrays with the old layout: wrong strides, silently wrong answers (every query point given the
+  // first one's). Refuse to load there rather than answer wrongly; the wheels use pybind11 >= 2.13.
+  {
+    const std::string numpy = py::module_::import("numpy").attr("__version__").cast<std::string>();
+    if (numpy.size() > 1 && numpy[0] >= '2' && numpy[1] == '.')
+      throw py::import_error("toyrt: this build (pybind11 " + std::to_string(PYBIND11_VERSION_MAJOR) + "." +
+                             std::to_string(PYBIND11_VERSION_MINOR) + ") cannot read numpy " + numpy +
+                             " arrays: use numpy < 2, or a toyrt wheel (pip install toyrt-*.whl, built with pybind11 "
+                             ">= 2.13)");
+  }
+#endif
   m.doc() = "TOYRT's native core: watertight triangles, SAH BVH, two-level scenes, batch ray queries.";
   m.attr("__version__") = "0.1.0";
   m.attr("defaults") = core_defaults();
