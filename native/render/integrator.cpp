@@ -49,10 +49,11 @@ SurfaceHit surface_at(const Scene& scene, const Hit& hit) {
   return s;
 }
 
-// The material id of the triangle a hit found (-1: none given).
+// The material id of the triangle a hit found; -1 for a mesh without material ids, which renders
+// with the default grey (surface_at) and so emits nothing.
 int32_t material_of(const Scene& scene, const Hit& hit) {
   const MeshShading& sh = scene.shading(scene.instance(uint32_t(hit.instance)).mesh);
-  return sh.material_ids.empty() ? 0 : sh.material_ids[size_t(hit.prim)];
+  return sh.material_ids.empty() ? -1 : sh.material_ids[size_t(hit.prim)];
 }
 
 // What the out-of-line lighting functions below share with direct_lighting: the point's shadow

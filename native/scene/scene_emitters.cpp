@@ -15,9 +15,10 @@ void Scene::gather_emitters() {
     const MeshShading& sh = shading_[inst.mesh];
     const std::vector<Vec3>& v = mesh.vertices();
     const std::vector<Triangle>& tris = mesh.triangles();
+    // A mesh without material ids renders with the default grey, which emits nothing.
+    if (sh.material_ids.empty()) continue;
     for (size_t t = 0; t < tris.size(); ++t) {
-      // No material ids: every triangle has material 0 (the default grey when there are none).
-      const size_t mat = sh.material_ids.empty() ? 0 : size_t(sh.material_ids[t]);
+      const size_t mat = size_t(sh.material_ids[t]);
       if (mat >= emission_.size()) continue;
       const MaterialEmission& e = emission_[mat];
       if (!e.emits() || !e.sampled) continue;

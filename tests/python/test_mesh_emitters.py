@@ -90,3 +90,19 @@ def test_zero_area_emissive_triangles_light_nothing_and_leave_no_nan():
     s.commit()
     img = s.render(camera_above(size=2.0, resolution=4), samples=16)
     assert np.isfinite(img).all() and not img[..., :3].any()
+
+
+def test_a_mesh_without_material_ids_is_default_grey_and_emits_nothing():
+    # Material 0 emits, but a mesh given no material ids renders with the default grey: it is
+    # neither seen glowing nor sampled as a light (the same answer on both paths).
+    s = toyrt.Scene()
+    s.add_material("diffuse", color=(0.0, 0.0, 0.0), emission=(3.0, 3.0, 3.0))
+    s.add_material("diffuse", color=(1.0, 1.0, 1.0))
+    fv, ft = grid(1, 40.0, 0.0)
+    s.add_mesh(fv, ft, material_ids=1)
+    ev, et = grid(1, 1.0, 0.5)
+    s.add_mesh(ev, et)                                    # no material ids
+    s.commit()
+    assert s.last_commit["emissive_triangles"] == 0
+    img = s.render(camera_above(height=0.25, size=0.002, resolution=2), samples=16)
+    assert not img[..., :3].any()
