@@ -175,6 +175,9 @@ CPU_LEVELS = $(shell grep -qw sse4_2 /proc/cpuinfo && echo v2) $(shell grep -qw 
 EXT_ZIP    = $(DIST)/render_toyrt-$(VERSION)-linux_x64.zip
 LEGACY_ZIP = $(DIST)/render_toyrt-$(VERSION)-legacy-linux_x64.zip
 test-package: package
+	@# The glibc floor docs/install.md states: a symbol from a newer glibc would raise every wheel's tag.
+	@n=$$(ls $(DIST)/toyrt-$(VERSION)-cp*-manylinux_2_34_x86_64.whl 2>/dev/null | wc -l); \
+		[ $$n -eq 3 ] || { echo "test-package: expected 3 manylinux_2_34 wheels, found: $$(ls $(DIST))" >&2; exit 1; }
 	tests/package/fresh_venv.sh $(SYS_PY) 1 $(DIST)/toyrt-$(VERSION)-cp311-*.whl
 	tests/package/fresh_venv.sh $(SYS_PY) 2 $(DIST)/toyrt-$(VERSION)-cp311-*.whl
 	tests/package/fresh_venv.sh $(PY313) 2 $(DIST)/toyrt-$(VERSION)-cp313-*.whl $(CPU_LEVELS)

@@ -9,7 +9,9 @@ namespace {
 
 Vec2 direction_to_uv(const Vec3& d) {
   const float u = 0.5f - std::atan2(d.y, d.x) / (2.0f * kPi);
-  const float v = 0.5f + std::atan2(d.z, std::hypot(d.x, d.y)) / kPi;
+  // sqrt, not std::hypot: d is a unit vector (nothing to overflow), and hypotf would raise the
+  // wheels' glibc floor from 2.34 to 2.35 (docs/install.md).
+  const float v = 0.5f + std::atan2(d.z, std::sqrt(d.x * d.x + d.y * d.y)) / kPi;
   return Vec2(u - std::floor(u), std::clamp(v, 0.0f, 1.0f));
 }
 
