@@ -14,15 +14,6 @@
 namespace toyrt::queries {
 namespace {
 
-Ray ray_at(const RayBatch& b, size_t i) {
-  Ray r;
-  r.org = Vec3(b.origins[3 * i], b.origins[3 * i + 1], b.origins[3 * i + 2]);
-  r.dir = Vec3(b.directions[3 * i], b.directions[3 * i + 1], b.directions[3 * i + 2]);
-  r.tnear = b.tnear ? b.tnear[i * b.tnear_stride] : 0.0f;
-  r.tfar = b.tfar ? b.tfar[i * b.tfar_stride] : kInfinity;
-  return r;
-}
-
 // Rays per task, as in the nearest-hit batch: every ray here walks its whole length, so smaller
 // grains balance better than there.
 constexpr size_t kRayGrain = 64;
@@ -44,7 +35,7 @@ void count_intersections(const Scene& scene, const RayBatch& rays, uint32_t* cou
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.count, kRayGrain), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t i = r.begin(); i != r.end(); ++i) {
         uint32_t n = 0;
-        for_each_crossing(scene, ray_at(rays, i), [&](uint32_t, uint32_t, uint32_t, const Crossing&) { ++n; });
+        for_each_crossing(scene, rays.at(i), [&](uint32_t, uint32_t, uint32_t, const Crossing&) { ++n; });
         counts[i] = n;
       }
     });
@@ -79,7 +70,7 @@ HitList list_intersections(const Scene& scene, const RayBatch& rays, size_t max_
       };
       std::vector<Entry> entries;  // one per task, reused by its rays
       for (size_t i = r.begin(); i != r.end(); ++i) {
-        const Ray ray = ray_at(rays, i);
+        const Ray ray = rays.at(i);
         entries.clear();
         for_each_crossing(scene, ray, [&](uint32_t instance, uint32_t mesh, uint32_t prim, const Crossing& c) {
           entries.push_back({c.t, int32_t(instance), int32_t(mesh), int32_t(prim), float(c.u), float(c.v)});

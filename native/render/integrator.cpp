@@ -63,6 +63,23 @@ struct DiffusePoint {
   int depth;
 };
 
+// A cosine-distributed direction around the shading normal, from sample dimension `dim` of the
+// point's path vertex; cos is its cosine to ns (the density is cos / pi).
+struct CosineDirection {
+  Vec3 wi;
+  float cos;
+};
+CosineDirection cosine_direction(const DiffusePoint& at, uint32_t pixel, uint32_t sample, uint32_t dim,
+                                 const IntegratorSettings& settings) {
+  const Vec3 local =
+      sample_cosine_hemisphere(sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, dim), settings.seed));
+  return {Frame::from_normal(at.ns).to_world(local), local.z};
+}
+
+// cos / pdf of a sample drawn with density `pdf`, times its power-heuristic weight against the
+// other strategy's density `other` at the same direction (one sample each).
+float mis_cos_over_pdf(float cos, float pdf, float other) { return cos * pdf / (pdf * pdf + other * other); }
+
 // The environment map as a light: one sample from the map's distribution and one
 // cosine-distributed, combined by the power heuristic, so a bright sun in the map and a uniform
 // sky are both found with little noise.
@@ -76,17 +93,13 @@ struct DiffusePoint {
   if (es.pdf > 0.0f) {
     const float cos_s = glm::dot(at.ns, es.wi);
     if (cos_s > 0.0f && glm::dot(at.ng, es.wi) > 0.0f && !scene.occluded(Ray{at.origin, 0.0f, es.wi, kInfinity})) {
-      const float pc = cos_s * kInvPi;
-      sum += at.f * es.radiance * (cos_s * es.pdf / (es.pdf * es.pdf + pc * pc));
+      sum += at.f * es.radiance * mis_cos_over_pdf(cos_s, es.pdf, cos_s * kInvPi);
     }
   }
-  const Vec3 local = sample_cosine_hemisphere(
-      sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 1), settings.seed));
-  const Vec3 wi = Frame::from_normal(at.ns).to_world(local);
-  if (glm::dot(at.ng, wi) > 0.0f && local.z > 0.0f && !scene.occluded(Ray{at.origin, 0.0f, wi, kInfinity})) {
-    const float pc = local.z * kInvPi, pe = environment_pdf(env, wi);
-    sum += at.f * environment_radiance(env, image, wi) * (local.z * pc / (pe * pe + pc * pc));
-  }
+  const CosineDirection c = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings);
+  if (glm::dot(at.ng, c.wi) > 0.0f && c.cos > 0.0f && !scene.occluded(Ray{at.origin, 0.0f, c.wi, kInfinity}))
+    sum += at.f * environment_radiance(env, image, c.wi) *
+           mis_cos_over_pdf(c.cos, c.cos * kInvPi, environment_pdf(env, c.wi));
   return sum;
 }
 
@@ -125,23 +138,20 @@ EmissiveTriangle emissive_triangle_at(const Scene& scene, const Hit& hit, const 
       const float cos_s = glm::dot(at.ns, ls.wi);
       if (cos_s > 0.0f && glm::dot(at.ng, ls.wi) > 0.0f &&
           !scene.occluded(Ray{at.origin, 0.0f, ls.point - at.origin, 1.0f})) {
-        const float pb = cos_s * kInvPi;
-        sum += at.f * ls.radiance * (cos_s * ls.pdf / (ls.pdf * ls.pdf + pb * pb));
+        sum += at.f * ls.radiance * mis_cos_over_pdf(cos_s, ls.pdf, cos_s * kInvPi);
       }
     }
   }
-  const Vec3 local = sample_cosine_hemisphere(
-      sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 4), settings.seed));
-  const Vec3 wi = Frame::from_normal(at.ns).to_world(local);
-  if (glm::dot(at.ng, wi) <= 0.0f || local.z <= 0.0f) return sum;
+  const CosineDirection c = cosine_direction(at, pixel, sample, kDimsPerVertex - 4, settings);
+  const Vec3 wi = c.wi;
+  if (glm::dot(at.ng, wi) <= 0.0f || c.cos <= 0.0f) return sum;
   const Hit hit = scene.intersect(Ray{at.origin, 0.0f, wi, kInfinity});
   const int32_t m = hit.found() ? material_of(scene, hit) : -1;
   if (m < 0 || size_t(m) >= scene.emission().size() || !scene.emission()[size_t(m)].emits()) return sum;
   const MaterialEmission& e = scene.emission()[size_t(m)];
   const EmissiveTriangle t = emissive_triangle_at(scene, hit, e);
   const float pl = emitter_pdf(emitters, p, t, wi, glm::dot(t.p0 + hit.u * t.e1 + hit.v * t.e2 - p, wi));
-  const float pb = local.z * kInvPi;
-  return sum + at.f * e.radiance * (local.z * pb / (pl * pl + pb * pb));  // f L cos / pb x the weight
+  return sum + at.f * e.radiance * mis_cos_over_pdf(c.cos, c.cos * kInvPi, pl);
 }
 
 // Light arriving at a diffuse point: one sample per light, or one light chosen by contribution.
@@ -176,9 +186,7 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
   else if (world.background_lights_surfaces && world.background != Vec3(0.0f)) {
     // A constant background: a cosine-distributed direction makes the estimate f L cos / pdf =
     // albedo L when nothing blocks it, exactly.
-    const Vec3 local = sample_cosine_hemisphere(
-        sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 1), settings.seed));
-    const Vec3 wi = Frame::from_normal(ns).to_world(local);
+    const Vec3 wi = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings).wi;
     if (glm::dot(ng, wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, wi, kInfinity}))
       sum += f * world.background * kPi;  // f = albedo / pi
   }

@@ -337,15 +337,6 @@ bool Scene::occluded(const Ray& ray) const {
 
 namespace {
 
-Ray ray_at(const RayBatch& b, size_t i) {
-  Ray r;
-  r.org = Vec3(b.origins[3 * i], b.origins[3 * i + 1], b.origins[3 * i + 2]);
-  r.dir = Vec3(b.directions[3 * i], b.directions[3 * i + 1], b.directions[3 * i + 2]);
-  r.tnear = b.tnear ? b.tnear[i * b.tnear_stride] : 0.0f;
-  r.tfar = b.tfar ? b.tfar[i * b.tfar_stride] : kInfinity;
-  return r;
-}
-
 // Rays per task: enough to amortise scheduling, few enough to balance incoherent batches.
 constexpr size_t kRayGrain = 256;
 
@@ -357,7 +348,7 @@ void Scene::intersect(const RayBatch& rays, const HitBatch& hits, int threads) c
   run_with_threads(threads, [&] {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.count, kRayGrain), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t i = r.begin(); i != r.end(); ++i) {
-        const Hit h = intersect(ray_at(rays, i));
+        const Hit h = intersect(rays.at(i));
         hits.t[i] = h.t;
         hits.u[i] = h.u;
         hits.v[i] = h.v;
@@ -373,7 +364,7 @@ void Scene::occluded(const RayBatch& rays, uint8_t* blocked, int threads) const 
   check_threads(threads);
   run_with_threads(threads, [&] {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.count, kRayGrain), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i != r.end(); ++i) blocked[i] = occluded(ray_at(rays, i)) ? 1 : 0;
+      for (size_t i = r.begin(); i != r.end(); ++i) blocked[i] = occluded(rays.at(i)) ? 1 : 0;
     });
   });
 }

@@ -60,6 +60,16 @@ struct RayBatch {
   const float* tfar = nullptr;
   size_t tfar_stride = 0;
   size_t count = 0;
+
+  // Ray i of the batch (tnear 0 and tfar infinite where their arrays are not given).
+  Ray at(size_t i) const {
+    Ray r;
+    r.org = Vec3(origins[3 * i], origins[3 * i + 1], origins[3 * i + 2]);
+    r.dir = Vec3(directions[3 * i], directions[3 * i + 1], directions[3 * i + 2]);
+    r.tnear = tnear ? tnear[i * tnear_stride] : 0.0f;
+    r.tfar = tfar ? tfar[i * tfar_stride] : kInfinity;
+    return r;
+  }
 };
 
 // Where a batch's hits go: one entry per ray in each array.
