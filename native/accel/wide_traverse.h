@@ -33,6 +33,12 @@ inline uint32_t mask_of(V lanes) {
   constexpr int n = int(sizeof(V) / sizeof(int32_t));
 #if defined(__AVX__)
   if constexpr (n == 8) return uint32_t(_mm256_movemask_ps(reinterpret_cast<__m256>(lanes)));
+#elif defined(__SSE__)
+  if constexpr (n == 8) {  // two SSE halves
+    __m128 half[2];
+    std::memcpy(half, &lanes, sizeof half);
+    return uint32_t(_mm_movemask_ps(half[0])) | uint32_t(_mm_movemask_ps(half[1])) << 4;
+  }
 #endif
 #if defined(__SSE__)
   if constexpr (n == 4) return uint32_t(_mm_movemask_ps(reinterpret_cast<__m128>(lanes)));

@@ -1,4 +1,4 @@
-// Leaf storage for tracing: triangles in blocks of four, coordinates side by side, so the
+// Leaf storage for tracing: triangles in blocks of eight, coordinates side by side, so the
 // watertight test of triangle.h runs on a whole block with one set of SIMD instructions. Each lane
 // evaluates exactly the scalar test's expressions (the build disables FMA contraction), so the
 // block test is as watertight as the scalar one; the rare lanes that need the scalar test's
@@ -12,20 +12,23 @@
 
 namespace toyrt {
 
-inline constexpr int kBlockWidth = 4;
+// Eight lanes: one AVX register per coordinate row, so a leaf of five to eight triangles (the
+// SAH builder's leaves hold up to eight) costs one block test instead of two blocks of four;
+// where AVX is absent (x86-64-v2) each row is two SSE registers.
+inline constexpr int kBlockWidth = 8;
 inline constexpr uint32_t kNoTriangle = 0xFFFFFFFFu;
 
-struct alignas(16) TriangleBlock {
+struct alignas(32) TriangleBlock {
   float p[3][3][kBlockWidth];  // [vertex][axis][lane]
   uint32_t prim[kBlockWidth];  // triangle index in the mesh; kNoTriangle for an unused lane
 
   Vec3 vertex(int lane, int k) const { return {p[k][0][lane], p[k][1][lane], p[k][2][lane]}; }
 };
-static_assert(sizeof(TriangleBlock) == 160, "TriangleBlock: 9 coordinate rows and the ids");
+static_assert(sizeof(TriangleBlock) == 320, "TriangleBlock: 9 coordinate rows and the ids");
 
-namespace simd4 {
-using vfloat = float __attribute__((vector_size(16)));
-using vint = int32_t __attribute__((vector_size(16)));
+namespace simdb {  // vectors of one lane per triangle of a block
+using vfloat = float __attribute__((vector_size(kBlockWidth * sizeof(float))));
+using vint = int32_t __attribute__((vector_size(kBlockWidth * sizeof(float))));
 inline vfloat load(const float* p) {
   vfloat v;
   std::memcpy(&v, p, sizeof v);
@@ -41,7 +44,7 @@ inline vfloat abs(vfloat x) {
 }
 inline vfloat max(vfloat a, vfloat b) { return a > b ? a : b; }
 using simd::mask_of;
-}  // namespace simd4
+}  // namespace simdb
 
 // Tests the block's triangles against [tnear, tfar). For each lane hit, hit(lane, t) is called
 // (nearest lanes are not sorted; the caller keeps the minimum); with AnyHit the first ends it.
@@ -49,7 +52,7 @@ using simd::mask_of;
 template <bool AnyHit, class OnHit>
 [[gnu::always_inline]] inline bool intersect_block(const WatertightRay& r, const TriangleBlock& b, float tnear,
                                                    float tfar, OnHit&& hit) {
-  using namespace simd4;
+  using namespace simdb;
   const vfloat ox = splat(r.org[r.kx]), oy = splat(r.org[r.ky]), oz = splat(r.org[r.kz]);
   const vfloat sx = splat(r.sx), sy = splat(r.sy), sz = splat(r.sz);
   // Translated and sheared vertices, exactly as intersect_triangle computes them.
