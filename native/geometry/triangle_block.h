@@ -43,6 +43,11 @@ inline vfloat abs(vfloat x) {
   return x;
 }
 inline vfloat max(vfloat a, vfloat b) { return a > b ? a : b; }
+inline vint bits_of(vfloat x) {
+  vint bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  return bits;
+}
 using simd::mask_of;
 }  // namespace simdb
 
@@ -56,12 +61,11 @@ template <bool AnyHit, class OnHit>
   const vfloat ox = splat(r.org[r.kx]), oy = splat(r.org[r.ky]), oz = splat(r.org[r.kz]);
   const vfloat sx = splat(r.sx), sy = splat(r.sy), sz = splat(r.sz);
   // Translated and sheared vertices, exactly as intersect_triangle computes them.
-  vfloat x[3], y[3], z[3];
+  vfloat x[3], y[3], vz[3];
   for (int k = 0; k < 3; ++k) {
-    const vfloat vz = load(b.p[k][r.kz]) - oz;
-    x[k] = (load(b.p[k][r.kx]) - ox) - sx * vz;
-    y[k] = (load(b.p[k][r.ky]) - oy) - sy * vz;
-    z[k] = sz * vz;
+    vz[k] = load(b.p[k][r.kz]) - oz;
+    x[k] = (load(b.p[k][r.kx]) - ox) - sx * vz[k];
+    y[k] = (load(b.p[k][r.ky]) - oy) - sy * vz[k];
   }
   const vfloat eu = x[2] * y[1] - y[2] * x[1];
   const vfloat ev = x[0] * y[2] - y[0] * x[2];
@@ -71,14 +75,22 @@ template <bool AnyHit, class OnHit>
   std::memcpy(&used, b.prim, sizeof used);
   used = used != vint{} - 1;  // lanes holding a triangle
   const vint exact_zero = (eu == zero) | (ev == zero) | (ew == zero);
-  const vint mixed = ((eu < zero) | (ev < zero) | (ew < zero)) & ((eu > zero) | (ev > zero) | (ew > zero));
+  // Edge functions of both signs: the ray passes outside. By sign bits (some negative and not
+  // all), which is the comparison's answer on every lane without an exact zero; those lanes go
+  // to the scalar test whatever `mixed` says.
+  const vint su = bits_of(eu), sv = bits_of(ev), sw = bits_of(ew);
+  const vint mixed = ((su | sv | sw) & ~(su & sv & sw)) < vint{};
+  // Most blocks a ray reaches it misses on every lane: stop before the depth and distance.
+  if (!mask_of(used & (~mixed | exact_zero))) return false;
+  vfloat z[3];
+  for (int k = 0; k < 3; ++k) z[k] = sz * vz[k];
   const vfloat det = eu + ev + ew;
   const vfloat scaled_t = eu * z[0] + ev * z[1] + ew * z[2];
   const vfloat abs_det = abs(det);
   const vfloat signed_t = det < zero ? -scaled_t : scaled_t;
   const vint in_range = (det != zero) & (signed_t < splat(tfar) * abs_det);
   const vint candidate = used & ~mixed & in_range;
-  // Most blocks a ray reaches it misses entirely: stop before the error bound.
+  // Or misses by distance: stop before the error bound.
   if (!mask_of(candidate | (used & exact_zero))) return false;
 
   // near_start_error of triangle.h, lane-wise.
