@@ -61,7 +61,9 @@ void Mesh::build(BuilderKind kind, const BuildConfig& config, BuildStats* stats)
   std::vector<Vec3> centers;
   std::vector<uint32_t> valid;
   prepare(boxes, centers, valid);
-  finish(build_bvh(kind, boxes.data(), centers.data(), boxes.size(), config, stats), valid);
+  BuildConfig mine = config;
+  mine.sah.leaf_without_search = kBlockWidth;  // finish() collapses with leaves of one block
+  finish(build_bvh(kind, boxes.data(), centers.data(), boxes.size(), mine, stats), valid);
 }
 
 void Mesh::finish(Bvh bvh, const std::vector<uint32_t>& valid) {
