@@ -2,6 +2,10 @@
 
 #include "accel/wide_traverse.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -35,25 +39,42 @@ Mesh::Mesh(std::vector<Vec3> vertices, std::vector<Triangle> triangles)
 }
 
 void Mesh::prepare(std::vector<BBox>& boxes, std::vector<Vec3>& centers, std::vector<uint32_t>& valid) {
+  // In parallel: on a million triangles the degenerate test (a cross product in double) and the
+  // boxes took 35-80 ms, a tenth of the commit, on one thread.
+  constexpr size_t kGrain = 16384;
+  const size_t n = triangles_.size();
+  std::vector<uint8_t> keep(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const Triangle& t = triangles_[i];
+      keep[i] = !is_degenerate(vertices_[t.x], vertices_[t.y], vertices_[t.z]);
+    }
+  });
   valid.clear();
-  valid.reserve(triangles_.size());
-  for (size_t i = 0; i < triangles_.size(); ++i) {
-    const Triangle& t = triangles_[i];
-    if (!is_degenerate(vertices_[t.x], vertices_[t.y], vertices_[t.z])) valid.push_back(uint32_t(i));
-  }
+  valid.reserve(n);
+  for (size_t i = 0; i < n; ++i)
+    if (keep[i]) valid.push_back(uint32_t(i));
   boxes.resize(valid.size());
   centers.resize(valid.size());
-  bounds_ = BBox{};
-  for (size_t k = 0; k < valid.size(); ++k) {
-    const Triangle& t = triangles_[valid[k]];
-    BBox b;
-    b.extend(vertices_[t.x]);
-    b.extend(vertices_[t.y]);
-    b.extend(vertices_[t.z]);
-    boxes[k] = b;
-    centers[k] = b.center();
-    bounds_.extend(b);
-  }
+  bounds_ = tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, valid.size(), kGrain), BBox{},
+      [&](const tbb::blocked_range<size_t>& r, BBox acc) {
+        for (size_t k = r.begin(); k != r.end(); ++k) {
+          const Triangle& t = triangles_[valid[k]];
+          BBox b;
+          b.extend(vertices_[t.x]);
+          b.extend(vertices_[t.y]);
+          b.extend(vertices_[t.z]);
+          boxes[k] = b;
+          centers[k] = b.center();
+          acc.extend(b);
+        }
+        return acc;
+      },
+      [](BBox a, const BBox& b) {
+        a.extend(b);
+        return a;
+      });
 }
 
 void Mesh::build(BuilderKind kind, const BuildConfig& config, BuildStats* stats) {
