@@ -133,7 +133,7 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       "and refraction, weighted by F and 1 - F; deeper ones choose one. 0: never split.\n"
       "passes: names of render passes to fill beside the image, read afterwards from last_passes, defined\n"
       "as Cycles' data passes: 'depth' (planar camera z, first sample, 1e10 on a miss), 'mist', 'position'\n"
-      "(first sample), 'normal' (world, averaged), 'diffuse_color' (albedo, averaged), 'glossy_color' (black),\n"
+      "(first sample), 'normal' (world, averaged), 'diffuse_color' (albedo, averaged),\n"
       "'emission', 'object_index', 'material_index' (first sample). mist: (start, depth, falloff exponent) in\n"
       "metres, as world.mist_settings (falloff QUADRATIC 2, LINEAR 1, INVERSE_QUADRATIC 0.5). object_index:\n"
       "a value per instance (object pass_index), material_index: per material id (material pass_index).");
@@ -245,8 +245,8 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
            py::arg("on_tile") = py::none(), py::arg("should_cancel") = py::none(),
            py::arg("first_sample") = RenderSettings{}.first_sample,
            py::arg("split_depth") = IntegratorSettings{}.split_depth, py::arg("passes") = py::none(),
-           py::arg("mist") = py::none(), py::arg("object_index") = py::none(),
-           py::arg("material_index") = py::none(), render_doc.c_str())
+           py::arg("mist") = py::none(), py::arg("object_index") = py::none(), py::arg("material_index") = py::none(),
+           render_doc.c_str())
       .def_property_readonly(
           "last_render", &PyScene::last_render,
           "What the last render did: cancelled, cancel_latency_ms, tiles_done, tiles_total, render_ms,\n"

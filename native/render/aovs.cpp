@@ -14,20 +14,20 @@ struct AovInfo {
   int channels;
 };
 constexpr std::array<AovInfo, kAovCount> kAovs{{{"depth", 1},
-                                                 {"mist", 1},
-                                                 {"position", 3},
-                                                 {"normal", 3},
-                                                 {"diffuse_color", 3},
-                                                 {"glossy_color", 3},
-                                                 {"emission", 3},
-                                                 {"object_index", 1},
-                                                 {"material_index", 1}}};
+                                                {"mist", 1},
+                                                {"position", 3},
+                                                {"normal", 3},
+                                                {"diffuse_color", 3},
+                                                {"emission", 3},
+                                                {"object_index", 1},
+                                                {"material_index", 1}}};
 
 // Cycles' mist (kernel/film/data_passes.h): the distance from the camera (perspective) or along
 // its axis (orthographic) mapped to [0, 1] over [start, start + depth], then the falloff power.
 float mist_at(const MistSettings& m, const Camera& camera, const Vec3& p) {
-  const float distance = camera.type == CameraType::Orthographic ? std::fabs(glm::dot(p - camera.position, camera.axis_z))
-                                                                 : glm::length(p - camera.position);
+  const float distance = camera.type == CameraType::Orthographic
+                             ? std::fabs(glm::dot(p - camera.position, camera.axis_z))
+                             : glm::length(p - camera.position);
   const float x = m.depth > 0.0f ? std::clamp((distance - m.start) / m.depth, 0.0f, 1.0f) : 1.0f;
   if (m.falloff == 1.0f) return x;
   if (m.falloff == 2.0f) return x * x;
@@ -89,7 +89,6 @@ void AovPixel::store(AovBuffers& b, size_t pixel, float inv) const {
   put(Aov::Position, position_);
   put(Aov::Normal, normal_sum_ * inv);
   put(Aov::DiffuseColor, diffuse_sum_ * inv);
-  put(Aov::GlossyColor, Vec3(0.0f));  // no glossy closure among TOYRT's materials yet: black (noted by the add-on)
   put(Aov::Emission, emission_sum_ * inv);
   put(Aov::ObjectIndex, Vec3(object_));
   put(Aov::MaterialIndex, Vec3(material_));

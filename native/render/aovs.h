@@ -4,7 +4,7 @@
 //     when the path's sample is 0); depth is the planar camera-space z, 1e10 where nothing is hit;
 //     the others 0 there;
 //   normal (world space, the shading normal turned to the viewer), diffuse_color (the diffuse
-//     albedo), glossy_color, emission: averaged over samples, 0 for samples that hit nothing;
+//     albedo), emission: averaged over samples, 0 for samples that hit nothing;
 //   mist: 1 - mean over samples of (1 - mist(distance)), so 1 where nothing is hit.
 // Only the first surface a camera ray hits counts, as in Cycles for opaque surfaces. A render that
 // asks for no pass allocates and computes none of this (the integrator gets a null FirstHit).
@@ -21,18 +21,7 @@ namespace toyrt {
 
 struct Camera;
 
-enum class Aov : uint8_t {
-  Depth,
-  Mist,
-  Position,
-  Normal,
-  DiffuseColor,
-  GlossyColor,
-  Emission,
-  ObjectIndex,
-  MaterialIndex,
-  Count
-};
+enum class Aov : uint8_t { Depth, Mist, Position, Normal, DiffuseColor, Emission, ObjectIndex, MaterialIndex, Count };
 inline constexpr size_t kAovCount = size_t(Aov::Count);
 
 // The name render(passes=...) takes ("depth", "diffuse_color", ...) and the float channels per pixel.

@@ -57,7 +57,6 @@ using TileSink = std::function<void(const Tile&, const RenderResult&)>;
 // material, std::logic_error for an uncommitted scene, RenderTooLarge before allocating.
 // `passes`: the render passes to fill beside Combined (aovs.h); none costs nothing.
 RenderResult render(const Scene& scene, const Camera& camera, const RenderSettings& settings,
-                    const TileSink& on_tile = {}, const CancelPoll& should_cancel = {},
-                    const AovRequest& passes = {});
+                    const TileSink& on_tile = {}, const CancelPoll& should_cancel = {}, const AovRequest& passes = {});
 
 }  // namespace toyrt

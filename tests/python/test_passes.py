@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import toyrt
 
-ALL = ["depth", "mist", "position", "normal", "diffuse_color", "glossy_color", "emission", "object_index",
+ALL = ["depth", "mist", "position", "normal", "diffuse_color", "emission", "object_index",
        "material_index"]
 
 
@@ -47,7 +47,7 @@ def test_depth_is_the_planar_distance_and_normal_albedo_indices_are_the_planes()
         assert np.allclose(p["diffuse_color"][right], (0.2, 0.4, 0.6), atol=1e-6)
         assert np.all(p["object_index"][left] == 3.0) and np.all(p["object_index"][right] == 7.0)
         assert np.all(p["material_index"][left] == 11.0) and np.all(p["material_index"][right] == 13.0)
-        assert np.all(p["glossy_color"] == 0.0) and np.all(p["emission"] == 0.0)
+        assert np.all(p["emission"] == 0.0)
 
 
 def test_mist_is_cycles_ramp_of_the_camera_distance():
