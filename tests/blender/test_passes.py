@@ -121,6 +121,12 @@ def interior(index):
 STATE = {}
 
 
+def passes_are_switched_where_blender_users_look():
+    check(hasattr(bpy.types, "VIEWLAYER_PT_toyrt_passes"), "a Passes panel in the View Layer tab")
+    mist = getattr(bpy.types, "EEVEE_WORLD_PT_mist", None)
+    check(mist is not None and "TOYRT" in mist.COMPAT_ENGINES, "Blender's Mist panel (World tab) opened to TOYRT")
+
+
 def toyrt_passes_against_closed_forms():
     build_scene()
     p, result, printed = render("TOYRT")
@@ -195,4 +201,5 @@ def toyrt_passes_equal_cycles():
           f"where nothing is hit ({miss.sum()} pixels) Depth is 1e10 and Mist 1, as Cycles'")
 
 
-run_script([toyrt_passes_against_closed_forms, toyrt_passes_equal_cycles], "passes", TMP)
+run_script([passes_are_switched_where_blender_users_look, toyrt_passes_against_closed_forms,
+            toyrt_passes_equal_cycles], "passes", TMP)
