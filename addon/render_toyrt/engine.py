@@ -57,7 +57,7 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             report.error(f"render failed: {err}", self.report)
 
     def _render(self, depsgraph, toyrt):
-        from . import passes, report, sync
+        from . import denoise, passes, report, sync
         from .camera import export_camera
 
         scene = depsgraph.scene
@@ -121,31 +121,47 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         if passes.black(wanted):
             report.note("passes left black (TOYRT does not produce them yet): " + ", ".join(passes.black(wanted)),
                         self.report)
+        computed = [p.native for p in wanted if p.native]
+        denoising = settings.use_denoising and denoise.available() is None
+        if settings.use_denoising and not denoising:
+            report.note(denoise.available(), self.report)  # the frame is still rendered, not denoised
+        if denoising:
+            computed += [a for a in denoise.AUXILIARIES if a not in computed]
         progress.rendering()
         image = t_scene.render(
             camera, samples=samples, seed=settings.seed + frame, max_specular_depth=settings.max_specular_depth,
             area_light_sampling=settings.area_light_sampling, light_sampling=settings.light_sampling,
             threads=self._threads(scene), tile_size=tile, on_tile=on_tile, should_cancel=progress.poll,
-            passes=[p.native for p in wanted if p.native], mist=passes.mist(scene.world),
+            passes=computed, mist=passes.mist(scene.world),
             object_index=np.array(cache.object_pass_index, np.float32),
             material_index=np.array(cache.material_pass_index, np.float32))
         info = t_scene.last_render
         if info["cancelled"]:
             return
-        if wanted:
-            self._write_passes(image, t_scene.last_passes, wanted)
+        if denoising:
+            progress.phase("Denoising")
+            noisy, image = image, denoise.denoise(image, t_scene.last_passes)
+        else:
+            noisy = image
+        if wanted or settings.use_denoising:
+            self._write_passes(image, t_scene.last_passes, wanted, noisy if settings.use_denoising else None)
         elapsed = time.perf_counter() - started
         progress.finished(f"Export {stats['export_s'] * 1000:.0f} ms, BVH {build_ms:.0f} ms, "
                           f"Render {info['render_ms'] / 1000:.2f} s, {stats.get('triangles', 0):,} triangles")
         print(f"TOYRT: frame {frame} done in {elapsed:.2f} s ({image.shape[1]}x{image.shape[0]}, {samples} samples)",
               flush=True)
 
-    def _write_passes(self, image, computed, wanted):
-        """The whole frame once more, every pass beside Combined (tiles stream Combined only)."""
+    def _write_passes(self, image, computed, wanted, noisy=None):
+        """The whole frame once more, every pass beside Combined (tiles stream Combined only) and,
+        when denoising, the render before it as the Noisy Image pass."""
+        from .passes import NOISY
+
         height, width = image.shape[:2]
         result = self.begin_result(0, 0, width, height)
         layer = result.layers[0].passes
         _set_rect(layer["Combined"].rect, np.ascontiguousarray(image[::-1]))
+        if noisy is not None and layer.get(NOISY) is not None:
+            _set_rect(layer[NOISY].rect, np.ascontiguousarray(noisy[::-1]))
         for p in wanted:
             target = layer.get(p.name) if hasattr(layer, "get") else None
             if target is None:

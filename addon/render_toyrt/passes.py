@@ -61,10 +61,21 @@ def enabled(view_layer) -> list[Pass]:
 
 
 def register(engine, scene, view_layer) -> None:
-    """RenderEngine.update_render_passes: Combined and every pass turned on."""
+    """RenderEngine.update_render_passes: Combined, every pass turned on, and (denoising) the
+    noisy render, as Cycles keeps it."""
     engine.register_pass(scene, view_layer, "Combined", 4, "RGBA", "COLOR")
     for p in enabled(view_layer):
         engine.register_pass(scene, view_layer, p.name, len(p.channels), p.channels, p.kind)
+    if denoising(scene):
+        engine.register_pass(scene, view_layer, NOISY, 4, "RGBA", "COLOR")
+
+
+NOISY = "Noisy Image"  # Cycles' name of the render before denoising, the same in 3.x and 5.x
+
+
+def denoising(scene) -> bool:
+    settings = getattr(scene, "toyrt", None)
+    return bool(settings is not None and settings.use_denoising)
 
 
 def mist(world) -> tuple[float, float, float]:

@@ -43,6 +43,7 @@ class RENDER_PT_toyrt(bpy.types.Panel):
         layout.prop(settings, "builder")
         layout.prop(settings, "max_specular_depth")
         layout.prop(settings, "seed")
+        layout.prop(settings, "use_denoising")
         layout.label(text=f"Threads: {context.scene.render.threads} (Performance settings)")
 
 
