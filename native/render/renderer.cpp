@@ -103,6 +103,7 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
   auto render_tile = [&](const Tile& t) {
     const float inv = 1.0f / float(settings.samples);
     const int first = settings.first_sample, last = settings.first_sample + settings.samples;
+    const bool with_passes = passes.any();  // read once: the plain loop below must stay as it was
     for (int j = t.y; j < t.y + t.height; ++j) {
       if (cancel.load(std::memory_order_relaxed)) return false;
       for (int i = t.x; i < t.x + t.width; ++i) {
@@ -112,7 +113,7 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
         const uint32_t pixel = uint32_t(py) * uint32_t(camera.width) + uint32_t(px);
         Vec3 sum(0.0f);
         const size_t index = size_t(j) * size_t(result.width) + size_t(i);
-        if (passes.any()) {
+        if (with_passes) {
           // Passes asked for: the same samples, each reporting its first surface (aovs.h).
           AovPixel aov(passes, camera);
           for (int s = first; s < last; ++s) {
@@ -126,7 +127,7 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
           }
           aov.store(result.passes, index, inv);
         }
-        for (int s = first; s < last && !passes.any(); ++s) {
+        for (int s = with_passes ? last : first; s < last; ++s) {
           // A relaxed load every few samples costs nothing next to a path, and bounds the cancel
           // latency by a few samples whatever the sample count.
           if ((s - first) % kCancelCheckSamples == kCancelCheckSamples - 1 && cancel.load(std::memory_order_relaxed))
