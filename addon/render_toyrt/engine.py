@@ -108,10 +108,13 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         tile = 32
         tiles_total = max(1, -(-width // tile) * -(-height // tile))
         frame = scene.frame_current
+        # Blender renders each view layer in turn: the result of this one only (without the name,
+        # layers[0] is the first layer, and a second layer's pixels would land on it).
+        layer_name = depsgraph.view_layer.name
 
         def on_tile(x, y, w, h, pixels):
             bottom = height - (y + h)
-            result = self.begin_result(x, bottom, w, h)
+            result = self.begin_result(x, bottom, w, h, layer=layer_name)
             _set_rect(result.layers[0].passes["Combined"].rect, np.ascontiguousarray(pixels[::-1]))
             self.end_result(result)
             tiles_done[0] += 1
@@ -144,20 +147,21 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         else:
             noisy = image
         if wanted or settings.use_denoising:
-            self._write_passes(image, t_scene.last_passes, wanted, noisy if settings.use_denoising else None)
+            self._write_passes(image, t_scene.last_passes, wanted, noisy if settings.use_denoising else None,
+                               layer_name)
         elapsed = time.perf_counter() - started
         progress.finished(f"Export {stats['export_s'] * 1000:.0f} ms, BVH {build_ms:.0f} ms, "
                           f"Render {info['render_ms'] / 1000:.2f} s, {stats.get('triangles', 0):,} triangles")
         print(f"TOYRT: frame {frame} done in {elapsed:.2f} s ({image.shape[1]}x{image.shape[0]}, {samples} samples)",
               flush=True)
 
-    def _write_passes(self, image, computed, wanted, noisy=None):
+    def _write_passes(self, image, computed, wanted, noisy, layer_name):
         """The whole frame once more, every pass beside Combined (tiles stream Combined only) and,
         when denoising, the render before it as the Noisy Image pass."""
         from .passes import NOISY
 
         height, width = image.shape[:2]
-        result = self.begin_result(0, 0, width, height)
+        result = self.begin_result(0, 0, width, height, layer=layer_name)
         layer = result.layers[0].passes
         _set_rect(layer["Combined"].rect, np.ascontiguousarray(image[::-1]))
         if noisy is not None and layer.get(NOISY) is not None:

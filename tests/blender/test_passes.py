@@ -67,8 +67,8 @@ def multilayer_exr(scene):
     st.file_format, st.color_depth = "OPEN_EXR_MULTILAYER", "32"
 
 
-def read_passes(path):
-    """{pass name: (h, w, channels) float32, rows from the top} of a multilayer EXR's view layer,
+def read_layers(path):
+    """{view layer: {pass name: (h, w, channels) float32, rows from the top}} of a multilayer EXR,
     each pass's channels in their registered order. Blender 3.4 writes one part holding every
     channel, 5.x a part per pass (OpenImageIO's subimages): both are read."""
     import OpenImageIO as oiio
@@ -84,13 +84,14 @@ def read_passes(path):
             pixels = inp.read_image(format="float")
             for k, full in enumerate(names):
                 layer_pass, _, chan = full.rpartition(".")
-                grouped.setdefault(layer_pass.split(".", 1)[-1], []).append((chan, pixels[:, :, k]))
+                layer, _, name = layer_pass.partition(".")
+                grouped.setdefault(layer, {}).setdefault(name, []).append((chan, pixels[:, :, k]))
             part += 1
     finally:
         inp.close()
     order = "RGBAXYZWUV"  # Blender's channel ids: put each pass back in its registered order
-    return {name: np.stack([px for _, px in sorted(ch, key=lambda c: order.index(c[0][0].upper()))], -1)
-            for name, ch in grouped.items()}
+    return {layer: {name: np.stack([px for _, px in sorted(ch, key=lambda c: order.index(c[0][0].upper()))], -1)
+                    for name, ch in passes.items()} for layer, passes in grouped.items()}
 
 
 def render(engine, samples=16, tag=""):
@@ -104,7 +105,7 @@ def render(engine, samples=16, tag=""):
     multilayer_exr(scene)
     path = os.path.join(TMP, f"{engine.lower()}{tag}.exr")
     result, printed = render_still(path)
-    return (read_passes(path) if os.path.exists(path) else {}), result, printed
+    return (read_layers(path).get("ViewLayer", {}) if os.path.exists(path) else {}), result, printed
 
 
 def interior(index):
@@ -201,6 +202,24 @@ def toyrt_passes_equal_cycles():
           f"where nothing is hit ({miss.sum()} pixels) Depth is 1e10 and Mist 1, as Cycles'")
 
 
+def each_view_layer_gets_its_own_passes():
+    """A second view layer with Depth only: Blender renders the layers in turn, and each one's
+    Combined and passes must land in its own layer of the result, not on the first."""
+    build_scene()
+    second = bpy.context.scene.view_layers.new("Second")
+    second.use_pass_z = True
+    try:
+        render("TOYRT")
+        layers = read_layers(os.path.join(TMP, "toyrt.exr"))
+    finally:
+        bpy.context.scene.view_layers.remove(second)
+    first, other = layers.get("ViewLayer", {}), layers.get("Second", {})
+    check(sorted(other) == ["Combined", "Depth"], f"the second layer has its own passes ({sorted(other)})")
+    check("Combined" in other and np.array_equal(other["Combined"], first.get("Combined")),
+          "its Combined is the same scene's image, not black")
+    check("Depth" in other and np.array_equal(other["Depth"], first.get("Depth")), "its Depth equals the first's")
+
+
 def denoising_lowers_the_error_or_says_why_not():
     """4 samples of a scene lit by a grey world (noisy: one cosine ray per sample) against 1,024.
     The emitter is hidden: its edges are aliasing against a bright radiance, which OIDN keeps."""
@@ -244,4 +263,5 @@ def denoising_lowers_the_error_or_says_why_not():
 
 
 run_script([passes_are_switched_where_blender_users_look, toyrt_passes_against_closed_forms,
-            toyrt_passes_equal_cycles, denoising_lowers_the_error_or_says_why_not], "passes", TMP)
+            toyrt_passes_equal_cycles, each_view_layer_gets_its_own_passes,
+            denoising_lowers_the_error_or_says_why_not], "passes", TMP)
