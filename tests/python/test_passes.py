@@ -97,3 +97,23 @@ def test_an_unknown_pass_is_a_value_error_naming_the_known_ones():
     s = two_tiles()
     with pytest.raises(ValueError, match="unknown pass 'vector'.*depth"):
         s.render(camera_down(), samples=1, passes=["vector"])
+
+
+def test_diffuse_color_reads_the_texture_and_emission_the_radiance_and_glass_has_no_albedo():
+    s = toyrt.Scene()
+    tex = s.add_texture(np.full((4, 4, 3), (0.25, 0.5, 0.75), np.float32), srgb=False)
+    s.add_material("diffuse", texture=tex)  # x < 0: a constant texture, linear
+    s.add_material("diffuse", color=(0, 0, 0), emission=(2.0, 1.0, 0.5))  # 0 < x < 0.5: an emitter
+    s.add_material("glass", ior=1.5)  # x > 0.5: glass
+    for k, (x0, x1) in enumerate(((-5.0, 0.0), (0.0, 0.5), (0.5, 5.0))):
+        v = np.array([[x0, -5, 0], [x1, -5, 0], [x1, 5, 0], [x0, 5, 0]], np.float32)
+        s.add_mesh(v, [[0, 1, 2], [0, 2, 3]], uvs=np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float32),
+                   material_ids=k)
+    s.commit()
+    s.render(camera_down(), samples=4, passes=["diffuse_color", "emission", "normal"])
+    p = s.last_passes
+    tex_px, glow_px, glass_px = (slice(None), slice(0, 7)), (slice(None), slice(9, 11)), (slice(None), slice(13, 16))
+    assert np.allclose(p["diffuse_color"][tex_px], (0.25, 0.5, 0.75), atol=1e-6)
+    assert np.allclose(p["emission"][glow_px], (2.0, 1.0, 0.5)) and np.all(p["emission"][tex_px] == 0)
+    assert np.all(p["diffuse_color"][glow_px] == 0)  # black Diffuse under its emission
+    assert np.all(p["diffuse_color"][glass_px] == 0) and np.allclose(p["normal"][glass_px], (0, 0, 1))
