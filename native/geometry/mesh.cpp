@@ -61,7 +61,9 @@ void Mesh::build(BuilderKind kind, const BuildConfig& config, BuildStats* stats)
   std::vector<Vec3> centers;
   std::vector<uint32_t> valid;
   prepare(boxes, centers, valid);
-  finish(build_bvh(kind, boxes.data(), centers.data(), boxes.size(), config, stats), valid);
+  BuildConfig mine = config;
+  mine.sah.leaf_without_search = kBlockWidth;  // finish() collapses with leaves of one block
+  finish(build_bvh(kind, boxes.data(), centers.data(), boxes.size(), mine, stats), valid);
 }
 
 void Mesh::finish(Bvh bvh, const std::vector<uint32_t>& valid) {
@@ -70,7 +72,11 @@ void Mesh::finish(Bvh bvh, const std::vector<uint32_t>& valid) {
   wide_ = collapse(bvh_, kBlockWidth);
   // Copy every leaf's triangles into blocks and point the wide leaves at them.
   blocks_.clear();
-  blocks_.reserve(bvh_.prim_ids.size() / 2);
+  auto blocks_of = [](uint32_t count) { return size_t((count + kBlockWidth - 1) / kBlockWidth); };
+  size_t block_count = blocks_of(wide_.root_leaf_count);
+  for (const WideNode& n : wide_.nodes)
+    for (int i = 0; i < kWidth; ++i) block_count += blocks_of(n.count[i]);
+  blocks_.reserve(block_count);  // exactly: a block is 320 bytes, a guess would waste tens of MB
   auto emit = [&](uint32_t first, uint32_t count) {
     const uint32_t start = uint32_t(blocks_.size());
     for (uint32_t k = 0; k < count; k += kBlockWidth) {
