@@ -32,7 +32,7 @@ CMAKE_ARGS ?=
 APT_PACKAGES := cmake g++ make libglm-dev pybind11-dev python3-dev python3-numpy python3-venv \
 	libembree-dev libtbb-dev libgtest-dev googletest ocl-icd-opencl-dev opencl-headers \
 	pocl-opencl-icd clinfo blender python3-matplotlib clang clang-format-14 libclang-rt-14-dev \
-	xvfb xauth libgl1-mesa-dri assimp-testmodels
+	xvfb xauth libgl1-mesa-dri assimp-testmodels python3-openimageio
 # The stamp's name carries a hash of the list, so adding a package re-runs the check.
 APT_STAMP   := $(BUILD)/.stamp-apt-$(firstword $(shell printf '%s' '$(APT_PACKAGES)' | md5sum))
 VENV_STAMP  := $(VENV)/.stamp-requirements

@@ -672,6 +672,11 @@ def main():
           + "; Mitsuba's independent sampler " + ", ".join(f"{fmt(b)}" for n, a, b, c in sl if b is not None)
           + ". A slope steeper than -0.5 is the stratification paying off; TOYRT has no switch to another "
             "pattern, so this is the only comparison made.")
+    # Measured by hand, not by make bench (tests/blender/test_passes.py, bench/passes_cost.py): kept
+    # in its own file so that a new report carries it over unchanged.
+    passes = DOC.parent / "results" / "passes.md"
+    if passes.exists():
+        w("\n" + passes.read_text().rstrip())
     w("\n## Reproducing\n")
     w(f"`make bench` ({meta.get('total_seconds', 0) / 60:.0f} minutes here, with the Cycles references "
       f"{'cached' if all(d['reference'].get('cached') for d in scenes.values()) else 'rendered'}; "

@@ -42,6 +42,11 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             self._viewport.draw(context, depsgraph)
 
     # ---- F12 and command-line renders ---------------------------------------------------------------
+    def update_render_passes(self, scene=None, renderlayer=None) -> None:
+        """The passes the View Layer turns on, named and laid out as Cycles does (passes.py)."""
+        from . import passes
+
+        passes.register(self, scene, renderlayer)
 
     def render(self, depsgraph) -> None:
         from . import native, report
@@ -52,7 +57,7 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             report.error(f"render failed: {err}", self.report)
 
     def _render(self, depsgraph, toyrt):
-        from . import report, sync
+        from . import denoise, passes, report, sync
         from .camera import export_camera
 
         scene = depsgraph.scene
@@ -103,28 +108,73 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         tile = 32
         tiles_total = max(1, -(-width // tile) * -(-height // tile))
         frame = scene.frame_current
+        # Blender renders each view layer in turn: the result of this one only (without the name,
+        # layers[0] is the first layer, and a second layer's pixels would land on it).
+        layer_name = depsgraph.view_layer.name
 
         def on_tile(x, y, w, h, pixels):
             bottom = height - (y + h)
-            result = self.begin_result(x, bottom, w, h)
+            result = self.begin_result(x, bottom, w, h, layer=layer_name)
             _set_rect(result.layers[0].passes["Combined"].rect, np.ascontiguousarray(pixels[::-1]))
             self.end_result(result)
             tiles_done[0] += 1
             progress.tiles(tiles_done[0], tiles_total)
 
+        wanted = passes.enabled(depsgraph.view_layer)
+        if passes.black(wanted):
+            report.note("passes left black (TOYRT does not produce them yet): " + ", ".join(passes.black(wanted)),
+                        self.report)
+        computed = [p.native for p in wanted if p.native]
+        denoising = settings.use_denoising and denoise.available() is None
+        if settings.use_denoising and not denoising:
+            report.note(denoise.available(), self.report)  # the frame is still rendered, not denoised
+        if denoising:
+            computed += [a for a in denoise.AUXILIARIES if a not in computed]
         progress.rendering()
         image = t_scene.render(
             camera, samples=samples, seed=settings.seed + frame, max_specular_depth=settings.max_specular_depth,
             area_light_sampling=settings.area_light_sampling, light_sampling=settings.light_sampling,
-            threads=self._threads(scene), tile_size=tile, on_tile=on_tile, should_cancel=progress.poll)
+            threads=self._threads(scene), tile_size=tile, on_tile=on_tile, should_cancel=progress.poll,
+            passes=computed, mist=passes.mist(scene.world),
+            object_index=np.array(cache.object_pass_index, np.float32),
+            material_index=np.array(cache.material_pass_index, np.float32))
         info = t_scene.last_render
         if info["cancelled"]:
             return
+        if denoising:
+            progress.phase("Denoising")
+            noisy, image = image, denoise.denoise(image, t_scene.last_passes)
+        else:
+            noisy = image
+        if wanted or settings.use_denoising:
+            self._write_passes(image, t_scene.last_passes, wanted, noisy if settings.use_denoising else None,
+                               layer_name)
         elapsed = time.perf_counter() - started
         progress.finished(f"Export {stats['export_s'] * 1000:.0f} ms, BVH {build_ms:.0f} ms, "
                           f"Render {info['render_ms'] / 1000:.2f} s, {stats.get('triangles', 0):,} triangles")
         print(f"TOYRT: frame {frame} done in {elapsed:.2f} s ({image.shape[1]}x{image.shape[0]}, {samples} samples)",
               flush=True)
+
+    def _write_passes(self, image, computed, wanted, noisy, layer_name):
+        """The whole frame once more, every pass beside Combined (tiles stream Combined only) and,
+        when denoising, the render before it as the Noisy Image pass."""
+        from .passes import NOISY
+
+        height, width = image.shape[:2]
+        result = self.begin_result(0, 0, width, height, layer=layer_name)
+        layer = result.layers[0].passes
+        _set_rect(layer["Combined"].rect, np.ascontiguousarray(image[::-1]))
+        if noisy is not None and layer.get(NOISY) is not None:
+            _set_rect(layer[NOISY].rect, np.ascontiguousarray(noisy[::-1]))
+        for p in wanted:
+            target = layer.get(p.name) if hasattr(layer, "get") else None
+            if target is None:
+                continue  # not registered by Blender for this layer (it should be): nothing to fill
+            values = computed.get(p.native) if p.native else None
+            if values is None:
+                values = np.zeros((height, width, len(p.channels)), np.float32)  # a pass TOYRT leaves black
+            _set_rect(target.rect, np.ascontiguousarray(values[::-1]))
+        self.end_result(result)
 
     @staticmethod
     def _threads(scene):
@@ -136,16 +186,17 @@ _RECT_FLAT = [None]  # does this Blender's pass.rect.foreach_set take a flat buf
 
 
 def _set_rect(rect, pixels):
-    """One foreach_set of an (h, w, 4) tile: Blender 3.x wants it as (N, 4), 5.0 as a flat
-    buffer of N * 4 floats (each refuses the other's shape); tried once, then remembered."""
+    """One foreach_set of an (h, w, c) tile: Blender 3.x wants it as (N, c), 5.0 as a flat
+    buffer of N * c floats (each refuses the other's shape); tried once, then remembered."""
+    channels = pixels.shape[2]
     if _RECT_FLAT[0] is None:
         try:
-            rect.foreach_set(pixels.reshape(-1, 4))
+            rect.foreach_set(pixels.reshape(-1, channels))
             _RECT_FLAT[0] = False
             return
         except (TypeError, RuntimeError, ValueError):
             _RECT_FLAT[0] = True
-    rect.foreach_set(pixels.ravel() if _RECT_FLAT[0] else pixels.reshape(-1, 4))
+    rect.foreach_set(pixels.ravel() if _RECT_FLAT[0] else pixels.reshape(-1, channels))
 
 
 @persistent

@@ -31,6 +31,10 @@ class TOYRTRenderSettings(bpy.types.PropertyGroup):
     max_specular_depth: bpy.props.IntProperty(
         name="Max Specular Depth", description="Refractions and reflections a path may take through glass",
         default=8, min=0, max=128)
+    use_denoising: bpy.props.BoolProperty(
+        name="Denoise", description="Denoise the final render with Intel Open Image Denoise (the pyoidn package), "
+        "its albedo and normal from the Diffuse Color and Normal passes; the noisy render is kept as the "
+        "Noisy Image pass", default=False)
     seed: bpy.props.IntProperty(
         name="Seed", description="Seed of the sampling pattern (the frame number is added when animating)",
         default=0, min=0)

@@ -33,7 +33,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import materials
+from . import materials, passes
 from .camera import export_camera
 from .lights import LightSpec, light_spec
 from .materials import ImageKey
@@ -72,6 +72,9 @@ class SceneSync(MaterialSync):
         self.texture_notes: dict[ImageKey, tuple[str, ...]] = {}
         self.lights: tuple[LightSpec, ...] | None = None   # the light specs last sent
         self.world: WorldSpec | None = None
+        # Object / Material Index passes (final-render walks): pass_index per instance, per material id.
+        self.object_pass_index: list[int] = []
+        self.material_pass_index: list[int] = []
         self._should_cancel: Callable[[], bool] | None = None   # set by sync() for a full walk
         self._converted_now: set[str] = set()  # materials converted during the current walk
         self.synced = False
@@ -172,7 +175,7 @@ class SceneSync(MaterialSync):
         instances, lights and the world compared with what the native scene has."""
         t0 = time.perf_counter()
         self.counters["walks"] += 1
-        placed, seen, exported_now, light_specs = [], set(), set(), []
+        placed, seen, exported_now, light_specs, pass_index = [], set(), set(), [], []
         used_materials = {}
         tri_instanced = 0
         pool, by_fingerprint, owners = {}, {}, {}
@@ -244,6 +247,7 @@ class SceneSync(MaterialSync):
                 if owner is not None and bake is None:
                     owners.setdefault(owner, []).append(len(placed))
                 placed.append((entry[0], _IDENTITY if bake is not None else matrix))
+                pass_index.append(obj.pass_index)
                 tri_instanced += entry[1]
 
         for entry in pool.values():
@@ -260,6 +264,8 @@ class SceneSync(MaterialSync):
             for name, mat in used_materials.items():
                 if name not in self._converted_now:
                     self.counters["materials_converted"] += self._reconvert(mat)
+            self.object_pass_index = pass_index
+            self.material_pass_index = passes.per_material_id(self.materials, used_materials)
         live = [e for e in self.meshes.values() if e[0] >= 0]
         tri_stored = sum(e[1] for e in live)
         self.stats = dict(export_s=time.perf_counter() - t0, meshes=len(live), instances=len(placed),

@@ -11,7 +11,8 @@ COMPATIBLE_PANELS = (
     "DATA_PT_camera", "DATA_PT_lens", "DATA_PT_camera_display", "DATA_PT_context_camera",
     "DATA_PT_light", "DATA_PT_EEVEE_light", "DATA_PT_context_light",
     "MATERIAL_PT_preview", "EEVEE_MATERIAL_PT_context_material", "EEVEE_MATERIAL_PT_surface",
-    "WORLD_PT_context_world", "EEVEE_WORLD_PT_surface",
+    "WORLD_PT_context_world", "EEVEE_WORLD_PT_surface", "EEVEE_WORLD_PT_mist",  # the Mist pass's settings
+    "VIEWLAYER_PT_layer",
 )
 
 
@@ -42,7 +43,36 @@ class RENDER_PT_toyrt(bpy.types.Panel):
         layout.prop(settings, "builder")
         layout.prop(settings, "max_specular_depth")
         layout.prop(settings, "seed")
+        layout.prop(settings, "use_denoising")
         layout.label(text=f"Threads: {context.scene.render.threads} (Performance settings)")
+
+
+class VIEWLAYER_PT_toyrt_passes(bpy.types.Panel):
+    """The View Layer's own pass switches that TOYRT fills (passes.py), grouped as Cycles' Passes
+    panel groups them; the others (Vector, AO, ...) are registered black when turned on elsewhere."""
+    bl_label = "Passes"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "view_layer"
+    COMPAT_ENGINES = {"TOYRT"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        view_layer = context.view_layer
+        col = layout.column(heading="Data", align=True)
+        for prop in ("use_pass_combined", "use_pass_z", "use_pass_mist", "use_pass_position", "use_pass_normal"):
+            col.prop(view_layer, prop)
+        col = layout.column(heading="Indexes", align=True)
+        col.prop(view_layer, "use_pass_object_index")
+        col.prop(view_layer, "use_pass_material_index")
+        col = layout.column(heading="Light", align=True)
+        col.prop(view_layer, "use_pass_diffuse_color", text="Diffuse Color")
+        col.prop(view_layer, "use_pass_emit", text="Emission")
 
 
 def _panels():
@@ -54,6 +84,7 @@ def _panels():
 
 def register() -> None:
     bpy.utils.register_class(RENDER_PT_toyrt)
+    bpy.utils.register_class(VIEWLAYER_PT_toyrt_passes)
     for panel in _panels():
         panel.COMPAT_ENGINES.add("TOYRT")
 
@@ -61,4 +92,5 @@ def register() -> None:
 def unregister() -> None:
     for panel in _panels():
         panel.COMPAT_ENGINES.discard("TOYRT")
+    bpy.utils.unregister_class(VIEWLAYER_PT_toyrt_passes)
     bpy.utils.unregister_class(RENDER_PT_toyrt)

@@ -130,7 +130,13 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       "(progressive rendering). A window too large for the memory available raises MemoryError\n"
       "before anything is allocated.\n"
       "split_depth: glass (Fresnel) surfaces among the first split_depth path vertices trace both reflection\n"
-      "and refraction, weighted by F and 1 - F; deeper ones choose one. 0: never split.");
+      "and refraction, weighted by F and 1 - F; deeper ones choose one. 0: never split.\n"
+      "passes: names of render passes to fill beside the image, read afterwards from last_passes, defined\n"
+      "as Cycles' data passes: 'depth' (planar camera z, first sample, 1e10 on a miss), 'mist', 'position'\n"
+      "(first sample), 'normal' (world, averaged), 'diffuse_color' (albedo, averaged),\n"
+      "'emission', 'object_index', 'material_index' (first sample). mist: (start, depth, falloff exponent) in\n"
+      "metres, as world.mist_settings (falloff QUADRATIC 2, LINEAR 1, INVERSE_QUADRATIC 0.5). object_index:\n"
+      "a value per instance (object pass_index), material_index: per material id (material pass_index).");
 
   // The types and their parameters, read from the core's tables (each type documents its own).
   static const std::string light_doc =
@@ -238,11 +244,16 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
            py::arg("threads") = RenderSettings{}.threads, py::arg("tile_size") = RenderSettings{}.tile_size,
            py::arg("on_tile") = py::none(), py::arg("should_cancel") = py::none(),
            py::arg("first_sample") = RenderSettings{}.first_sample,
-           py::arg("split_depth") = IntegratorSettings{}.split_depth, render_doc.c_str())
+           py::arg("split_depth") = IntegratorSettings{}.split_depth, py::arg("passes") = py::none(),
+           py::arg("mist") = py::none(), py::arg("object_index") = py::none(), py::arg("material_index") = py::none(),
+           render_doc.c_str())
       .def_property_readonly(
           "last_render", &PyScene::last_render,
           "What the last render did: cancelled, cancel_latency_ms, tiles_done, tiles_total, render_ms,\n"
           "samples, light_sampling.")
+      .def_property_readonly("last_passes", &PyScene::last_passes,
+                             "The passes the last render was asked for: name -> (height, width, channels) float32,\n"
+                             "rows from the top (see render's `passes`).")
       .def(
           "set_material",
           [](PyScene& self, int64_t material, const std::string& kind, py::handle color, int64_t texture, float ior,

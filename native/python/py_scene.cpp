@@ -179,10 +179,35 @@ py::dict PyScene::last_commit() {
   return d;
 }
 
+namespace {
+// render()'s pass arguments as the core's request: names, the mist settings (start, depth,
+// falloff exponent) and the pass-index tables (per instance, per material id).
+AovRequest aov_request(py::handle passes, py::handle mist, py::handle object_index, py::handle material_index) {
+  AovRequest r;
+  if (!passes.is_none())
+    for (py::handle name : passes) r.mask |= 1u << uint32_t(parse_aov(py::cast<std::string>(name)));
+  if (!mist.is_none()) {
+    const auto m = py::cast<std::tuple<float, float, float>>(mist);
+    r.mist = MistSettings{std::get<0>(m), std::get<1>(m), std::get<2>(m)};
+  }
+  auto table = [](py::handle obj) {
+    if (obj.is_none()) return std::vector<float>();
+    const FloatArray a = FloatArray::ensure(obj);
+    if (!a || a.ndim() != 1) throw py::value_error("render: a pass-index table must be a 1-D array of numbers");
+    return std::vector<float>(a.data(), a.data() + a.size());
+  };
+  r.object_index = table(object_index);
+  r.material_index = table(material_index);
+  return r;
+}
+}  // namespace
+
 py::array_t<float> PyScene::render(const py::dict& camera_settings, int samples, uint32_t seed, int max_specular_depth,
                                    const std::string& area_light_sampling, const std::string& light_sampling,
                                    int threads, int tile_size, py::object on_tile, py::object should_cancel,
-                                   int first_sample, int split_depth) {
+                                   int first_sample, int split_depth, py::handle passes, py::handle mist,
+                                   py::handle object_index, py::handle material_index) {
+  const AovRequest request = aov_request(passes, mist, object_index, material_index);
   const Camera camera = Camera::make(to_camera(camera_settings));
   RenderSettings settings;
   settings.samples = samples;
@@ -218,7 +243,15 @@ py::array_t<float> PyScene::render(const py::dict& camera_settings, int samples,
     // The scene is read in place under the shared lock: edits wait for the render to end.
     py::gil_scoped_release release;
     std::shared_lock lock(mutex_);
-    result = toyrt::render(scene_, camera, settings, sink, poll);
+    result = toyrt::render(scene_, camera, settings, sink, poll, request);
+  }
+  last_passes_ = py::dict();
+  for (size_t k = 0; k < kAovCount; ++k) {
+    const std::vector<float>& d = result.passes.data[k];
+    if (d.empty()) continue;
+    py::array_t<float> pass({py::ssize_t(result.height), py::ssize_t(result.width), py::ssize_t(aov_channels(Aov(k)))});
+    std::memcpy(pass.mutable_data(), d.data(), d.size() * sizeof(float));
+    last_passes_[aov_name(Aov(k))] = pass;
   }
   last_render_ = py::dict();
   last_render_["cancelled"] = result.cancelled;

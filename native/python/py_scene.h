@@ -47,8 +47,10 @@ class PyScene {
   py::array_t<float> render(const py::dict& camera, int samples, uint32_t seed, int max_specular_depth,
                             const std::string& area_light_sampling, const std::string& light_sampling, int threads,
                             int tile_size, py::object on_tile, py::object should_cancel, int first_sample,
-                            int split_depth);
+                            int split_depth, py::handle passes, py::handle mist, py::handle object_index,
+                            py::handle material_index);
   py::dict last_render() { return last_render_; }
+  py::dict last_passes() { return last_passes_; }
 
   // Ray arrays of any leading shape (..., 3): answers come in that shape. normals / mesh_ids add
   // "normal" (unit geometric normal in world space, 0 on a miss) and "mesh" (-1 on a miss).
@@ -94,6 +96,7 @@ class PyScene {
 
   Scene scene_;
   py::dict last_render_;
+  py::dict last_passes_;
   std::shared_mutex mutex_;
 };
 

@@ -229,7 +229,7 @@ Vec3 visible_lights(const World& world, const Vec3& org, const Vec3& unit_dir, f
 // The radiance arriving along `ray`, whose first vertex is path vertex `depth` (0: the camera
 // ray). Recursive only where a Fresnel surface is split, so at most split_depth levels deep.
 Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, uint32_t sample,
-                const IntegratorSettings& settings) {
+                const IntegratorSettings& settings, FirstHit* first = nullptr) {
   static const Material kDefault = Lambert{};
   const World& world = scene.world();
   const std::vector<Material>& materials = scene.materials();
@@ -258,10 +258,13 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     const Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;
     const Material& m =
         s.material >= 0 && size_t(s.material) < materials.size() ? materials[size_t(s.material)] : kDefault;
+    if (first) *first = FirstHit{true, s.p, ns, Vec3(0.0f), Vec3(0.0f), hit.instance, s.material};
     // A camera or specular ray sees an emitting surface's radiance (both sides, as Cycles' mesh
     // lights); its BSDF (black for a pure Emission shader) still scatters below.
-    if (scene.any_emission() && s.material >= 0 && size_t(s.material) < materials.size())
+    if (scene.any_emission() && s.material >= 0 && size_t(s.material) < materials.size()) {
       radiance += throughput * scene.emission()[size_t(s.material)].radiance;
+      if (first) first->emission = scene.emission()[size_t(s.material)].radiance;
+    }
     // One generic dispatch per hit, no per-type code: the lambda is instantiated per material
     // type, so for an inline scatter() (Lambert's) the compiler sees the answer's kind as a
     // constant and keeps only the diffuse path, as fast as a hand-written case. It returns
@@ -272,6 +275,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
         [&](const auto& material) {
           const Scatter sc = scatter(material, ShadingPoint{wo, s.ng, s.ns, s.uv}, ctx);
           if (sc.kind == Scatter::Kind::Diffuse) {
+            if (first) first->diffuse = sc.f * kPi;  // f = albedo / pi
             radiance += throughput * direct_lighting(scene, s, ng, ns, sc.f, depth, pixel, sample, settings);
             return false;
           }
@@ -288,6 +292,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
           return true;
         },
         m);
+    first = nullptr;  // passes see the first surface only
     if (!go_on) break;
   }
   return radiance;
@@ -296,8 +301,8 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
 }  // namespace
 
 Vec3 trace_path(const Scene& scene, const Ray& camera_ray, uint32_t pixel, uint32_t sample,
-                const IntegratorSettings& settings) {
-  const Vec3 radiance = trace_from(scene, camera_ray, 0, pixel, sample, settings);
+                const IntegratorSettings& settings, FirstHit* first) {
+  const Vec3 radiance = trace_from(scene, camera_ray, 0, pixel, sample, settings, first);
   // A numerical failure anywhere (it should not happen) must not poison the pixel.
   if (!is_finite(radiance)) return Vec3(0.0f);
   return glm::max(radiance, Vec3(0.0f));

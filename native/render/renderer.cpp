@@ -35,7 +35,7 @@ std::string format_bytes(size_t bytes) {
 }
 }  // namespace
 
-size_t render_memory_estimate(const Camera& camera, const RenderSettings& settings) {
+size_t render_memory_estimate(const Camera& camera, const RenderSettings& settings, const AovRequest& passes) {
   // Sizes in double: a window of 1e6 x 1e6 pixels must not wrap around before it is refused.
   const double w = std::max(0, camera.window.width()), h = std::max(0, camera.window.height());
   const double pixels = w * h;
@@ -44,7 +44,10 @@ size_t render_memory_estimate(const Camera& camera, const RenderSettings& settin
   const double threads = settings.threads > 0 ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
   // Framebuffer and the caller's copy (RGBA float each); a Tile and a queue slot per tile; a
   // worker's stack and TBB's bookkeeping (1 MB is generous: the integrator keeps its state on the stack).
-  const double bytes = pixels * 4 * sizeof(float) * 2 + tiles * (sizeof(Tile) + sizeof(size_t)) + threads * 1e6;
+  double channels = 4;
+  for (size_t k = 0; k < kAovCount; ++k)
+    if (passes.has(Aov(k))) channels += aov_channels(Aov(k));
+  const double bytes = pixels * channels * sizeof(float) * 2 + tiles * (sizeof(Tile) + sizeof(size_t)) + threads * 1e6;
   return bytes >= 1.8e19 ? SIZE_MAX : size_t(bytes);
 }
 
@@ -62,7 +65,7 @@ size_t available_memory_bytes() {
 }
 
 RenderResult render(const Scene& scene, const Camera& camera, const RenderSettings& requested, const TileSink& on_tile,
-                    const CancelPoll& should_cancel) {
+                    const CancelPoll& should_cancel, const AovRequest& passes) {
   requested.check();
   scene.check_renderable();
   // The settings with "auto" light sampling resolved for this scene: a copy of a few ints, the
@@ -72,7 +75,7 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
       resolve_light_sampling(requested.integrator.light_sampling, scene.world().lights.size());
   const auto start = std::chrono::steady_clock::now();
   const PixelWindow win = camera.window;
-  const size_t needed = render_memory_estimate(camera, settings), available = available_memory_bytes();
+  const size_t needed = render_memory_estimate(camera, settings, passes), available = available_memory_bytes();
   if (needed > available)
     throw RenderTooLarge("render: a " + std::to_string(win.width()) + " x " + std::to_string(win.height()) +
                          " image needs " + format_bytes(needed) + " but only " + format_bytes(available) +
@@ -82,6 +85,7 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
   result.width = win.width();
   result.height = win.height();
   result.rgba.assign(size_t(result.width) * size_t(result.height) * 4, 0.0f);
+  result.passes.allocate(passes, result.width, result.height);
   std::vector<Tile> tiles;
   for (int y = 0; y < result.height; y += settings.tile_size)
     for (int x = 0; x < result.width; x += settings.tile_size)
@@ -99,6 +103,7 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
   auto render_tile = [&](const Tile& t) {
     const float inv = 1.0f / float(settings.samples);
     const int first = settings.first_sample, last = settings.first_sample + settings.samples;
+    const bool with_passes = passes.any();  // read once: the plain loop below must stay as it was
     for (int j = t.y; j < t.y + t.height; ++j) {
       if (cancel.load(std::memory_order_relaxed)) return false;
       for (int i = t.x; i < t.x + t.width; ++i) {
@@ -107,7 +112,22 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
         const int px = win.x0 + i, py = win.y0 + j;
         const uint32_t pixel = uint32_t(py) * uint32_t(camera.width) + uint32_t(px);
         Vec3 sum(0.0f);
-        for (int s = first; s < last; ++s) {
+        const size_t index = size_t(j) * size_t(result.width) + size_t(i);
+        if (with_passes) {
+          // Passes asked for: the same samples, each reporting its first surface (aovs.h).
+          AovPixel aov(passes, camera);
+          for (int s = first; s < last; ++s) {
+            if ((s - first) % kCancelCheckSamples == kCancelCheckSamples - 1 && cancel.load(std::memory_order_relaxed))
+              return false;
+            const Vec2 jitter = sobol_owen_2d(pixel, uint32_t(s), 0, settings.integrator.seed);
+            FirstHit hit;
+            sum += trace_path(scene, camera.generate(float(px) + jitter.x, float(py) + jitter.y), pixel, uint32_t(s),
+                              settings.integrator, &hit);
+            aov.add(hit, s == first);
+          }
+          aov.store(result.passes, index, inv);
+        }
+        for (int s = with_passes ? last : first; s < last; ++s) {
           // A relaxed load every few samples costs nothing next to a path, and bounds the cancel
           // latency by a few samples whatever the sample count.
           if ((s - first) % kCancelCheckSamples == kCancelCheckSamples - 1 && cancel.load(std::memory_order_relaxed))
@@ -116,7 +136,7 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
           sum += trace_path(scene, camera.generate(float(px) + jitter.x, float(py) + jitter.y), pixel, uint32_t(s),
                             settings.integrator);
         }
-        float* out = &result.rgba[(size_t(j) * size_t(result.width) + size_t(i)) * 4];
+        float* out = &result.rgba[index * 4];
         out[0] = sum.x * inv;
         out[1] = sum.y * inv;
         out[2] = sum.z * inv;

@@ -5,6 +5,7 @@
 
 #include "camera/camera.h"
 #include "core/cancel_poll.h"
+#include "render/aovs.h"
 #include "render/integrator.h"
 #include "render/render_settings.h"
 
@@ -23,6 +24,7 @@ struct Tile {
 struct RenderResult {
   int width = 0, height = 0;  // of the camera's pixel window
   std::vector<float> rgba;    // width * height * 4, rows from the top
+  AovBuffers passes;          // the passes asked for (render's `passes`), the same layout
   bool cancelled = false;
   size_t tiles_done = 0, tiles_total = 0;
   double render_ms = 0.0;
@@ -35,9 +37,9 @@ struct RenderTooLarge : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Bytes a render of `camera`'s pixel window will allocate: its framebuffer, a copy for the
-// caller (the binding returns one), the tile list and a per-thread allowance.
-size_t render_memory_estimate(const Camera& camera, const RenderSettings& settings);
+// Bytes a render of `camera`'s pixel window will allocate: its framebuffer and passes, a copy of
+// them for the caller (the binding returns one), the tile list and a per-thread allowance.
+size_t render_memory_estimate(const Camera& camera, const RenderSettings& settings, const AovRequest& passes = {});
 // Memory the system can give now (Linux MemAvailable; the physical memory elsewhere), in bytes.
 size_t available_memory_bytes();
 
@@ -53,7 +55,8 @@ using TileSink = std::function<void(const Tile&, const RenderResult&)>;
 // Renders the committed scene in place (no copy of it: the caller keeps it unchanged until this
 // returns). Throws std::invalid_argument for settings out of bounds or a material id without its
 // material, std::logic_error for an uncommitted scene, RenderTooLarge before allocating.
+// `passes`: the render passes to fill beside Combined (aovs.h); none costs nothing.
 RenderResult render(const Scene& scene, const Camera& camera, const RenderSettings& settings,
-                    const TileSink& on_tile = {}, const CancelPoll& should_cancel = {});
+                    const TileSink& on_tile = {}, const CancelPoll& should_cancel = {}, const AovRequest& passes = {});
 
 }  // namespace toyrt

@@ -1,0 +1,98 @@
+"""Render passes through Blender's own switches: the View Layer's use_pass_* properties choose
+them, and each is registered under the name, channels and type Cycles gives it on the running
+Blender (Cycles' list_render_passes, intern/cycles/blender/addon/engine.py), so a compositing setup
+or a multilayer EXR reader made for Cycles works with TOYRT. The values are the core's
+(native/render/aovs.h: Cycles' definitions); a pass TOYRT cannot produce is registered and left
+black, with one note."""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import bpy
+
+
+class Pass(NamedTuple):
+    prop: str       # the View Layer property that turns it on
+    name_3: str     # Cycles' name on Blender 3.x-4.x
+    name_5: str     # Cycles' name on Blender 5.x
+    channels: str   # channel ids, one letter per channel
+    kind: str       # register_pass's type
+    native: str | None  # the core's pass (render(passes=...)); None: left black
+
+    @property
+    def name(self) -> str:
+        return self.name_5 if bpy.app.version >= (5, 0, 0) else self.name_3
+
+
+# Cycles' order of list_render_passes, the View Layer's standard properties only (its own
+# view_layer.cycles ones need the Cycles add-on and are not TOYRT's).
+PASSES = (
+    Pass("use_pass_z", "Depth", "Depth", "Z", "VALUE", "depth"),
+    Pass("use_pass_mist", "Mist", "Mist", "Z", "VALUE", "mist"),
+    Pass("use_pass_position", "Position", "Position", "XYZ", "VECTOR", "position"),
+    Pass("use_pass_normal", "Normal", "Normal", "XYZ", "VECTOR", "normal"),
+    Pass("use_pass_vector", "Vector", "Vector", "XYZW", "VECTOR", None),
+    Pass("use_pass_uv", "UV", "UV", "UVA", "VECTOR", None),
+    Pass("use_pass_object_index", "IndexOB", "Object Index", "X", "VALUE", "object_index"),
+    Pass("use_pass_material_index", "IndexMA", "Material Index", "X", "VALUE", "material_index"),
+    Pass("use_pass_diffuse_direct", "DiffDir", "Diffuse Direct", "RGB", "COLOR", None),
+    Pass("use_pass_diffuse_indirect", "DiffInd", "Diffuse Indirect", "RGB", "COLOR", None),
+    Pass("use_pass_diffuse_color", "DiffCol", "Diffuse Color", "RGB", "COLOR", "diffuse_color"),
+    Pass("use_pass_glossy_direct", "GlossDir", "Glossy Direct", "RGB", "COLOR", None),
+    Pass("use_pass_glossy_indirect", "GlossInd", "Glossy Indirect", "RGB", "COLOR", None),
+    # TOYRT's materials have no glossy closure (glass's reflection is not one yet): black, noted.
+    Pass("use_pass_glossy_color", "GlossCol", "Glossy Color", "RGB", "COLOR", None),
+    Pass("use_pass_transmission_direct", "TransDir", "Transmission Direct", "RGB", "COLOR", None),
+    Pass("use_pass_transmission_indirect", "TransInd", "Transmission Indirect", "RGB", "COLOR", None),
+    Pass("use_pass_transmission_color", "TransCol", "Transmission Color", "RGB", "COLOR", None),
+    Pass("use_pass_emit", "Emit", "Emission", "RGB", "COLOR", "emission"),
+    Pass("use_pass_environment", "Env", "Environment", "RGB", "COLOR", None),
+    Pass("use_pass_shadow", "Shadow", "Shadow", "RGB", "COLOR", None),  # a 3.x property only
+    Pass("use_pass_ambient_occlusion", "AO", "Ambient Occlusion", "RGB", "COLOR", None),
+)
+
+# World mist falloff -> Cycles' exponent (blender/sync.cpp).
+_MIST_FALLOFF = {"QUADRATIC": 2.0, "LINEAR": 1.0, "INVERSE_QUADRATIC": 0.5}
+
+
+def enabled(view_layer) -> list[Pass]:
+    """The passes the View Layer turns on, in Cycles' order (Combined is always there)."""
+    return [p for p in PASSES if getattr(view_layer, p.prop, False)]
+
+
+def register(engine, scene, view_layer) -> None:
+    """RenderEngine.update_render_passes: Combined, every pass turned on, and (denoising) the
+    noisy render, as Cycles keeps it."""
+    engine.register_pass(scene, view_layer, "Combined", 4, "RGBA", "COLOR")
+    for p in enabled(view_layer):
+        engine.register_pass(scene, view_layer, p.name, len(p.channels), p.channels, p.kind)
+    if denoising(scene):
+        engine.register_pass(scene, view_layer, NOISY, 4, "RGBA", "COLOR")
+
+
+NOISY = "Noisy Image"  # Cycles' name of the render before denoising, the same in 3.x and 5.x
+
+
+def denoising(scene) -> bool:
+    settings = getattr(scene, "toyrt", None)
+    return bool(settings is not None and settings.use_denoising)
+
+
+def mist(world) -> tuple[float, float, float]:
+    """(start, depth, falloff exponent) of the World's mist settings; Blender's defaults without a world."""
+    if world is None:
+        return 5.0, 25.0, 2.0
+    m = world.mist_settings
+    return float(m.start), float(m.depth), _MIST_FALLOFF.get(m.falloff, 2.0)
+
+
+def black(passes: list[Pass]) -> list[str]:
+    """The names of the passes TOYRT leaves black."""
+    return [p.name for p in passes if p.native is None]
+
+
+def per_material_id(materials: dict, used: dict) -> list[int]:
+    """Material pass_index per native material id, from sync's name -> (id, spec) table and the
+    Blender materials the walk saw (0 for an id none of them has)."""
+    ids = {materials[name][0]: mat.pass_index for name, mat in used.items() if name in materials}
+    return [ids.get(k, 0) for k in range(max(ids, default=-1) + 1)]

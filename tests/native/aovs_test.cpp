@@ -1,0 +1,119 @@
+// The render passes' per-pixel rules (render/aovs.h), each against Cycles' definition: what
+// comes from the first sample only, what is averaged, Cycles' mist falloffs, and that a render
+// pays only for the passes it asks for.
+#include "render/aovs.h"
+#include "camera/camera.h"
+
+#include <gtest/gtest.h>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <stdexcept>
+
+namespace toyrt {
+namespace {
+
+// A perspective camera at (0, 0, 5) looking down -Z.
+Camera camera_above() {
+  CameraParams p;
+  p.resolution_x = p.resolution_y = 1;
+  p.matrix_world = glm::translate(Mat4(1.0f), Vec3(0.0f, 0.0f, 5.0f));
+  return Camera::make(p);
+}
+
+AovRequest all_passes() {
+  AovRequest r;
+  r.mask = (1u << kAovCount) - 1u;
+  r.object_index = {7.0f, 9.0f};
+  r.material_index = {3.0f};
+  return r;
+}
+
+FirstHit hit_at(Vec3 p, Vec3 n, Vec3 albedo, int32_t instance = 1, int32_t material = 0) {
+  return FirstHit{true, p, n, albedo, Vec3(0.0f), instance, material};
+}
+
+// Reads pass `aov` of the one pixel of `b`.
+Vec3 value(const AovBuffers& b, Aov aov) {
+  const std::vector<float>& d = b.data[size_t(aov)];
+  return aov_channels(aov) == 1 ? Vec3(d[0]) : Vec3(d[0], d[1], d[2]);
+}
+
+TEST(AovPixel, DepthPositionAndIndicesComeFromTheFirstSampleOnly) {
+  const Camera cam = camera_above();
+  const AovRequest r = all_passes();
+  AovBuffers b;
+  b.allocate(r, 1, 1);
+  AovPixel px(r, cam);
+  px.add(hit_at(Vec3(0.3f, 0.0f, 1.0f), Vec3(0, 0, 1), Vec3(0.5f)), true);         // 4 m below: planar z
+  px.add(hit_at(Vec3(0.0f, 0.0f, 0.0f), Vec3(0, 0, 1), Vec3(0.5f), 0, 0), false);  // another object behind
+  px.store(b, 0, 0.5f);
+  EXPECT_FLOAT_EQ(value(b, Aov::Depth).x, 4.0f);  // planar, not the 4.011 m distance
+  EXPECT_EQ(value(b, Aov::Position), Vec3(0.3f, 0.0f, 1.0f));
+  EXPECT_FLOAT_EQ(value(b, Aov::ObjectIndex).x, 9.0f);  // instance 1's
+  EXPECT_FLOAT_EQ(value(b, Aov::MaterialIndex).x, 3.0f);
+}
+
+TEST(AovPixel, AFirstSampleThatMissesLeavesDepth1e10AndIndexZeroEvenIfLaterOnesHit) {
+  const Camera cam = camera_above();
+  const AovRequest r = all_passes();
+  AovBuffers b;
+  b.allocate(r, 1, 1);
+  AovPixel px(r, cam);
+  px.add(FirstHit{}, true);
+  px.add(hit_at(Vec3(0.0f), Vec3(0, 0, 1), Vec3(0.5f)), false);
+  px.store(b, 0, 0.5f);
+  EXPECT_EQ(value(b, Aov::Depth).x, 1e10f);
+  EXPECT_EQ(value(b, Aov::ObjectIndex).x, 0.0f);
+  EXPECT_EQ(value(b, Aov::Position), Vec3(0.0f));
+}
+
+TEST(AovPixel, NormalAlbedoAndMistAreAveragedWithMissesCountingAsNothingHit) {
+  const Camera cam = camera_above();
+  AovRequest r = all_passes();
+  r.mist = MistSettings{1.0f, 8.0f, 1.0f};  // linear over [1, 9] m
+  AovBuffers b;
+  b.allocate(r, 1, 1);
+  AovPixel px(r, cam);
+  px.add(hit_at(Vec3(0.0f), Vec3(0, 0, 1), Vec3(0.8f, 0.4f, 0.2f)), true);  // 5 m: mist 0.5
+  px.add(FirstHit{}, false);                                                // a miss: mist 1
+  px.store(b, 0, 0.5f);
+  EXPECT_EQ(value(b, Aov::Normal), Vec3(0.0f, 0.0f, 0.5f));
+  EXPECT_EQ(value(b, Aov::DiffuseColor), Vec3(0.4f, 0.2f, 0.1f));
+  EXPECT_FLOAT_EQ(value(b, Aov::Mist).x, 1.0f - 0.5f * (1.0f - 0.5f));
+}
+
+TEST(AovPixel, MistFollowsCyclesFalloffExponents) {
+  const Camera cam = camera_above();
+  for (const auto& [falloff, expected] : {std::pair{2.0f, 0.25f}, {1.0f, 0.5f}, {0.5f, 0.70710678f}, {3.0f, 0.125f}}) {
+    AovRequest r;
+    r.mask = 1u << uint32_t(Aov::Mist);
+    r.mist = MistSettings{1.0f, 8.0f, falloff};
+    AovBuffers b;
+    b.allocate(r, 1, 1);
+    AovPixel px(r, cam);
+    px.add(hit_at(Vec3(0.0f), Vec3(0, 0, 1), Vec3(0.5f)), true);
+    px.store(b, 0, 1.0f);
+    EXPECT_NEAR(value(b, Aov::Mist).x, expected, 1e-6f) << "falloff " << falloff;
+  }
+}
+
+TEST(AovBuffers, OnlyThePassesAskedForAreAllocated) {
+  AovRequest r;
+  r.mask = (1u << uint32_t(Aov::Depth)) | (1u << uint32_t(Aov::Normal));
+  AovBuffers b;
+  b.allocate(r, 4, 3);
+  for (size_t k = 0; k < kAovCount; ++k) {
+    const Aov aov = Aov(k);
+    EXPECT_EQ(b.data[k].size(), r.has(aov) ? size_t(12 * aov_channels(aov)) : 0u) << aov_name(aov);
+  }
+  EXPECT_EQ(b.data[size_t(Aov::Depth)][0], 1e10f);  // an unrendered pixel reads as nothing hit
+  EXPECT_FALSE(AovRequest{}.any());
+}
+
+TEST(Aov, NamesParseBackAndAnUnknownOneIsRefused) {
+  for (size_t k = 0; k < kAovCount; ++k) EXPECT_EQ(parse_aov(aov_name(Aov(k))), Aov(k));
+  EXPECT_THROW(parse_aov("vector"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace toyrt
