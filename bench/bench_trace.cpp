@@ -53,6 +53,7 @@ struct Row {
   std::string mesh, rays, threads;
   size_t count;
   double toyrt_ms, embree_ms, ratio;  // medians of interleaved runs; ratio: the median of Embree's / TOYRT's time
+  double robust_ms, robust_ratio;     // the same against Embree in its robust mode
 };
 
 // Two operations timed in alternation, `runs` times each: the median of each one's times and the
@@ -147,6 +148,7 @@ int main(int argc, char** argv) {
     scene.add_instance(scene.add_mesh(traced.vertices, traced.triangles), Mat4(1.0f));
     scene.commit();
     const EmbreeScene embree(traced.vertices, traced.triangles);
+    const EmbreeScene robust(traced.vertices, traced.triangles, true);
 
     // Camera rays that hit (a frame around the bounds misses in its corners; those rays cost
     // little in either engine and say nothing about traversal), and the surface points they find.
@@ -191,15 +193,15 @@ int main(int argc, char** argv) {
         };
         // Embree through the same harness: TBB tasks of 256 rays, single-ray queries, writing
         // the same fields (t, prim, instance, u, v) as TOYRT's batch.
-        const auto theirs = [&] {
+        auto engine = [&](const EmbreeScene& peer) {
           run_with_threads(threads, [&] {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 256),
                               [&](const tbb::blocked_range<size_t>& r) {
                                 for (size_t i = r.begin(); i != r.end(); ++i) {
                                   if (shadow) {
-                                    blocked[i] = embree.occluded(rays[i]);
+                                    blocked[i] = peer.occluded(rays[i]);
                                   } else {
-                                    const Hit h = embree.intersect(rays[i]);
+                                    const Hit h = peer.intersect(rays[i]);
                                     t[i] = h.t;
                                     u[i] = h.u;
                                     v[i] = h.v;
@@ -210,8 +212,10 @@ int main(int argc, char** argv) {
                               });
           });
         };
-        const Timing tm = interleaved(runs, mine, theirs);
-        rows.push_back({c.name, kind, std::to_string(threads), rays.size(), tm.a_ms, tm.b_ms, tm.ratio});
+        const Timing tm = interleaved(runs, mine, [&] { engine(embree); });
+        const Timing tr = interleaved(runs, mine, [&] { engine(robust); });
+        rows.push_back(
+            {c.name, kind, std::to_string(threads), rays.size(), tm.a_ms, tm.b_ms, tm.ratio, tr.b_ms, tr.ratio});
         std::fprintf(stderr, "  %-28s %d thread(s): TOYRT %.2f Mrays/s, Embree %.2f Mrays/s, %.2fx\n", kind.c_str(),
                      threads, rays.size() / tm.a_ms / 1e3, rays.size() / tm.b_ms / 1e3, tm.ratio);
       }
@@ -233,13 +237,14 @@ int main(int argc, char** argv) {
      << "into the rays the mesh blocks (shadow, occluded) and those that reach the light (shadow, unoccluded). The "
      << "closed room: the 1.0M-triangle sphere inside a box room of 12 triangles, the light outside the room, so a "
      << "wall blocks every shadow ray (its builds are not timed). TOYRT / Embree > 1: TOYRT is faster.\n\n"
-     << "## Tracing\n\n| mesh | rays | threads | count | TOYRT Mrays/s | Embree Mrays/s | TOYRT / Embree |\n"
-     << "|---|---|---|---|---|---|---|\n";
+     << "## Tracing\n\n| mesh | rays | threads | count | TOYRT Mrays/s | Embree Mrays/s | TOYRT / Embree | "
+     << "Embree robust Mrays/s | TOYRT / Embree robust |\n"
+     << "|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
     char line[512];
-    std::snprintf(line, sizeof line, "| %s | %s | %s | %zu | %.2f | %.2f | **%.2f** |\n", r.mesh.c_str(),
+    std::snprintf(line, sizeof line, "| %s | %s | %s | %zu | %.2f | %.2f | **%.2f** | %.2f | %.2f |\n", r.mesh.c_str(),
                   r.rays.c_str(), r.threads.c_str(), r.count, r.count / r.toyrt_ms / 1e3, r.count / r.embree_ms / 1e3,
-                  r.ratio);
+                  r.ratio, r.count / r.robust_ms / 1e3, r.robust_ratio);
     md << line;
   }
   md << "\n## Building\n\n" << builds.str();
