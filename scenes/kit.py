@@ -96,6 +96,25 @@ def glossy(name, color, roughness, distribution="GGX"):
     return mat
 
 
+def diffuse_and_glossy(name, diffuse_color, glossy_color, roughness, fac=None):
+    """A Mix Shader (factor fac) or, with fac None, an Add Shader of a Diffuse BSDF and a GGX
+    Glossy BSDF (TOYRT: its 'diffuse_glossy' material)."""
+    mat, mix = surface(name, "ShaderNodeAddShader" if fac is None else "ShaderNodeMixShader")
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    first = 0 if fac is None else 1
+    if fac is not None:
+        mix.inputs[0].default_value = fac
+    d = nodes.new("ShaderNodeBsdfDiffuse")
+    d.inputs["Color"].default_value = (*diffuse_color, 1.0)
+    g = nodes.new("ShaderNodeBsdfGlossy")
+    g.distribution = "GGX"
+    g.inputs["Color"].default_value = (*glossy_color, 1.0)
+    g.inputs["Roughness"].default_value = roughness
+    links.new(d.outputs[0], mix.inputs[first])
+    links.new(g.outputs[0], mix.inputs[first + 1])
+    return mat
+
+
 def metal(name, color, roughness):
     """A Principled BSDF with Metallic 1 (TOYRT: a glossy of its base colour, noted)."""
     mat, bsdf = surface(name, "ShaderNodeBsdfPrincipled")

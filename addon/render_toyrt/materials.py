@@ -14,6 +14,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .material_mix import mix_of_diffuse_and_glossy
+
 DEFAULT_GREY = (0.8, 0.8, 0.8)   # Blender's default surface colour
 MAGENTA = (1.0, 0.0, 1.0)        # placeholder for missing images
 PLACEHOLDER_PIXELS = np.array([[MAGENTA]], np.float32)   # one magenta pixel, linear
@@ -46,6 +48,8 @@ class MaterialSpec:
     ior: float = 1.45
     roughness: float = 0.5
     shadowing: str = "separable"
+    diffuse_weight: float = 1.0                              # 'diffuse_glossy': the diffuse part's weight
+    glossy_color: tuple[float, float, float] = DEFAULT_GREY  # 'diffuse_glossy': the glossy part's colour
     emission: tuple[float, float, float] = (0.0, 0.0, 0.0)   # colour x strength, linear radiance
     emission_sampling: str = "AUTO"                           # Blender 4.x's names (3.x: AUTO or NONE)
 
@@ -53,8 +57,10 @@ class MaterialSpec:
         """Keyword arguments of toyrt.Scene.add_material / set_material, with the texture's id."""
         args = dict(kind=self.kind, color=self.color, texture=texture_id, ior=self.ior, emission=self.emission,
                     emission_sampling=self.emission_sampling)
-        if self.kind == "glossy":   # the core refuses keywords a kind does not read
+        if self.kind in ("glossy", "diffuse_glossy"):   # the core refuses keywords a kind does not read
             args.update(roughness=self.roughness, shadowing=self.shadowing)
+        if self.kind == "diffuse_glossy":
+            args.update(diffuse_weight=self.diffuse_weight, glossy_color=self.glossy_color)
         return args
 
 
@@ -229,6 +235,11 @@ def _convert(mat, notes):
         # Cycles renders an unconnected surface black; the nearest we have is a black diffuse.
         notes.append(f"material '{name}': nothing linked to the Surface output (black)")
         return _diffuse((0.0, 0.0, 0.0))
+    return _convert_node(name, node, notes)
+
+
+def _convert_node(name, node, notes):
+    """The shader node `node` of material `name` as (MaterialSpec, image)."""
     t = node.type
     if t == "BSDF_DIFFUSE":
         rough = input_socket(node, "Roughness")
@@ -239,6 +250,10 @@ def _convert(mat, notes):
         return _principled(name, node, notes)
     if t in ("BSDF_GLOSSY", "BSDF_ANISOTROPIC"):   # 4.0+: the Glossy node is ShaderNodeBsdfAnisotropic
         return _glossy(name, node, notes)
+    if t in ("MIX_SHADER", "ADD_SHADER"):
+        mixed = mix_of_diffuse_and_glossy(name, node, notes, _convert_node)
+        if mixed is not None:
+            return mixed
     if t == "EMISSION":
         # Emission alone has no BSDF: a black surface that glows (Cycles).
         emission = _emission(name, input_socket(node, "Color"), input_socket(node, "Strength"), notes)
@@ -383,8 +398,8 @@ def _metal(name, node, notes):
     if aniso is not None and (aniso.is_linked or aniso.default_value > 0.0):
         extras.append("anisotropy")
     if getattr(node, "distribution", "GGX") != "GGX":
-        extras.append(f"{node.distribution} as single-scatter GGX")
-    notes.append(f"material '{name}': Principled metal {', '.join(extras)} (glossy of its base colour)")
+        extras.append(f"{node.distribution} (single-scatter GGX)")
+    notes.append(f"material '{name}': Principled metal without {', '.join(extras)} (glossy of its base colour)")
     spec = _glossy_spec(name, None, input_socket(node, "Roughness"), notes)
     if base is not None:
         spec = replace(spec, color=_finite_color(name, base.default_value, "base colour", notes))

@@ -13,13 +13,17 @@ Glossy Glossy::make(const Vec3& color, float roughness, GgxShadowing shadowing) 
   return Glossy{color, std::clamp(roughness, 0.0f, 1.0f), shadowing};
 }
 
-Glossy Glossy::from_params(const Params& params) {
-  const Glossy d;
+GgxShadowing shadowing_from_params(const Params& params) {
   const std::string shadowing = params.text("shadowing", "separable");
   if (shadowing != "separable" && shadowing != "correlated")
     throw std::invalid_argument("glossy: shadowing must be 'separable' or 'correlated', not '" + shadowing + "'");
+  return shadowing == "separable" ? GgxShadowing::Separable : GgxShadowing::HeightCorrelated;
+}
+
+Glossy Glossy::from_params(const Params& params) {
+  const Glossy d;
   return make(params.color("color", d.color), float(params.number("roughness", d.roughness)),
-              shadowing == "separable" ? GgxShadowing::Separable : GgxShadowing::HeightCorrelated);
+              shadowing_from_params(params));
 }
 
 Scatter scatter(const Glossy& m, const ShadingPoint& s, const MaterialContext&) {

@@ -29,6 +29,9 @@ struct Glossy {
   static Glossy from_params(const Params& params);
 };
 
+// The `shadowing` parameter ('separable' by default); throws std::invalid_argument for another name.
+GgxShadowing shadowing_from_params(const Params& params);
+
 Scatter scatter(const Glossy& m, const ShadingPoint& s, const MaterialContext& ctx);
 inline int32_t texture_index(const Glossy&) { return -1; }
 

@@ -55,10 +55,11 @@ struct Scatter {
     Diffuse,   // direct lighting with BRDF value f, then the path ends
     Specular,  // the path continues along branches[0] with weight 1 (f / pdf = 1)
     Split,     // each of the `count` branches is traced on its own, weighted by its probability
-    Glossy,    // lights sampled with MIS against `glossy`, then the path continues along its sample
+    Glossy,    // lights sampled with MIS against `glossy`, then the path continues along its sample;
+               // a diffuse part f, if not 0, gets its direct light as a Diffuse answer does
   };
   Kind kind = Kind::Diffuse;
-  Vec3 f{0.0f};  // Diffuse: for directions on wo's side of the surface
+  Vec3 f{0.0f};  // Diffuse, and Glossy's diffuse part (0: none): for directions on wo's side
   int count = 0;
   SpecularSample branches[2];
   GlossyLobe glossy;

@@ -282,6 +282,8 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             return false;
           }
           if (sc.kind == Scatter::Kind::Glossy) {
+            if (sc.f != Vec3(0.0f))
+              radiance += throughput * direct_lighting(scene, s, ng, ns, sc.f, depth, pixel, sample, settings);
             const Vec3 origin = offset_ray_origin(s.p, ng);
             const uint32_t dim = vertex_dimension(depth, 0);
             radiance += throughput * glossy_direct_lighting(scene, s.p, origin, ng, sc.glossy, pixel, sample, dim + 1,

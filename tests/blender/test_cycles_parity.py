@@ -195,6 +195,18 @@ def scene_glossy_sweep(p):
     kit.world((0, 0, 0))
 
 
+def scene_diffuse_and_glossy(p):
+    # Mix and Add shaders of a Diffuse and a Glossy BSDF: balls at three mix factors and one sum.
+    kit.plane("floor", 8.0, kit.diffuse("floor", (0.6, 0.6, 0.6)))
+    for i, (fac, rough) in enumerate(p["balls"]):
+        x = (i - (len(p["balls"]) - 1) / 2) * 1.0
+        mat = kit.diffuse_and_glossy(f"mixed{i}", (0.7, 0.25, 0.15), (0.9, 0.9, 0.9), rough, fac)
+        kit.uv_sphere(f"ball{i}", 0.42, (x, 0.0, 0.42), mat)
+    kit.point_light("lamp", (0.8, -1.5, 2.5), 150.0, radius=0.25)
+    camera((0.0, -4.5, 1.6), (0, 0, 0.35))
+    kit.world((0, 0, 0))
+
+
 # A real file: five 1 m point lights of 100 W a metre above a torus, from Debian's assimp-testmodels
 # (Blender 2.50; the Makefile installs it). Its own camera, lights and grey world.
 TORUS_FILE = Path("/usr/share/assimp/models/BLEND/TorusLightsCams_250_compressed.blend")
@@ -265,6 +277,8 @@ SCENES_SPEC = [
                                                     lamp="point", mean_limit=0.005, sample_factor=2), 8),
     ("glossy_sweep_area", scene_glossy_sweep, dict(roughness=[0.05, 0.2, 0.4, 0.7, 1.0], color=(0.9, 0.75, 0.5),
                                                    lamp="area", mean_limit=0.005, sample_factor=4), 8),
+    ("mix_diffuse_glossy", scene_diffuse_and_glossy, dict(balls=[(0.2, 0.3), (0.5, 0.3), (0.8, 0.3), (None, 0.1)],
+                                                          mean_limit=0.005, sample_factor=2), 8),
     # Cycles' defaults: the light is seen through and in the glass (camera, glossy and transmission
     # rays see it), and the world lights the floor, as in TOYRT.
     ("glass_sphere_visible_light", scene_glass, dict(light=(1.0, -1.0, 3.0), power=120.0, ior=1.45, uv_repeat=4.0,

@@ -3,6 +3,7 @@
 // albedo (the continuation ray escapes with weight G2 / G1); under a small spherical lamp it shows
 // f(z, z) I / d^2, whether the lamp is a delta (light sampling alone) or has a radius (light
 // sampling and the continuation ray combined by MIS: wrong weights double or lose the light).
+#include "materials/material.h"
 #include "render/renderer.h"
 #include "sampling/ggx.h"
 
@@ -106,4 +107,25 @@ TEST(GlossyRender, SharpFloorReflectsTheLampWithoutNaN) {
   // A mirror under a disc of radiance L that fills the reflected direction shows L.
   const double lamp_radiance = 100.0 / (4.0 * kPiD) / (kPiD * 0.1 * 0.1);
   EXPECT_NEAR(r.rgba[0], lamp_radiance, 2e-2 * lamp_radiance);
+}
+
+TEST(GlossyRender, DiffuseAndGlossySideBySideAddTheirLight) {
+  // A Mix Shader of a Diffuse and a Glossy BSDF at factor 0.25 under a delta lamp 1 m above:
+  // (0.75 albedo / pi + 0.25 colour / (4 pi)) I / d^2 at roughness 1, normal incidence.
+  Scene scene;
+  const float h = 10.0f;
+  MeshShading sh;
+  sh.material_ids = {0, 0};
+  scene.add_instance(scene.add_mesh({{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}}, {{0, 1, 2}, {0, 2, 3}}, sh),
+                     Mat4(1.0f));
+  Params p;
+  p.set("color", Vec3(0.5f)).set("diffuse_weight", 0.75).set("glossy_color", Vec3(0.25f)).set("roughness", 1.0);
+  scene.add_material(make_material("diffuse_glossy", p));
+  const float power = 100.0f;
+  scene.add_light(PointLight::make(Vec3(0.0f, 0.0f, 1.0f), power, Vec3(1.0f)));
+  scene.commit();
+  const RenderResult r = render(scene, pixel_above(), samples(16));
+  const double irradiance = power / (4.0 * kPiD);
+  const double expected = (0.75 * 0.5 / kPiD + 0.25 / (4.0 * kPiD)) * irradiance;
+  EXPECT_NEAR(r.rgba[0], expected, 1e-4 * expected);
 }
