@@ -278,7 +278,7 @@ SCENES_SPEC = [
     ("glossy_sweep_area", scene_glossy_sweep, dict(roughness=[0.05, 0.2, 0.4, 0.7, 1.0], color=(0.9, 0.75, 0.5),
                                                    lamp="area", mean_limit=0.005, sample_factor=4), 8),
     ("mix_diffuse_glossy", scene_diffuse_and_glossy, dict(balls=[(0.2, 0.3), (0.5, 0.3), (0.8, 0.3), (None, 0.1)],
-                                                          mean_limit=0.005, sample_factor=2), 8),
+                                                          mean_limit=0.005, sample_factor=4), 8),
     # Cycles' defaults: the light is seen through and in the glass (camera, glossy and transmission
     # rays see it), and the world lights the floor, as in TOYRT.
     ("glass_sphere_visible_light", scene_glass, dict(light=(1.0, -1.0, 3.0), power=120.0, ior=1.45, uv_repeat=4.0,
