@@ -13,7 +13,7 @@ namespace toyrt {
 
 struct GlossyLobe {
   Frame frame{Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};  // z: the shading normal on wo's side
-  Vec3 wo{0.0f, 0.0f, 1.0f};                                  // local, unit, wo.z > 0
+  Vec3 wo{0.0f, 0.0f, 1.0f};                                 // local, unit, wo.z > 0
   Vec3 tint{0.0f};  // the Fresnel term as Blender's Glossy BSDF has it: the colour, at every angle
   float alpha = kGgxMinAlpha;
   GgxShadowing shadowing = GgxShadowing::Separable;
@@ -25,8 +25,8 @@ struct BsdfEval {
 };
 
 struct BsdfSample {
-  Vec3 wi{0.0f};       // world, unit
-  Vec3 weight{0.0f};   // f cos / pdf; 0: no continuation
+  Vec3 wi{0.0f};      // world, unit
+  Vec3 weight{0.0f};  // f cos / pdf; 0: no continuation
   float pdf = 0.0f;
 };
 

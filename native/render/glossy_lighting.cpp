@@ -16,9 +16,9 @@ Vec3 glossy_direct_lighting(const Scene& scene, const Vec3& p, const Vec3& origi
     // ray visibility), for their light as for their image.
     const LightVisibility v = world.light_visibility[j];
     if (!v.specular) continue;
-    const LightSample ls = sample_light(world.lights[j], p,
-                                        sobol_owen_2d(pixel, sample, first_dim + uint32_t(j), settings.seed),
-                                        settings.area_sampling);
+    const LightSample ls =
+        sample_light(world.lights[j], p, sobol_owen_2d(pixel, sample, first_dim + uint32_t(j), settings.seed),
+                     settings.area_sampling);
     if (!ls.valid() || glm::dot(ng, ls.wi) <= 0.0f) continue;
     const BsdfEval e = evaluate_lobe(lobe, ls.wi);
     const float cos_i = glm::dot(lobe.frame.n, ls.wi);

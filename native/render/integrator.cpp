@@ -286,8 +286,8 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
               radiance += throughput * direct_lighting(scene, s, ng, ns, sc.f, depth, pixel, sample, settings);
             const Vec3 origin = offset_ray_origin(s.p, ng);
             const uint32_t dim = vertex_dimension(depth, 0);
-            radiance += throughput * glossy_direct_lighting(scene, s.p, origin, ng, sc.glossy, pixel, sample, dim + 1,
-                                                            settings);
+            radiance += throughput *
+                        glossy_direct_lighting(scene, s.p, origin, ng, sc.glossy, pixel, sample, dim + 1, settings);
             const BsdfSample g = sample_lobe(
                 sc.glossy, sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 5), settings.seed));
             if (!(g.pdf > 0.0f) || glm::dot(g.wi, ng) <= 0.0f) return false;

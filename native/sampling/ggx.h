@@ -104,8 +104,8 @@ inline GgxEval ggx_reflection_eval(float alpha, GgxShadowing shadowing, const Ve
   const Vec3 h = glm::normalize(wo + wi);  // wo + wi has z > 0, so a length > 0
   const float d = ggx_d(alpha, h);
   const float ro = ggx_root(alpha, wo), ri = ggx_root(alpha, wi);
-  const float g2_over_cos = shadowing == GgxShadowing::Separable ? 4.0f / ((wo.z + ro) * (wi.z + ri))
-                                                                  : 2.0f / (wi.z * ro + wo.z * ri);
+  const float g2_over_cos =
+      shadowing == GgxShadowing::Separable ? 4.0f / ((wo.z + ro) * (wi.z + ri)) : 2.0f / (wi.z * ro + wo.z * ri);
   return {0.25f * d * g2_over_cos, d / (2.0f * (wo.z + ro))};
 }
 

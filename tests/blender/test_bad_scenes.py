@@ -312,5 +312,6 @@ def test_100k_objects():
 
 
 PARTS = [test_empty_scene, test_no_camera, test_edges_and_points_only, test_zero_scale, test_nan_vertices,
-         test_far_from_origin, test_missing_image, test_unsupported_nodes, test_glossy_and_metal, test_library_linked, test_100k_objects]
+         test_far_from_origin, test_missing_image, test_unsupported_nodes, test_glossy_and_metal, test_library_linked,
+         test_100k_objects]
 run_script(PARTS, "bad scenes", TMP)

@@ -5,9 +5,9 @@
 // integrated numerically equals the sampler's mean weight and never exceeds 1; roughness 0
 // converges to the mirror; grazing and degenerate directions give finite numbers; bad roughness
 // and colours have a defined result.
+#include "sampling/ggx.h"
 #include "materials/glossy.h"
 #include "materials/material.h"
-#include "sampling/ggx.h"
 #include "statistics.h"
 
 #include <gtest/gtest.h>
@@ -177,7 +177,9 @@ TEST(Ggx, CorrelatedAlbedoMatchesCyclesTable) {
     const float alpha = ggx_alpha(float(rough));
     const Vec3 wo(float(std::sqrt(1.0 - mu * mu)), 0.0f, float(mu));
     const double albedo = hemisphere_integral(
-        [&](const Vec3& wi) { return double(ggx_reflection_eval(alpha, GgxShadowing::HeightCorrelated, wo, wi).f) * wi.z; },
+        [&](const Vec3& wi) {
+          return double(ggx_reflection_eval(alpha, GgxShadowing::HeightCorrelated, wo, wi).f) * wi.z;
+        },
         1024, 512);
     EXPECT_NEAR(albedo, t.e, 2e-3) << "roughness " << rough << " cos_o " << mu;
   }
@@ -251,8 +253,8 @@ TEST(Ggx, GrazingAndDegenerateDirectionsAreFinite) {
     }
   }
   // A direction exactly opposite wo's mirror (h = 0) has no half vector: 0, not NaN.
-  const GgxEval opposite = ggx_reflection_eval(0.5f, GgxShadowing::Separable, Vec3(0.6f, 0.0f, 0.8f),
-                                               Vec3(-0.6f, 0.0f, -0.8f));
+  const GgxEval opposite =
+      ggx_reflection_eval(0.5f, GgxShadowing::Separable, Vec3(0.6f, 0.0f, 0.8f), Vec3(-0.6f, 0.0f, -0.8f));
   EXPECT_EQ(opposite.f, 0.0f);
 }
 
