@@ -28,4 +28,18 @@ Vec3 glossy_direct_lighting(const Scene& scene, const Vec3& p, const Vec3& origi
                             const GlossyLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t first_dim,
                             const IntegratorSettings& settings);
 
+// A glossy vertex's whole work: its lamps' light (glossy_direct_lighting, lamp j from dimension
+// light_dim + j) and the continuation the lobe draws from dimension lobe_dim: direction, weight
+// f cos / pdf and pdf (0: the path ends, the sample left below the geometric surface). Out of
+// line, so the integrator's loop, which a Lambert-only scene runs, stays the size it was.
+struct GlossyStep {
+  Vec3 radiance{0.0f};
+  Vec3 wi{0.0f};
+  Vec3 weight{0.0f};
+  float pdf = 0.0f;
+};
+[[gnu::noinline]] GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng,
+                                           const GlossyLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t light_dim,
+                                           uint32_t lobe_dim, const IntegratorSettings& settings);
+
 }  // namespace toyrt

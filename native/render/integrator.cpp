@@ -156,7 +156,10 @@ EmissiveTriangle emissive_triangle_at(const Scene& scene, const Hit& hit, const 
 }
 
 // Light arriving at a diffuse point: one sample per light, or one light chosen by contribution.
-Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f, int depth,
+// Always inlined: a Lambert hit and a glossy answer's diffuse part both call it, and as a
+// function of two callers the compiler stopped inlining it into the Lambert path, which then
+// cost 1.4 % more instructions (cachegrind) than before glossy materials existed.
+[[gnu::always_inline]] inline Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f, int depth,
                      uint32_t pixel, uint32_t sample, const IntegratorSettings& settings) {
   const World& world = scene.world();
   const Vec3 origin = offset_ray_origin(s.p, ng);
@@ -285,12 +288,11 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             if (sc.f != Vec3(0.0f))
               radiance += throughput * direct_lighting(scene, s, ng, ns, sc.f, depth, pixel, sample, settings);
             const Vec3 origin = offset_ray_origin(s.p, ng);
-            const uint32_t dim = vertex_dimension(depth, 0);
-            radiance += throughput *
-                        glossy_direct_lighting(scene, s.p, origin, ng, sc.glossy, pixel, sample, dim + 1, settings);
-            const BsdfSample g = sample_lobe(
-                sc.glossy, sobol_owen_2d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 5), settings.seed));
-            if (!(g.pdf > 0.0f) || glm::dot(g.wi, ng) <= 0.0f) return false;
+            const GlossyStep g = glossy_vertex(scene, s.p, origin, ng, sc.glossy, pixel, sample,
+                                               vertex_dimension(depth, 1), vertex_dimension(depth, kDimsPerVertex - 5),
+                                               settings);
+            radiance += throughput * g.radiance;
+            if (!(g.pdf > 0.0f)) return false;
             throughput *= g.weight;
             bsdf_pdf = g.pdf;
             light_only = depth >= settings.max_specular_depth;
