@@ -25,7 +25,11 @@ struct SurfaceHit {
   int32_t material = -1;
 };
 
-SurfaceHit surface_at(const Scene& scene, const Hit& hit) {
+// Always inlined, as is the material visit in trace_from: once the glossy cases were there GCC
+// stopped inlining both into trace_from. Forced, and with the diffuse f passed by value, a
+// Lambert-only render runs 0.8 % more instructions per path than before glossy materials (1.4 %
+// without: docs/render.md, "A scene pays for what it uses").
+[[gnu::always_inline]] inline SurfaceHit surface_at(const Scene& scene, const Hit& hit) {
   const Instance& inst = scene.instance(uint32_t(hit.instance));
   const Mesh& mesh = scene.mesh(inst.mesh);
   const Triangle& tri = mesh.triangles()[size_t(hit.prim)];
@@ -156,10 +160,7 @@ EmissiveTriangle emissive_triangle_at(const Scene& scene, const Hit& hit, const 
 }
 
 // Light arriving at a diffuse point: one sample per light, or one light chosen by contribution.
-// Always inlined: a Lambert hit and a glossy answer's diffuse part both call it, and as a
-// function of two callers the compiler stopped inlining it into the Lambert path, which then
-// cost 1.4 % more instructions (cachegrind) than before glossy materials existed.
-[[gnu::always_inline]] inline Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f, int depth,
+Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f, int depth,
                      uint32_t pixel, uint32_t sample, const IntegratorSettings& settings) {
   const World& world = scene.world();
   const Vec3 origin = offset_ray_origin(s.p, ng);
@@ -278,19 +279,22 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     const MaterialContext ctx{
         &scene.textures(), depth < settings.split_depth, pixel, sample, vertex_dimension(depth, 0), settings.seed};
     const bool go_on = std::visit(
-        [&](const auto& material) {
+        [&](const auto& material) __attribute__((always_inline)) {
           const Scatter sc = scatter(material, ShadingPoint{wo, s.ng, s.ns, s.uv}, ctx);
           if (sc.kind == Scatter::Kind::Diffuse) {
-            radiance += throughput * direct_lighting(scene, s, ng, ns, sc.f, depth, pixel, sample, settings);
+            // f by value: a reference into sc would make the whole answer (its glossy lobe and
+            // specular branches, dead here) live in memory across the call.
+            const Vec3 f = sc.f;
+            radiance += throughput * direct_lighting(scene, s, ng, ns, f, depth, pixel, sample, settings);
             return false;
           }
           if (sc.kind == Scatter::Kind::Glossy) {
             if (sc.f != Vec3(0.0f))
               radiance += throughput * direct_lighting(scene, s, ng, ns, sc.f, depth, pixel, sample, settings);
             const Vec3 origin = offset_ray_origin(s.p, ng);
-            const GlossyStep g = glossy_vertex(scene, s.p, origin, ng, sc.glossy, pixel, sample,
-                                               vertex_dimension(depth, 1), vertex_dimension(depth, kDimsPerVertex - 5),
-                                               settings);
+            const GlossyStep g =
+                glossy_vertex(scene, s.p, origin, ng, sc.glossy, pixel, sample, vertex_dimension(depth, 1),
+                              vertex_dimension(depth, kDimsPerVertex - 5), settings);
             radiance += throughput * g.radiance;
             if (!(g.pdf > 0.0f)) return false;
             throughput *= g.weight;
