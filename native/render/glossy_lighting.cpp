@@ -35,9 +35,9 @@ Vec3 glossy_direct_lighting(const Scene& scene, const Vec3& p, const Vec3& origi
   return sum;
 }
 
-GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng,
-                         const GlossyLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t light_dim,
-                         uint32_t lobe_dim, const IntegratorSettings& settings) {
+GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng, const GlossyLobe& lobe,
+                         uint32_t pixel, uint32_t sample, uint32_t light_dim, uint32_t lobe_dim,
+                         const IntegratorSettings& settings) {
   GlossyStep step;
   step.radiance = glossy_direct_lighting(scene, p, origin, ng, lobe, pixel, sample, light_dim, settings);
   const BsdfSample g = sample_lobe(lobe, sobol_owen_2d(pixel, sample, lobe_dim, settings.seed));
