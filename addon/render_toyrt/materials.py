@@ -397,8 +397,9 @@ def _metal(name, node, notes):
     aniso = input_socket(node, "Anisotropic")
     if aniso is not None and (aniso.is_linked or aniso.default_value > 0.0):
         extras.append("anisotropy")
-    if getattr(node, "distribution", "GGX") != "GGX":
-        extras.append(f"{node.distribution} (single-scatter GGX)")
+    distribution = getattr(node, "distribution", "GGX")
+    if distribution != "GGX":   # 4.x/5.x default to Multiscatter GGX
+        extras.append("multiscatter GGX" if distribution == "MULTI_GGX" else f"{distribution.title()} distribution")
     notes.append(f"material '{name}': Principled metal without {', '.join(extras)} (glossy of its base colour)")
     spec = _glossy_spec(name, None, input_socket(node, "Roughness"), notes)
     if base is not None:
