@@ -52,8 +52,43 @@ Flat flatten(const std::vector<Ray>& rays) {
 struct Row {
   std::string mesh, rays, threads;
   size_t count;
-  double toyrt_ms, embree_ms;
+  double toyrt_ms, embree_ms, ratio;  // medians of interleaved runs; ratio: the median of Embree's / TOYRT's time
 };
+
+// Two operations timed in alternation, `runs` times each: the median of each one's times and the
+// median of the per-run ratios b / a (a ratio from the same moment of a shared machine).
+struct Timing {
+  double a_ms, b_ms, ratio;
+};
+double ms_of(const std::function<void()>& f) {
+  const auto start = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+Timing interleaved(int runs, const std::function<void()>& a, const std::function<void()>& b) {
+  a();  // warm: first-touch page faults, the thread pool, each engine's first build
+  b();
+  std::vector<double> as, bs, ratios;
+  for (int i = 0; i < runs; ++i) {
+    as.push_back(ms_of(a));
+    bs.push_back(ms_of(b));
+    ratios.push_back(bs.back() / as.back());
+  }
+  return {median(as), median(bs), median(ratios)};
+}
+
+std::string triangles_label(size_t n) {
+  char s[32];
+  if (n >= 1000000)
+    std::snprintf(s, sizeof s, "%.1fM", n / 1e6);
+  else
+    std::snprintf(s, sizeof s, "%zuK", (n + 500) / 1000);
+  return s;
+}
 
 }  // namespace
 
@@ -69,80 +104,116 @@ int main(int argc, char** argv) {
   struct Case {
     std::string name;
     MeshData mesh;
+    bool room = false;  // inside a closed room, lit from outside it: every shadow ray is blocked
   };
   std::vector<Case> cases;
-  cases.push_back({"bumpy sphere, 1.0M triangles", uv_sphere(708, 708, 1.0f, 0.15f)});
-  cases.push_back({"triangle soup, 200K triangles", triangle_soup(200000, 0.02f, 1)});
+  for (int rings : sphere_rings(quick)) {
+    if (rings == 224) continue;  // 10K, 1M, 4M (quick: 10K)
+    char name[64];
+    std::snprintf(name, sizeof name, "bumpy sphere, %s triangles",
+                  triangles_label(2 * size_t(rings) * (rings - 1)).c_str());
+    cases.push_back({name, uv_sphere(rings, rings, 1.0f, 0.15f)});
+  }
+  cases.push_back({"triangle soup, 200K triangles", triangle_soup(quick ? 20000 : 200000, 0.02f, 1)});
+  if (quick) cases.back().name = "triangle soup, 20K triangles";
+  cases.push_back({quick ? "bumpy sphere, 100K, in a closed room" : "bumpy sphere, 1.0M, in a closed room",
+                   uv_sphere(quick ? 224 : 708, quick ? 224 : 708, 1.0f, 0.15f), true});
 
   std::ostringstream md, builds;
   std::vector<Row> rows;
   builds << "| mesh | threads | TOYRT build ms | Embree build ms | TOYRT / Embree (time) |\n|---|---|---|---|---|\n";
   for (const Case& c : cases) {
     std::fprintf(stderr, "%s\n", c.name.c_str());
-    // Builds, each thread count.
+    const MeshData traced = c.room ? in_closed_room(c.mesh, 0.5f) : c.mesh;
+    // Builds, each thread count (warm: each engine's first build in the process is not timed).
     for (int threads : {1, all}) {
-      const double mine = best_ms(std::max(1, runs / 2), [&] {
+      if (c.room) break;
+      const auto mine = [&] {
         Scene s;
-        s.add_instance(s.add_mesh(c.mesh.vertices, c.mesh.triangles), Mat4(1.0f));
+        s.add_instance(s.add_mesh(traced.vertices, traced.triangles), Mat4(1.0f));
         CommitOptions opt;
         opt.builder = BuilderKind::Sah;
         opt.threads = threads;
         s.commit(opt);
-      });
-      const double theirs =
-          best_ms(std::max(1, runs / 2), [&] { EmbreeScene e(c.mesh.vertices, c.mesh.triangles, false, threads); });
+      };
+      const auto theirs = [&] { EmbreeScene e(traced.vertices, traced.triangles, false, threads); };
+      const Timing t = interleaved(std::max(3, runs / 2), mine, theirs);
       char line[256];
-      std::snprintf(line, sizeof line, "| %s | %d | %.0f | %.0f | %.2f |\n", c.name.c_str(), threads, mine, theirs,
-                    mine / theirs);
+      std::snprintf(line, sizeof line, "| %s | %d | %.0f | %.0f | %.2f |\n", c.name.c_str(), threads, t.a_ms, t.b_ms,
+                    t.a_ms / t.b_ms);
       builds << line;
     }
     Scene scene;
-    scene.add_instance(scene.add_mesh(c.mesh.vertices, c.mesh.triangles), Mat4(1.0f));
+    scene.add_instance(scene.add_mesh(traced.vertices, traced.triangles), Mat4(1.0f));
     scene.commit();
-    const EmbreeScene embree(c.mesh.vertices, c.mesh.triangles);
+    const EmbreeScene embree(traced.vertices, traced.triangles);
 
-    const std::vector<Ray> primary = primary_rays(bounds_of(c.mesh), width, height);
-    std::vector<Hit> hits(primary.size());
-    for (size_t i = 0; i < primary.size(); ++i) hits[i] = embree.intersect(primary[i]);
+    // Camera rays that hit (a frame around the bounds misses in its corners; those rays cost
+    // little in either engine and say nothing about traversal), and the surface points they find.
+    const EmbreeScene bare(c.mesh.vertices, c.mesh.triangles);
+    std::vector<Ray> primary;
+    std::vector<Hit> hits;
+    for (const Ray& r : primary_rays(bounds_of(c.mesh), width, height)) {
+      const Hit h = bare.intersect(r);
+      if (!h.found()) continue;
+      primary.push_back(r);
+      hits.push_back(h);
+    }
     const BBox box = bounds_of(c.mesh);
-    const Vec3 light = box.center() + glm::length(box.extent()) * Vec3(-0.4f, -0.9f, 1.3f);
-    const std::vector<std::pair<std::string, std::vector<Ray>>> sets = {
-        {"primary", primary},
-        {"diffuse", diffuse_rays(c.mesh, primary, hits, 17)},
-        {"shadow", shadow_rays(c.mesh, primary, hits, light)}};
+    // A light outside the room (3 extents away), or beside the mesh, lighting part of it.
+    const Vec3 light = box.center() + glm::length(box.extent()) * (c.room ? 3.0f : 1.0f) * Vec3(-0.4f, -0.9f, 1.3f);
+    std::vector<Ray> blocked_rays, open_rays;
+    for (const Ray& r : shadow_rays(c.mesh, primary, hits, light))
+      (embree.occluded(r) ? blocked_rays : open_rays).push_back(r);
+    std::vector<std::pair<std::string, std::vector<Ray>>> sets;
+    if (!c.room) {
+      sets.push_back({"primary", primary});
+      sets.push_back({"diffuse", diffuse_rays(c.mesh, primary, hits, 17)});
+      sets.push_back({"shadow, unoccluded", open_rays});
+    }
+    sets.push_back({c.room ? "shadow, occluded by a wall" : "shadow, occluded", blocked_rays});
 
     for (const auto& [kind, rays] : sets) {
+      if (rays.empty()) continue;
       const Flat f = flatten(rays);
-      const bool shadow = kind == "shadow";
+      const bool shadow = kind.rfind("shadow", 0) == 0;
       const float tnear = 0.0f;
       const RayBatch batch{f.org.data(), f.dir.data(), &tnear, 0, f.tfar.data(), 1, f.count};
       std::vector<float> t(f.count), u(f.count), v(f.count);
       std::vector<int32_t> prim(f.count), inst(f.count);
       std::vector<uint8_t> blocked(f.count);
       for (int threads : {1, all}) {
-        const double mine = best_ms(runs, [&] {
+        const auto mine = [&] {
           if (shadow)
             scene.occluded(batch, blocked.data(), threads);
           else
             scene.intersect(batch, {t.data(), u.data(), v.data(), prim.data(), inst.data()}, threads);
-        });
-        // Embree through the same harness: TBB tasks of 256 rays, single-ray queries.
-        const double theirs = best_ms(runs, [&] {
+        };
+        // Embree through the same harness: TBB tasks of 256 rays, single-ray queries, writing
+        // the same fields (t, prim, instance, u, v) as TOYRT's batch.
+        const auto theirs = [&] {
           run_with_threads(threads, [&] {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 256),
                               [&](const tbb::blocked_range<size_t>& r) {
                                 for (size_t i = r.begin(); i != r.end(); ++i) {
-                                  if (shadow)
+                                  if (shadow) {
                                     blocked[i] = embree.occluded(rays[i]);
-                                  else
-                                    t[i] = embree.intersect(rays[i]).t;
+                                  } else {
+                                    const Hit h = embree.intersect(rays[i]);
+                                    t[i] = h.t;
+                                    u[i] = h.u;
+                                    v[i] = h.v;
+                                    prim[i] = h.prim;
+                                    inst[i] = h.instance;
+                                  }
                                 }
                               });
           });
-        });
-        rows.push_back({c.name, kind, std::to_string(threads), rays.size(), mine, theirs});
-        std::fprintf(stderr, "  %-8s %d thread(s): TOYRT %.1f Mrays/s, Embree %.1f Mrays/s\n", kind.c_str(), threads,
-                     rays.size() / mine / 1e3, rays.size() / theirs / 1e3);
+        };
+        const Timing tm = interleaved(runs, mine, theirs);
+        rows.push_back({c.name, kind, std::to_string(threads), rays.size(), tm.a_ms, tm.b_ms, tm.ratio});
+        std::fprintf(stderr, "  %-28s %d thread(s): TOYRT %.2f Mrays/s, Embree %.2f Mrays/s, %.2fx\n", kind.c_str(),
+                     threads, rays.size() / tm.a_ms / 1e3, rays.size() / tm.b_ms / 1e3, tm.ratio);
       }
     }
   }
@@ -152,18 +223,23 @@ int main(int argc, char** argv) {
   std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
   md << "# Trace benchmark: TOYRT against Embree " << RTC_VERSION_STRING << "\n\n"
      << "Written by `make bench-trace` (`build/bench/bench_trace`) on " << date << ": " << cpu_model() << ", " << all
-     << " hardware threads. Best of " << runs << " runs for tracing, each engine in the same process on the "
-     << "same rays; Embree 3 with its default scene flags and build quality, single-ray queries "
-     << "(`rtcIntersect1`/`rtcOccluded1`) through the same TBB harness as TOYRT's batch API. Rays: a " << width << "x"
-     << height << " pinhole camera (primary), one cosine-distributed bounce from each primary hit "
-     << "(diffuse), and one ray from each primary hit to a point light (shadow, any-hit query).\n\n"
+     << " hardware threads. Each engine in the same process on the same rays, timed in alternation (" << runs
+     << " runs each after a warm-up run): medians of the times, and the median of the per-run ratios, so both "
+     << "engines see the same moments of a shared machine. Embree 3 with its default scene flags and build quality, "
+     << "single-ray queries (`rtcIntersect1`/`rtcOccluded1`) through the same TBB harness as TOYRT's batch API, "
+     << "both writing t, prim, instance, u, v. Rays: the " << width << "x" << height
+     << " pinhole camera's rays that hit the mesh (primary), one cosine-distributed bounce from each primary hit "
+     << "(diffuse), and one ray from each primary hit to a point light (any-hit queries), split by Embree's answer "
+     << "into the rays the mesh blocks (shadow, occluded) and those that reach the light (shadow, unoccluded). The "
+     << "closed room: the 1.0M-triangle sphere inside a box room of 12 triangles, the light outside the room, so a "
+     << "wall blocks every shadow ray (its builds are not timed). TOYRT / Embree > 1: TOYRT is faster.\n\n"
      << "## Tracing\n\n| mesh | rays | threads | count | TOYRT Mrays/s | Embree Mrays/s | TOYRT / Embree |\n"
      << "|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
     char line[512];
     std::snprintf(line, sizeof line, "| %s | %s | %s | %zu | %.2f | %.2f | **%.2f** |\n", r.mesh.c_str(),
                   r.rays.c_str(), r.threads.c_str(), r.count, r.count / r.toyrt_ms / 1e3, r.count / r.embree_ms / 1e3,
-                  r.embree_ms / r.toyrt_ms);
+                  r.ratio);
     md << line;
   }
   md << "\n## Building\n\n" << builds.str();

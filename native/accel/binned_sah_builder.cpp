@@ -72,39 +72,59 @@ class Builder {
                                 });
   }
 
-  int bin_of(const Vec3& c, int axis, const BBox& centers, const Vec3& scale) const {
+  // Bins for a range of n primitives: the configured count for large ranges, fewer for small
+  // ones, where sweeping 3 x bins planes would cost more than the primitives they sort (a
+  // range of 16 has at most 15 distinct planes per axis anyway).
+  int bins_for(size_t n) const { return int(std::clamp<size_t>(n / 2, 4, size_t(cfg_.bins))); }
+
+  int bin_of(const Vec3& c, int axis, const BBox& centers, const Vec3& scale, int bins) const {
     // Clamped before the cast: centroids spanning more than FLT_MAX give inf * 0 = NaN here, and
     // a denormal extent an infinite scale; converting either to int is undefined (found by the
     // fuzzer, tests/fuzz). Such ranges all land in bin 0 and are split at the median.
     const float k = (c[axis] - centers.lo[axis]) * scale[axis];
-    return k >= 1.0f ? int(std::min(k, float(cfg_.bins - 1))) : 0;
+    return k >= 1.0f ? int(std::min(k, float(bins - 1))) : 0;
   }
 
-  Vec3 bin_scale(const BBox& centers) const {
+  Vec3 bin_scale(const BBox& centers, int bins) const {
     const Vec3 e = centers.extent();
     // (1 - eps) keeps the largest centroid in the last bin rather than one past it.
-    const float s = float(cfg_.bins) * (1.0f - 1e-6f);
+    const float s = float(bins) * (1.0f - 1e-6f);
     return {e.x > 0 ? s / e.x : 0.0f, e.y > 0 ? s / e.y : 0.0f, e.z > 0 ? s / e.z : 0.0f};
   }
 
-  Bins bin_range(size_t begin, size_t end, const BBox& centers, const Vec3& scale) const {
-    auto accumulate = [&](const tbb::blocked_range<size_t>& r, Bins bins) {
+  // Bins the range into `out`. Small ranges bin serially into `out` as it is, clearing only the
+  // bins they use (a whole Bins is 4.6 KB, and clearing it per node cost more than binning the
+  // small ranges near the leaves); large ones reduce fresh Bins in parallel.
+  void bin_range(size_t begin, size_t end, const BBox& centers, const Vec3& scale, int bins_used, Bins& out) const {
+    auto accumulate = [&](const tbb::blocked_range<size_t>& r, Bins& bins) {
       for (size_t i = r.begin(); i != r.end(); ++i) {
         const uint32_t p = ids_[i];
         for (int a = 0; a < 3; ++a) {
-          const int k = a * kMaxBins + bin_of(centers_[p], a, centers, scale);
+          const int k = a * kMaxBins + bin_of(centers_[p], a, centers, scale, bins_used);
           bins.box[k].extend(bounds_[p]);
           ++bins.count[k];
         }
       }
-      return bins;
     };
-    if (end - begin < cfg_.parallel_threshold) return accumulate({begin, end}, Bins{});
-    return tbb::parallel_reduce(tbb::blocked_range<size_t>(begin, end, 4096), Bins{}, accumulate,
-                                [&](Bins a, const Bins& b) {
-                                  a.merge(b, kMaxBins);
-                                  return a;
-                                });
+    if (end - begin < cfg_.parallel_threshold) {
+      for (int a = 0; a < 3; ++a)
+        for (int i = 0; i < bins_used; ++i) {
+          out.box[a * kMaxBins + i] = BBox{};
+          out.count[a * kMaxBins + i] = 0;
+        }
+      accumulate({begin, end}, out);
+      return;
+    }
+    out = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(begin, end, 4096), Bins{},
+        [&](const tbb::blocked_range<size_t>& r, Bins bins) {
+          accumulate(r, bins);
+          return bins;
+        },
+        [&](Bins a, const Bins& b) {
+          a.merge(b, kMaxBins);
+          return a;
+        });
   }
 
   struct Split {
@@ -113,7 +133,7 @@ class Builder {
     float cost = kInfinity;
   };
 
-  Split find_split(const Bins& bins, const BBox& box, size_t n) const {
+  Split find_split(const Bins& bins, const BBox& box, size_t n, int bins_used) const {
     Split best;
     const float inv_area = 1.0f / std::max(box.half_area(), 1e-30f);
     std::array<float, kMaxBins> right_cost;
@@ -121,14 +141,14 @@ class Builder {
       const int base = a * kMaxBins;
       BBox acc;
       uint32_t cnt = 0;
-      for (int i = cfg_.bins - 1; i > 0; --i) {  // right side holds bins i .. bins-1
+      for (int i = bins_used - 1; i > 0; --i) {  // right side holds bins i .. bins-1
         acc.extend(bins.box[base + i]);
         cnt += bins.count[base + i];
         right_cost[i] = cnt ? acc.half_area() * float(cnt) : kInfinity;
       }
       acc = BBox{};
       cnt = 0;
-      for (int i = 0; i < cfg_.bins - 1; ++i) {  // left side holds bins 0 .. i
+      for (int i = 0; i < bins_used - 1; ++i) {  // left side holds bins 0 .. i
         acc.extend(bins.box[base + i]);
         cnt += bins.count[base + i];
         if (cnt == 0 || cnt == n) continue;
@@ -151,19 +171,27 @@ class Builder {
     if (cfg_.cancel && cfg_.cancel->load(std::memory_order_relaxed)) throw BuildCancelled();
     nodes_[node].set_bbox(rb.box);
     const size_t n = end - begin;
-    if (n == 1) return make_leaf(node, begin, end);
+    if (n == 1 || n <= std::min(cfg_.leaf_without_search, cfg_.max_leaf)) return make_leaf(node, begin, end);
 
     size_t mid = begin;
     const Vec3 extent = rb.centers.extent();
     const bool coincident = extent.x <= 0 && extent.y <= 0 && extent.z <= 0;
     Split split;
     if (!coincident && depth < kMedianSplitDepth) {
-      const Vec3 scale = bin_scale(rb.centers);
-      split = find_split(bin_range(begin, end, rb.centers, scale), rb.box, n);
+      const int bins = bins_for(n);
+      const Vec3 scale = bin_scale(rb.centers, bins);
+      // One scratch Bins per thread: a node's binning and split search finish before its
+      // children are built, and a task this thread runs while waiting inside the parallel
+      // reduction finishes before the reduction's result is written here.
+      thread_local Bins scratch;
+      bin_range(begin, end, rb.centers, scale, bins, scratch);
+      split = find_split(scratch, rb.box, n, bins);
       const float leaf_cost = cfg_.intersection_cost * float(n);
       if (n <= cfg_.max_leaf && leaf_cost <= split.cost) return make_leaf(node, begin, end);
       if (split.axis >= 0) {
-        auto left_of = [&](uint32_t p) { return bin_of(centers_[p], split.axis, rb.centers, scale) <= split.bin; };
+        auto left_of = [&](uint32_t p) {
+          return bin_of(centers_[p], split.axis, rb.centers, scale, bins) <= split.bin;
+        };
         mid = size_t(std::partition(ids_.begin() + begin, ids_.begin() + end, left_of) - ids_.begin());
       }
     } else if (n <= cfg_.max_leaf) {

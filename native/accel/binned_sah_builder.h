@@ -13,7 +13,11 @@ namespace toyrt {
 struct BinnedSahConfig {
   int bins = 32;          // candidate split planes per axis are bins - 1
   uint32_t max_leaf = 8;  // ranges larger than this are always split
-  // Cost of one node visit relative to one primitive test. 3: leaves are tested four triangles
+  // Ranges of at most this many primitives become a leaf with no split search. A mesh sets its
+  // block width: tracing tests up to that many triangles in one block, and collapse() makes any
+  // subtree that small one leaf, so a split below it is work thrown away. 0: always search.
+  uint32_t leaf_without_search = 0;
+  // Cost of one node visit relative to one primitive test. 3: leaves are tested eight triangles
   // at a time (triangle_block.h), which makes a triangle cheap next to a node's cache misses;
   // measured on the 1M-triangle benchmark mesh, 3 beat 1 by 15-20 % and 6 by 5-10 %.
   float traversal_cost = 3.0f;

@@ -2,7 +2,7 @@
 // sorted codes, boxes filled in bottom up. The OpenCL build runs kernels/lbvh.cl (on PoCL here);
 // the reference build runs the same algorithm on the CPU, with the same float operations, so the
 // two agree node for node. Both end in the same binary Bvh the SAH builder makes (leaves of one
-// primitive; collapse() gathers them into 4-triangle leaves for tracing).
+// primitive; collapse() gathers them into leaves of up to 8 triangles, one block, for tracing).
 #pragma once
 
 #include "accel/bvh.h"

@@ -33,6 +33,12 @@ inline uint32_t mask_of(V lanes) {
   constexpr int n = int(sizeof(V) / sizeof(int32_t));
 #if defined(__AVX__)
   if constexpr (n == 8) return uint32_t(_mm256_movemask_ps(reinterpret_cast<__m256>(lanes)));
+#elif defined(__SSE__)
+  if constexpr (n == 8) {  // two SSE halves
+    __m128 half[2];
+    std::memcpy(half, &lanes, sizeof half);
+    return uint32_t(_mm_movemask_ps(half[0])) | uint32_t(_mm_movemask_ps(half[1])) << 4;
+  }
 #endif
 #if defined(__SSE__)
   if constexpr (n == 4) return uint32_t(_mm_movemask_ps(reinterpret_cast<__m128>(lanes)));
@@ -80,12 +86,15 @@ inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear
       tmax = min_keep(tmax, splat(tfar));
       uint32_t mask = mask_of(tmin <= tmax);
       if (mask != 0 && AnyHit) {
-        // Any hit ends the walk, so order matters little: no sort, visit the first child hit.
-        // Entry tnear, never popped as "beyond tfar" (an entry of 0 was, for segments ending
-        // before 0: occluded() missed what intersect() found; found by tests/fuzz).
-        current = Entry{n.child[__builtin_ctz(mask)], n.count[__builtin_ctz(mask)], tnear};
-        for (mask &= mask - 1; mask; mask &= mask - 1) {
-          const int i = __builtin_ctz(mask);
+        // Any hit ends the walk: no distance sort, the children hit in slot order, which
+        // collapse() makes decreasing box area (the likeliest blockers first): the first now,
+        // the rest stacked so that the next largest pops next. Entry tnear, never popped as
+        // "beyond tfar" (an entry of 0 was, for segments ending before 0: occluded() missed what
+        // intersect() found; found by tests/fuzz).
+        const int first = __builtin_ctz(mask);
+        current = Entry{n.child[first], n.count[first], tnear};
+        for (mask &= mask - 1; mask; mask &= ~(1u << (31 - __builtin_clz(mask)))) {
+          const int i = 31 - __builtin_clz(mask);
           stack[sp++] = Entry{n.child[i], n.count[i], tnear};
           if (n.count[i] == 0) __builtin_prefetch(&bvh.nodes[n.child[i]]);
         }

@@ -53,7 +53,7 @@ class Mesh {
   std::vector<Triangle> triangles_;
   Bvh bvh_;
   WideBvh wide_;  // bvh_ collapsed for tracing
-  // The leaves' triangles in blocks of four, in traversal order: a wide leaf child's `child`
+  // The leaves' triangles in blocks of eight, in traversal order: a wide leaf child's `child`
   // is its first block, its `count` the number of triangles (blocks = count rounded up to 4).
   std::vector<TriangleBlock> blocks_;
   BBox bounds_;

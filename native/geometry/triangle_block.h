@@ -1,4 +1,4 @@
-// Leaf storage for tracing: triangles in blocks of four, coordinates side by side, so the
+// Leaf storage for tracing: triangles in blocks of eight, coordinates side by side, so the
 // watertight test of triangle.h runs on a whole block with one set of SIMD instructions. Each lane
 // evaluates exactly the scalar test's expressions (the build disables FMA contraction), so the
 // block test is as watertight as the scalar one; the rare lanes that need the scalar test's
@@ -12,20 +12,23 @@
 
 namespace toyrt {
 
-inline constexpr int kBlockWidth = 4;
+// Eight lanes: one AVX register per coordinate row, so a leaf of five to eight triangles (the
+// SAH builder's leaves hold up to eight) costs one block test instead of two blocks of four;
+// where AVX is absent (x86-64-v2) each row is two SSE registers.
+inline constexpr int kBlockWidth = 8;
 inline constexpr uint32_t kNoTriangle = 0xFFFFFFFFu;
 
-struct alignas(16) TriangleBlock {
+struct alignas(32) TriangleBlock {
   float p[3][3][kBlockWidth];  // [vertex][axis][lane]
   uint32_t prim[kBlockWidth];  // triangle index in the mesh; kNoTriangle for an unused lane
 
   Vec3 vertex(int lane, int k) const { return {p[k][0][lane], p[k][1][lane], p[k][2][lane]}; }
 };
-static_assert(sizeof(TriangleBlock) == 160, "TriangleBlock: 9 coordinate rows and the ids");
+static_assert(sizeof(TriangleBlock) == 320, "TriangleBlock: 9 coordinate rows and the ids");
 
-namespace simd4 {
-using vfloat = float __attribute__((vector_size(16)));
-using vint = int32_t __attribute__((vector_size(16)));
+namespace simdb {  // vectors of one lane per triangle of a block
+using vfloat = float __attribute__((vector_size(kBlockWidth * sizeof(float))));
+using vint = int32_t __attribute__((vector_size(kBlockWidth * sizeof(float))));
 inline vfloat load(const float* p) {
   vfloat v;
   std::memcpy(&v, p, sizeof v);
@@ -40,8 +43,13 @@ inline vfloat abs(vfloat x) {
   return x;
 }
 inline vfloat max(vfloat a, vfloat b) { return a > b ? a : b; }
+inline vint bits_of(vfloat x) {
+  vint bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  return bits;
+}
 using simd::mask_of;
-}  // namespace simd4
+}  // namespace simdb
 
 // Tests the block's triangles against [tnear, tfar). For each lane hit, hit(lane, t) is called
 // (nearest lanes are not sorted; the caller keeps the minimum); with AnyHit the first ends it.
@@ -49,16 +57,15 @@ using simd::mask_of;
 template <bool AnyHit, class OnHit>
 [[gnu::always_inline]] inline bool intersect_block(const WatertightRay& r, const TriangleBlock& b, float tnear,
                                                    float tfar, OnHit&& hit) {
-  using namespace simd4;
+  using namespace simdb;
   const vfloat ox = splat(r.org[r.kx]), oy = splat(r.org[r.ky]), oz = splat(r.org[r.kz]);
   const vfloat sx = splat(r.sx), sy = splat(r.sy), sz = splat(r.sz);
   // Translated and sheared vertices, exactly as intersect_triangle computes them.
-  vfloat x[3], y[3], z[3];
+  vfloat x[3], y[3], vz[3];
   for (int k = 0; k < 3; ++k) {
-    const vfloat vz = load(b.p[k][r.kz]) - oz;
-    x[k] = (load(b.p[k][r.kx]) - ox) - sx * vz;
-    y[k] = (load(b.p[k][r.ky]) - oy) - sy * vz;
-    z[k] = sz * vz;
+    vz[k] = load(b.p[k][r.kz]) - oz;
+    x[k] = (load(b.p[k][r.kx]) - ox) - sx * vz[k];
+    y[k] = (load(b.p[k][r.ky]) - oy) - sy * vz[k];
   }
   const vfloat eu = x[2] * y[1] - y[2] * x[1];
   const vfloat ev = x[0] * y[2] - y[0] * x[2];
@@ -68,14 +75,22 @@ template <bool AnyHit, class OnHit>
   std::memcpy(&used, b.prim, sizeof used);
   used = used != vint{} - 1;  // lanes holding a triangle
   const vint exact_zero = (eu == zero) | (ev == zero) | (ew == zero);
-  const vint mixed = ((eu < zero) | (ev < zero) | (ew < zero)) & ((eu > zero) | (ev > zero) | (ew > zero));
+  // Edge functions of both signs: the ray passes outside. By sign bits (some negative and not
+  // all), which is the comparison's answer on every lane without an exact zero; those lanes go
+  // to the scalar test whatever `mixed` says.
+  const vint su = bits_of(eu), sv = bits_of(ev), sw = bits_of(ew);
+  const vint mixed = ((su | sv | sw) & ~(su & sv & sw)) < vint{};
+  // Most blocks a ray reaches it misses on every lane: stop before the depth and distance.
+  if (!mask_of(used & (~mixed | exact_zero))) return false;
+  vfloat z[3];
+  for (int k = 0; k < 3; ++k) z[k] = sz * vz[k];
   const vfloat det = eu + ev + ew;
   const vfloat scaled_t = eu * z[0] + ev * z[1] + ew * z[2];
   const vfloat abs_det = abs(det);
   const vfloat signed_t = det < zero ? -scaled_t : scaled_t;
   const vint in_range = (det != zero) & (signed_t < splat(tfar) * abs_det);
   const vint candidate = used & ~mixed & in_range;
-  // Most blocks a ray reaches it misses entirely: stop before the error bound.
+  // Or misses by distance: stop before the error bound.
   if (!mask_of(candidate | (used & exact_zero))) return false;
 
   // near_start_error of triangle.h, lane-wise.

@@ -138,3 +138,49 @@ TEST(Bvh, TraversalAgreesExactlyWithTestingEveryTriangle) {
     }
   }
 }
+
+// The any-hit walk visits a node's children in slot order, so collapse() stores them by
+// decreasing box area (the likeliest blockers first), with the empty slots last.
+TEST(WideBvh, ChildrenAreStoredByDecreasingArea) {
+  const Mesh mesh = built(in_closed_room(uv_sphere(60, 60, 1.0f, 0.15f), 0.5f));
+  const WideBvh& wide = mesh.wide_bvh();
+  ASSERT_FALSE(wide.nodes.empty());
+  for (const WideNode& n : wide.nodes) {
+    float previous = kInfinity;
+    for (int i = 0; i < kWidth; ++i) {
+      BBox b;
+      b.lo = {n.bounds[0][i], n.bounds[1][i], n.bounds[2][i]};
+      b.hi = {n.bounds[3][i], n.bounds[4][i], n.bounds[5][i]};
+      const float area = b.lo.x <= b.hi.x ? b.half_area() : -1.0f;  // an empty slot: below any box
+      EXPECT_LE(area, previous);
+      previous = area;
+    }
+  }
+}
+
+// A shadow ray from the model to a light outside the room is blocked (by a wall or the model),
+// and the any-hit walk agrees with the closest hit on every ray, whichever child it visits first.
+TEST(WideBvh, AnyHitAgreesWithClosestHitInAClosedRoom) {
+  const MeshData sphere = uv_sphere(40, 40, 1.0f, 0.15f);
+  const MeshData room = in_closed_room(sphere, 0.5f);
+  const Mesh mesh = built(room);
+  const std::vector<Ray> camera = primary_rays(bounds_of(sphere), 48, 36);
+  std::vector<Ray> aimed;
+  std::vector<Hit> hits;
+  const Mesh bare = built(sphere);
+  for (const Ray& r : camera) {
+    Hit h;
+    float tfar = r.tfar;
+    if (bare.intersect(r.org, r.dir, r.tnear, tfar, h.u, h.v, h.prim)) h.t = tfar;
+    aimed.push_back(r);
+    hits.push_back(h);
+  }
+  const std::vector<Ray> shadows = shadow_rays(sphere, aimed, hits, Vec3(-4.0f, -9.0f, 13.0f));
+  ASSERT_GT(shadows.size(), 100u);
+  for (const Ray& r : shadows) {
+    float tfar = r.tfar, u, v;
+    int32_t prim = -1;
+    EXPECT_TRUE(mesh.intersect(r.org, r.dir, r.tnear, tfar, u, v, prim));
+    EXPECT_TRUE(mesh.occluded(r.org, r.dir, r.tnear, r.tfar));
+  }
+}

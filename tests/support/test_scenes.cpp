@@ -98,6 +98,21 @@ BBox bounds_of(const MeshData& mesh) {
   return b;
 }
 
+MeshData in_closed_room(const MeshData& mesh, float margin) {
+  const BBox b = bounds_of(mesh);
+  const Vec3 lo = b.lo - margin * b.extent(), hi = b.hi + margin * b.extent();
+  MeshData m = mesh;
+  const uint32_t base = uint32_t(m.vertices.size());
+  for (int i = 0; i < 8; ++i) m.vertices.push_back({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
+  // The six faces as corner quadruples (bit 0 = x, 1 = y, 2 = z), two triangles each.
+  const uint32_t faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces) {
+    m.triangles.push_back({base + f[0], base + f[1], base + f[2]});
+    m.triangles.push_back({base + f[0], base + f[2], base + f[3]});
+  }
+  return m;
+}
+
 PrimitiveBounds triangle_bounds(const MeshData& mesh) {
   PrimitiveBounds p;
   for (const Triangle& t : mesh.triangles) {

@@ -29,6 +29,10 @@ MeshData slivers(size_t count, uint64_t seed);
 // The mesh scaled by `scale` about the origin, then moved by `offset`.
 MeshData transformed(const MeshData& mesh, float scale, const Vec3& offset);
 BBox bounds_of(const MeshData& mesh);
+// The mesh inside a closed box room (12 large triangles, facing inwards) `margin` times the
+// mesh's extent on each side: the scene where a shadow ray leaving towards a light outside is
+// blocked by a wall, whatever the dense mesh does.
+MeshData in_closed_room(const MeshData& mesh, float margin);
 // Each triangle's box and the box's centre: what the builders take.
 struct PrimitiveBounds {
   std::vector<BBox> boxes;
