@@ -275,7 +275,9 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     // One generic dispatch per hit, no per-type code: the lambda is instantiated per material
     // type, so for an inline scatter() (Lambert's) the compiler sees the answer's kind as a
     // constant and keeps only the diffuse path, as fast as a hand-written case. It returns
-    // whether the path goes on along `ray`.
+    // whether the path goes on along `ray`. Always inlined: with the glossy cases GCC made the
+    // lambda a function of its own, and the Lambert path paid for the call (cachegrind,
+    // docs/render.md "A scene pays for what it uses").
     const MaterialContext ctx{
         &scene.textures(), depth < settings.split_depth, pixel, sample, vertex_dimension(depth, 0), settings.seed};
     const bool go_on = std::visit(
