@@ -86,6 +86,44 @@ def glass(name, ior=1.5):
     return mat
 
 
+def glossy(name, color, roughness, distribution="GGX"):
+    """A Glossy BSDF (4.0+: the node is ShaderNodeBsdfAnisotropic, anisotropy 0), GGX by default:
+    what TOYRT's glossy material renders (4.x/5.x default to Multiscatter GGX, which it does not)."""
+    mat, bsdf = surface(name, "ShaderNodeBsdfGlossy")
+    bsdf.distribution = distribution
+    bsdf.inputs["Color"].default_value = (*color, 1.0)
+    bsdf.inputs["Roughness"].default_value = roughness
+    return mat
+
+
+def diffuse_and_glossy(name, diffuse_color, glossy_color, roughness, fac=None):
+    """A Mix Shader (factor fac) or, with fac None, an Add Shader of a Diffuse BSDF and a GGX
+    Glossy BSDF (TOYRT: its 'diffuse_glossy' material)."""
+    mat, mix = surface(name, "ShaderNodeAddShader" if fac is None else "ShaderNodeMixShader")
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    first = 0 if fac is None else 1
+    if fac is not None:
+        mix.inputs[0].default_value = fac
+    d = nodes.new("ShaderNodeBsdfDiffuse")
+    d.inputs["Color"].default_value = (*diffuse_color, 1.0)
+    g = nodes.new("ShaderNodeBsdfGlossy")
+    g.distribution = "GGX"
+    g.inputs["Color"].default_value = (*glossy_color, 1.0)
+    g.inputs["Roughness"].default_value = roughness
+    links.new(d.outputs[0], mix.inputs[first])
+    links.new(g.outputs[0], mix.inputs[first + 1])
+    return mat
+
+
+def metal(name, color, roughness):
+    """A Principled BSDF with Metallic 1 (TOYRT: a glossy of its base colour, noted)."""
+    mat, bsdf = surface(name, "ShaderNodeBsdfPrincipled")
+    bsdf.inputs["Base Color"].default_value = (*color, 1.0)
+    bsdf.inputs["Metallic"].default_value = 1.0
+    bsdf.inputs["Roughness"].default_value = roughness
+    return mat
+
+
 def emission(name, color, strength=1.0, sampling=None):
     """An Emission shader: a surface of radiance colour x strength on both sides, black itself.
     sampling: whether Cycles samples it as a light (4.x+ emission_sampling names; 3.x reads

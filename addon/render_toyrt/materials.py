@@ -14,6 +14,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .material_mix import mix_of_diffuse_and_glossy
+
 DEFAULT_GREY = (0.8, 0.8, 0.8)   # Blender's default surface colour
 MAGENTA = (1.0, 0.0, 1.0)        # placeholder for missing images
 PLACEHOLDER_PIXELS = np.array([[MAGENTA]], np.float32)   # one magenta pixel, linear
@@ -38,18 +40,28 @@ PLACEHOLDER = ImageKey("", False)
 @dataclass(frozen=True)
 class MaterialSpec:
     """What the core's material is made of: kind 'diffuse' (a colour or a texture), 'refraction'
-    or 'glass' (an index of refraction)."""
+    or 'glass' (an index of refraction), 'glossy' (a colour, a roughness and the masking-shadowing
+    of the Blender version: 'separable' in 3.x, 'correlated' since 4.0)."""
     kind: str
     color: tuple[float, float, float] = DEFAULT_GREY
     texture: ImageKey | None = None
     ior: float = 1.45
+    roughness: float = 0.5
+    shadowing: str = "separable"
+    diffuse_weight: float = 1.0                              # 'diffuse_glossy': the diffuse part's weight
+    glossy_color: tuple[float, float, float] = DEFAULT_GREY  # 'diffuse_glossy': the glossy part's colour
     emission: tuple[float, float, float] = (0.0, 0.0, 0.0)   # colour x strength, linear radiance
     emission_sampling: str = "AUTO"                           # Blender 4.x's names (3.x: AUTO or NONE)
 
     def arguments(self, texture_id: int = -1) -> dict:
         """Keyword arguments of toyrt.Scene.add_material / set_material, with the texture's id."""
-        return dict(kind=self.kind, color=self.color, texture=texture_id, ior=self.ior, emission=self.emission,
+        args = dict(kind=self.kind, color=self.color, texture=texture_id, ior=self.ior, emission=self.emission,
                     emission_sampling=self.emission_sampling)
+        if self.kind in ("glossy", "diffuse_glossy"):   # the core refuses keywords a kind does not read
+            args.update(roughness=self.roughness, shadowing=self.shadowing)
+        if self.kind == "diffuse_glossy":
+            args.update(diffuse_weight=self.diffuse_weight, glossy_color=self.glossy_color)
+        return args
 
 
 @dataclass(frozen=True)
@@ -223,6 +235,11 @@ def _convert(mat, notes):
         # Cycles renders an unconnected surface black; the nearest we have is a black diffuse.
         notes.append(f"material '{name}': nothing linked to the Surface output (black)")
         return _diffuse((0.0, 0.0, 0.0))
+    return _convert_node(name, node, notes)
+
+
+def _convert_node(name, node, notes):
+    """The shader node `node` of material `name` as (MaterialSpec, image)."""
     t = node.type
     if t == "BSDF_DIFFUSE":
         rough = input_socket(node, "Roughness")
@@ -231,6 +248,12 @@ def _convert(mat, notes):
         return _color_material(name, input_socket(node, "Color"), notes)
     if t == "BSDF_PRINCIPLED":
         return _principled(name, node, notes)
+    if t in ("BSDF_GLOSSY", "BSDF_ANISOTROPIC"):   # 4.0+: the Glossy node is ShaderNodeBsdfAnisotropic
+        return _glossy(name, node, notes)
+    if t in ("MIX_SHADER", "ADD_SHADER"):
+        mixed = mix_of_diffuse_and_glossy(name, node, notes, _convert_node)
+        if mixed is not None:
+            return mixed
     if t == "EMISSION":
         # Emission alone has no BSDF: a black surface that glows (Cycles).
         emission = _emission(name, input_socket(node, "Color"), input_socket(node, "Strength"), notes)
@@ -268,6 +291,71 @@ def _check_sharp(name, node, label, notes):
         notes.append(f"material '{name}': {label} tint (white)")
 
 
+def _shadowing() -> str:
+    """Cycles' GGX masking-shadowing: separable G1 G1 in 3.x, height-correlated since 4.0."""
+    try:
+        import bpy
+        version = tuple(bpy.app.version)
+    except ImportError:      # outside Blender
+        version = (3, 4, 0)
+    return "separable" if version < (4, 0, 0) else "correlated"
+
+
+def _constant(name, sock, label, fallback, notes, lo=None, hi=None) -> float:
+    """A float socket's constant value (a linked socket: that value, noted); NaN becomes
+    `fallback` and a value outside [lo, hi] is clamped, both noted."""
+    if sock is None:
+        return fallback
+    if sock.is_linked:
+        notes.append(f"material '{name}': linked {label} (its constant value)")
+    v = float(sock.default_value)
+    if v != v:
+        notes.append(f"material '{name}': {label} is NaN ({fallback})")
+        return fallback
+    if (lo is not None and v < lo) or (hi is not None and v > hi):
+        v = min(max(v, lo), hi)
+        notes.append(f"material '{name}': {label} outside [{lo}, {hi}] (clamped to {v:g})")
+    return v
+
+
+def _finite_color(name, value, label, notes) -> tuple[float, float, float]:
+    """A colour with NaN or negative channels replaced by 0, noted."""
+    c = rgb(value)
+    clean = tuple(x if x == x and x >= 0.0 else 0.0 for x in c)
+    if clean != c:
+        notes.append(f"material '{name}': {label} has NaN or negative channels (0)")
+    return tuple(min(x, 3.4e38) for x in clean)
+
+
+def _glossy_spec(name, color_sock, rough_sock, notes) -> MaterialSpec:
+    if color_sock is not None and color_sock.is_linked:
+        notes.append(f"material '{name}': linked glossy colour (its constant colour)")
+    color = _finite_color(name, color_sock.default_value, "colour", notes) if color_sock is not None else DEFAULT_GREY
+    rough = _constant(name, rough_sock, "roughness", 0.5, notes, 0.0, 1.0)
+    return MaterialSpec("glossy", color=color, roughness=rough, shadowing=_shadowing())
+
+
+def _glossy(name, node, notes):
+    """Blender's Glossy BSDF: GGX (Sharp in 3.x is roughness 0); other distributions as GGX."""
+    distribution = getattr(node, "distribution", "GGX")
+    if distribution == "SHARP":
+        rough = None
+    else:
+        rough = input_socket(node, "Roughness")
+        if distribution == "MULTI_GGX":
+            notes.append(f"material '{name}': Multiscatter GGX (single-scatter GGX: darker at high roughness)")
+        elif distribution != "GGX":
+            notes.append(f"material '{name}': {distribution.title()} glossy distribution (GGX)")
+    aniso = input_socket(node, "Anisotropy")
+    if aniso is not None and (aniso.is_linked or aniso.default_value != 0.0):
+        notes.append(f"material '{name}': anisotropic glossy (isotropic)")
+    normal = input_socket(node, "Normal")
+    if normal is not None and normal.is_linked:
+        notes.append(f"material '{name}': glossy normal input (the surface normal)")
+    spec = _glossy_spec(name, input_socket(node, "Color"), rough, notes)
+    return (replace(spec, roughness=0.0) if rough is None else spec), None
+
+
 def _principled(name, node, notes):
     trans = input_socket(node, "Transmission Weight", "Transmission")  # 4.0+ / 3.x
     if trans is not None and not trans.is_linked and trans.default_value >= 0.999:
@@ -275,8 +363,10 @@ def _principled(name, node, notes):
         if rough is not None and (rough.is_linked or rough.default_value > 0.0):
             notes.append(f"material '{name}': rough Principled transmission (sharp glass)")
         return MaterialSpec("glass", ior=_ior(name, node, notes)), None
-    extras = []
     metal = input_socket(node, "Metallic")
+    if metal is not None and not metal.is_linked and metal.default_value >= 0.999:
+        return _metal(name, node, notes)
+    extras = []
     if metal is not None and (metal.is_linked or metal.default_value > 0.0):
         extras.append("metallic")
     if trans is not None and (trans.is_linked or trans.default_value > 0.0):
@@ -290,6 +380,33 @@ def _principled(name, node, notes):
         notes.append(f"material '{name}': Principled {', '.join(extras)} (Lambert base colour)")
     spec, image = _color_material(name, input_socket(node, "Base Color"), notes)
     return replace(spec, emission=emission), image
+
+
+def _metal(name, node, notes):
+    """Principled BSDF with Metallic 1: a glossy lobe tinted by the base colour at every angle,
+    emission kept. What it leaves out goes in the one note: Cycles brightens metals towards white
+    at grazing (3.x by its Fresnel blend, 4.x+ by F82 tint), and the coat, anisotropy, other
+    distributions and a linked base colour."""
+    extras = ["grazing Fresnel brightening"]
+    base = input_socket(node, "Base Color")
+    if base is not None and linked_node(base) is not None:
+        extras.append(f"base colour from {linked_node(base).bl_idname}")
+    coat = input_socket(node, "Coat Weight", "Clearcoat")
+    if coat is not None and (coat.is_linked or coat.default_value > 0.0):
+        extras.append("coat")
+    aniso = input_socket(node, "Anisotropic")
+    if aniso is not None and (aniso.is_linked or aniso.default_value > 0.0):
+        extras.append("anisotropy")
+    distribution = getattr(node, "distribution", "GGX")
+    if distribution != "GGX":   # 4.x/5.x default to Multiscatter GGX
+        extras.append("multiscatter GGX" if distribution == "MULTI_GGX" else f"{distribution.title()} distribution")
+    notes.append(f"material '{name}': Principled metal without {', '.join(extras)} (glossy of its base colour)")
+    spec = _glossy_spec(name, None, input_socket(node, "Roughness"), notes)
+    if base is not None:
+        spec = replace(spec, color=_finite_color(name, base.default_value, "base colour", notes))
+    emission = _emission(name, input_socket(node, "Emission Color", "Emission"),
+                         input_socket(node, "Emission Strength"), notes)
+    return replace(spec, emission=emission), None
 
 
 def _color_material(name, sock, notes):

@@ -9,6 +9,8 @@
 #pragma once
 
 #include "core/type_table.h"
+#include "materials/diffuse_glossy.h"
+#include "materials/glossy.h"
 #include "materials/lambert.h"
 #include "materials/refraction.h"
 
@@ -19,17 +21,16 @@
 
 namespace toyrt {
 
-using Material = std::variant<Lambert, PerfectRefraction, FresnelDielectric>;
+using Material = std::variant<Lambert, PerfectRefraction, FresnelDielectric, Glossy, DiffuseGlossy>;
 
 // The texture a material reads (-1: none).
 inline int32_t texture_of(const Material& material) {
   return std::visit([](const auto& m) { return texture_index(m); }, material);
 }
 
-// A material of kind `kind` ("diffuse", "refraction", "glass": the kTypes) from its parameters.
-// Throws std::invalid_argument for another kind (listing the known ones), a bad value or an
-// argument the kind does not read. Texture ids are checked against the scene's textures by
-// Scene::add_material.
+// A material of kind `kind` ("diffuse", "refraction", "glass", "glossy", "diffuse_glossy": the kTypes) from its
+// parameters. Throws std::invalid_argument for another kind (listing the known ones), a bad value or an argument the
+// kind does not read. Texture ids are checked against the scene's textures by Scene::add_material.
 inline constexpr const char* kDefaultMaterialKind = Lambert::kType;  // Blender's default surface
 inline Material make_material(std::string_view kind, const Params& params) {
   return make_from_params<Material>(kind, params, "material", "kind");

@@ -1,12 +1,15 @@
 // The one interaction a material offers the integrator, with one signature for every type:
 //     Scatter scatter(const X&, const ShadingPoint&, const MaterialContext&);
 // The answer is either "diffuse with BRDF value f" (the integrator samples the lights there and
-// ends the path: direct lighting, as Cycles with max bounces 0) or up to two specular branches,
-// which the path follows. The integrator has no per-type code: it visits the Material variant
-// with a generic lambda, so a type without scatter() fails to compile.
+// ends the path: direct lighting, as Cycles with max bounces 0), a glossy lobe (lights sampled
+// with MIS against the lobe, then the path continues along a direction the lobe draws:
+// materials/glossy_lobe.h) or up to two specular branches, which the path follows. The
+// integrator has no per-type code: it visits the Material variant with a generic lambda, so a
+// type without scatter() fails to compile.
 #pragma once
 
 #include "core/math.h"
+#include "materials/glossy_lobe.h"
 #include "materials/texture.h"
 #include "sampling/sobol_owen.h"
 
@@ -52,15 +55,24 @@ struct Scatter {
     Diffuse,   // direct lighting with BRDF value f, then the path ends
     Specular,  // the path continues along branches[0] with weight 1 (f / pdf = 1)
     Split,     // each of the `count` branches is traced on its own, weighted by its probability
+    Glossy,    // lights sampled with MIS against `glossy`, then the path continues along its sample;
+               // a diffuse part f, if not 0, gets its direct light as a Diffuse answer does
   };
   Kind kind = Kind::Diffuse;
-  Vec3 f{0.0f};  // Diffuse: for directions on wo's side of the surface
+  Vec3 f{0.0f};  // Diffuse, and Glossy's diffuse part (0: none): for directions on wo's side
   int count = 0;
   SpecularSample branches[2];
+  GlossyLobe glossy;
 
   static Scatter diffuse(const Vec3& f) {
     Scatter s;
     s.f = f;
+    return s;
+  }
+  static Scatter glossy_lobe(const GlossyLobe& lobe) {
+    Scatter s;
+    s.kind = Kind::Glossy;
+    s.glossy = lobe;
     return s;
   }
   static Scatter specular(const SpecularSample& branch) {

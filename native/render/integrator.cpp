@@ -2,6 +2,7 @@
 
 #include "geometry/offset_ray.h"
 #include "lights/light_selector.h"
+#include "render/glossy_lighting.h"
 #include "sampling/frame.h"
 #include "sampling/sobol_owen.h"
 #include "sampling/warp.h"
@@ -211,9 +212,11 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
 // (in units of the unit direction), of those visible to that kind of ray. Lights are not
 // surfaces: as in Cycles, a ray that sees one goes on, so what is behind a light (another light,
 // a surface, the world) adds to it. A light at infinity (a sun, at FLT_MAX) is part of the world:
-// seen by a ray that leaves the scene (`escaped`), whatever the camera's clip end.
+// seen by a ray that leaves the scene (`escaped`), whatever the camera's clip end. bsdf_pdf > 0:
+// the ray was drawn by a glossy lobe with that density, and each lamp takes its power-heuristic
+// weight against the lamp sample glossy_direct_lighting took there.
 Vec3 visible_lights(const World& world, const Vec3& org, const Vec3& unit_dir, float from, float limit, bool escaped,
-                    bool camera, AreaSampling area_sampling) {
+                    bool camera, AreaSampling area_sampling, float bsdf_pdf) {
   constexpr float kAtInfinity = std::numeric_limits<float>::max();
   Vec3 radiance(0.0f);
   for (size_t j = 0; j < world.lights.size(); ++j) {
@@ -221,7 +224,8 @@ Vec3 visible_lights(const World& world, const Vec3& org, const Vec3& unit_dir, f
     if (!(camera ? v.camera : v.specular)) continue;
     const LightEval e = evaluate_light(world.lights[j], org, unit_dir, area_sampling);
     if (!e.hit()) continue;
-    if (e.distance == kAtInfinity ? escaped : (e.distance >= from && e.distance < limit)) radiance += e.radiance;
+    if (!(e.distance == kAtInfinity ? escaped : (e.distance >= from && e.distance < limit))) continue;
+    radiance += bsdf_pdf > 0.0f ? e.radiance * power_heuristic(bsdf_pdf, e.pdf) : e.radiance;
   }
   return radiance;
 }
@@ -234,13 +238,18 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
   const World& world = scene.world();
   const std::vector<Material>& materials = scene.materials();
   Vec3 throughput(1.0f), radiance(0.0f);
+  // After a glossy vertex: the density its lobe drew `ray` with (0 otherwise), and whether the
+  // ray only looks for light (past max_specular_depth, as Cycles traces the last bounce's ray
+  // for the emission it finds and shades nothing there).
+  float bsdf_pdf = 0.0f;
+  bool light_only = false;
   for (int depth = first_depth;; ++depth) {
     const Hit hit = scene.intersect(ray);
     if (!world.lights.empty()) {
       const float length = glm::length(ray.dir);
       radiance += throughput * visible_lights(world, ray.org, ray.dir / length, ray.tnear * length,
                                               std::min(hit.t, ray.tfar) * length, !hit.found(), depth == 0,
-                                              settings.area_sampling);
+                                              settings.area_sampling, bsdf_pdf);
     }
     if (!hit.found()) {
       const Environment& env = world.environment;
@@ -265,20 +274,43 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
       radiance += throughput * scene.emission()[size_t(s.material)].radiance;
       if (first) first->emission = scene.emission()[size_t(s.material)].radiance;
     }
+    if (light_only) break;
     // One generic dispatch per hit, no per-type code: the lambda is instantiated per material
     // type, so for an inline scatter() (Lambert's) the compiler sees the answer's kind as a
     // constant and keeps only the diffuse path, as fast as a hand-written case. It returns
-    // whether the path goes on along `ray`.
+    // whether the path goes on along `ray`. Always inlined: with the glossy cases GCC made the
+    // lambda a function of its own, and the Lambert path paid for the call (cachegrind,
+    // docs/render.md "A scene pays for what it uses").
     const MaterialContext ctx{
         &scene.textures(), depth < settings.split_depth, pixel, sample, vertex_dimension(depth, 0), settings.seed};
     const bool go_on = std::visit(
-        [&](const auto& material) {
+        [&](const auto& material) __attribute__((always_inline)) {
           const Scatter sc = scatter(material, ShadingPoint{wo, s.ng, s.ns, s.uv}, ctx);
           if (sc.kind == Scatter::Kind::Diffuse) {
             if (first) first->diffuse = sc.f * kPi;  // f = albedo / pi
-            radiance += throughput * direct_lighting(scene, s, ng, ns, sc.f, depth, pixel, sample, settings);
+            // f by value: a reference into sc would make the whole answer (its glossy lobe and
+            // specular branches, dead here) live in memory across the call.
+            const Vec3 f = sc.f;
+            radiance += throughput * direct_lighting(scene, s, ng, ns, f, depth, pixel, sample, settings);
             return false;
           }
+          if (sc.kind == Scatter::Kind::Glossy) {
+            if (first) first->diffuse = sc.f * kPi;  // the diffuse part beside the lobe (Mix, Add)
+            if (sc.f != Vec3(0.0f))
+              radiance += throughput * direct_lighting(scene, s, ng, ns, sc.f, depth, pixel, sample, settings);
+            const Vec3 origin = offset_ray_origin(s.p, ng);
+            const GlossyStep g =
+                glossy_vertex(scene, s.p, origin, ng, sc.glossy, pixel, sample, vertex_dimension(depth, 1),
+                              vertex_dimension(depth, kDimsPerVertex - 5), settings);
+            radiance += throughput * g.radiance;
+            if (!(g.pdf > 0.0f)) return false;
+            throughput *= g.weight;
+            bsdf_pdf = g.pdf;
+            light_only = depth >= settings.max_specular_depth;
+            ray = Ray{origin, 0.0f, g.wi, kInfinity};
+            return true;
+          }
+          bsdf_pdf = 0.0f;  // a delta branch: no lamp was sampled here
           if (depth >= settings.max_specular_depth) return false;
           if (sc.kind == Scatter::Kind::Split) {
             for (int b = 0; b < sc.count; ++b) {

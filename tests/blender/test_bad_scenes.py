@@ -225,6 +225,24 @@ def test_unsupported_nodes():
     check(px is not None and np.isfinite(px).all() and px[..., 1].mean() > 0, "and the image is lit")
 
 
+def test_glossy_and_metal():
+    clear_scene()
+    # A Glossy BSDF in Multiscatter GGX (4.x/5.x's default) and a Principled metal whose base
+    # colour is NaN: both render, finite, with one note naming what was approximated.
+    kit.plane("floor", 20.0, kit.glossy("shiny", (0.9, 0.8, 0.6), 0.3, distribution="MULTI_GGX"))
+    metal = kit.metal("nan_metal", (float("nan"), 0.5, 0.5), 0.4)
+    kit.box("box", 1.5, (0.5, 0.3, 0.75), material=metal)
+    kit.point_light("lamp", (0, 0, 4), 300.0, radius=0.3)
+    kit.world((0.2, 0.2, 0.2))
+    camera()
+    result, px, log = render("glossy")
+    warned = warnings_in(log)
+    check(result == {"FINISHED"} and len(warned) == 1 and "Multiscatter GGX" in warned[0]
+          and "Principled metal" in warned[0] and "NaN" in warned[0],
+          f"a multiscatter glossy and a NaN metal: one note naming both: {warned[:1]}")
+    check(px is not None and np.isfinite(px).all() and px[..., :3].mean() > 0, "and the image is lit and finite")
+
+
 def test_library_linked():
     # A library file holding a cube object with its mesh and material, written by this Blender.
     basic_scene()
@@ -294,5 +312,6 @@ def test_100k_objects():
 
 
 PARTS = [test_empty_scene, test_no_camera, test_edges_and_points_only, test_zero_scale, test_nan_vertices,
-         test_far_from_origin, test_missing_image, test_unsupported_nodes, test_library_linked, test_100k_objects]
+         test_far_from_origin, test_missing_image, test_unsupported_nodes, test_glossy_and_metal, test_library_linked,
+         test_100k_objects]
 run_script(PARTS, "bad scenes", TMP)

@@ -179,6 +179,46 @@ def scene_hdri(p):
     camera(p["camera"], (0, 0, 0.3))
 
 
+def scene_glossy_sweep(p):
+    # Material balls: a row of Glossy BSDF (GGX) spheres, roughness 0.05 to 1, over a diffuse floor
+    # (the spheres reflect it and each other: glossy chains ending on the floor's direct light),
+    # under one lamp the sharp balls show as a highlight.
+    kit.plane("floor", 8.0, kit.diffuse("floor", (0.6, 0.6, 0.6)))
+    for i, rough in enumerate(p["roughness"]):
+        x = (i - (len(p["roughness"]) - 1) / 2) * 0.9
+        kit.uv_sphere(f"ball{i}", 0.4, (x, 0.0, 0.4), kit.glossy(f"glossy{i}", p["color"], rough))
+    if p["lamp"] == "point":
+        kit.point_light("lamp", (0.8, -1.5, 2.5), 150.0, radius=0.25)
+    else:
+        kit.area_light("panel", (-0.8, -1.2, 2.2), 120.0, 1.2, 0.6, target=(0.0, 0.0, 0.3))
+    camera((0.0, -4.5, 1.6), (0, 0, 0.35))
+    kit.world((0, 0, 0))
+
+
+def scene_metal_sweep(p):
+    # Principled BSDF, Metallic 1, at the sweep's roughness values: TOYRT's glossy of the base colour
+    # against Cycles' metal Fresnel (brighter towards grazing) and, on 4.x/5.x, its multiscatter GGX.
+    kit.plane("floor", 8.0, kit.diffuse("floor", (0.6, 0.6, 0.6)))
+    for i, rough in enumerate(p["roughness"]):
+        x = (i - (len(p["roughness"]) - 1) / 2) * 0.9
+        kit.uv_sphere(f"ball{i}", 0.4, (x, 0.0, 0.4), kit.metal(f"metal{i}", p["color"], rough))
+    kit.point_light("lamp", (0.8, -1.5, 2.5), 150.0, radius=0.25)
+    camera((0.0, -4.5, 1.6), (0, 0, 0.35))
+    kit.world((0, 0, 0))
+
+
+def scene_diffuse_and_glossy(p):
+    # Mix and Add shaders of a Diffuse and a Glossy BSDF: balls at three mix factors and one sum.
+    kit.plane("floor", 8.0, kit.diffuse("floor", (0.6, 0.6, 0.6)))
+    for i, (fac, rough) in enumerate(p["balls"]):
+        x = (i - (len(p["balls"]) - 1) / 2) * 1.0
+        mat = kit.diffuse_and_glossy(f"mixed{i}", (0.7, 0.25, 0.15), (0.9, 0.9, 0.9), rough, fac)
+        kit.uv_sphere(f"ball{i}", 0.42, (x, 0.0, 0.42), mat)
+    kit.point_light("lamp", (0.8, -1.5, 2.5), 150.0, radius=0.25)
+    camera((0.0, -4.5, 1.6), (0, 0, 0.35))
+    kit.world((0, 0, 0))
+
+
 # A real file: five 1 m point lights of 100 W a metre above a torus, from Debian's assimp-testmodels
 # (Blender 2.50; the Makefile installs it). Its own camera, lights and grey world.
 TORUS_FILE = Path("/usr/share/assimp/models/BLEND/TorusLightsCams_250_compressed.blend")
@@ -243,6 +283,18 @@ SCENES_SPEC = [
     # simpler scenes with the same lights (docs/parity-blender-5.0.md): measured and reported
     # there, asserted on 3.4 only until the cause is found.
     ("torus_file", scene_torus_file, dict(file=TORUS_FILE.name, asserted_before=(4, 0, 0)), 0),
+    # Glossy roughness sweeps (GGX; the mean limit 0.5 %, the materials issue's), under a spherical
+    # point lamp and a rectangular area lamp; glossy bounces 8, diffuse bounces 0.
+    ("glossy_sweep_point", scene_glossy_sweep, dict(roughness=[0.05, 0.2, 0.4, 0.7, 1.0], color=(0.9, 0.75, 0.5),
+                                                    lamp="point", mean_limit=0.005, sample_factor=2), 8),
+    ("glossy_sweep_area", scene_glossy_sweep, dict(roughness=[0.05, 0.2, 0.4, 0.7, 1.0], color=(0.9, 0.75, 0.5),
+                                                   lamp="area", mean_limit=0.005, sample_factor=4), 8),
+    ("mix_diffuse_glossy", scene_diffuse_and_glossy, dict(balls=[(0.2, 0.3), (0.5, 0.3), (0.8, 0.3), (None, 0.1)],
+                                                          mean_limit=0.005, sample_factor=4), 8),
+    # Principled metals: measured and reported, not asserted (TOYRT omits the metal Fresnel's
+    # grazing brightening and, on 4.x/5.x, the multiscatter energy; docs/blender.md).
+    ("metal_sweep", scene_metal_sweep, dict(roughness=[0.05, 0.2, 0.4, 0.7, 1.0], color=(0.9, 0.75, 0.5),
+                                            asserted_before=(0, 0, 0), sample_factor=2), 8),
     # Cycles' defaults: the light is seen through and in the glass (camera, glossy and transmission
     # rays see it), and the world lights the floor, as in TOYRT.
     ("glass_sphere_visible_light", scene_glass, dict(light=(1.0, -1.0, 3.0), power=120.0, ior=1.45, uv_repeat=4.0,
@@ -349,7 +401,7 @@ def main():
         toyrt_s = time.perf_counter() - t1
         assert img.shape == ref.shape, f"{name}: TOYRT {img.shape} vs Cycles {ref.shape}"
         mean_rel, frac, bias = compare(img, ref)
-        ok = mean_rel <= MEAN_LIMIT and frac <= PIXEL_LIMIT
+        ok = mean_rel <= params.get("mean_limit", MEAN_LIMIT) and frac <= PIXEL_LIMIT
         asserted = tuple(bpy.app.version) < tuple(params.get("asserted_before", (99, 0, 0)))
         save_png(out_dir / f"{name}-toyrt.png", img)
         save_png(out_dir / f"{name}-cycles.png", ref)
@@ -442,6 +494,14 @@ def write_doc(results):
         "after the bilinear lookup; TOYRT does the same (Texture.EightBitSrgbIsFilteredBeforeDecodingAsCycles). "
         "Before that fix, decoding every texel at load made glass_sphere's magnified 8x8 checker +42 % too "
         "bright. Float images are kept linear by Blender and filtered linear by both (glass_sphere_float_texture).",
+        "- Glossy (GGX) roughness sweeps and Mix/Add of Diffuse and Glossy: balls at roughness 0.05-1 over a "
+        "diffuse floor, Cycles with glossy bounces 8 and diffuse bounces 0; these scenes pass at a mean "
+        "difference of 0.5 % (the materials issue's limit), at 2x (point lamp) and 4x (area lamp, mix) the "
+        "samples: the sharp balls' highlights are the noisiest pixels of both renders. The Glossy node is set to "
+        "GGX: 4.x/5.x default to Multiscatter GGX, which TOYRT renders as single-scatter GGX (noted).",
+        "- metal_sweep (Principled, Metallic 1, Blender's defaults otherwise) is reported, not asserted: TOYRT's "
+        "glossy of the base colour has neither the metal Fresnel's brightening towards grazing nor, on 4.x/5.x, "
+        "the multiscatter GGX energy (measured: 3.4 +0.14 % signed, 5.0 -4.1 %).",
         "",
     ]
     DOC.write_text("\n".join(lines))

@@ -77,7 +77,7 @@ TEST(Params, UnknownTypeListsTheKnownOnes) {
   EXPECT_EQ(refusal([] { make_light("HEMI", {}); }),
             "unknown light type 'HEMI': expected 'POINT', 'AREA', 'SPOT' or 'SUN'");
   EXPECT_EQ(refusal([] { make_material("metal", {}); }),
-            "unknown material kind 'metal': expected 'diffuse', 'refraction' or 'glass'");
+            "unknown material kind 'metal': expected 'diffuse', 'refraction', 'glass', 'glossy' or 'diffuse_glossy'");
 }
 
 TEST(Params, AllowedUnreadArgumentsPass) {
