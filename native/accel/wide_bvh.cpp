@@ -68,9 +68,15 @@ WideBvh collapse(const Bvh& bvh, uint32_t leaf_size) {
     // Children by decreasing surface area: the order an any-hit walk visits them in. A large box
     // is the likelier to block a shadow ray (a wall beside a dense model: found at once instead
     // of after the model's subtrees); the closest-hit walk sorts by distance and ignores it.
-    std::stable_sort(kids, kids + n, [&](uint32_t a, uint32_t b) {
-      return bvh.nodes[a].bbox().half_area() > bvh.nodes[b].bbox().half_area();
-    });
+    // An insertion sort: stable, and no allocation (std::stable_sort takes a temporary buffer,
+    // per node).
+    for (int i = 1; i < n; ++i) {
+      const uint32_t kid = kids[i];
+      const float area = bvh.nodes[kid].bbox().half_area();
+      int k = i;
+      for (; k > 0 && bvh.nodes[kids[k - 1]].bbox().half_area() < area; --k) kids[k] = kids[k - 1];
+      kids[k] = kid;
+    }
     WideNode node;
     for (int a = 0; a < 3; ++a)
       for (int i = 0; i < kWidth; ++i) {
