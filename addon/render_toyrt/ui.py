@@ -16,16 +16,20 @@ COMPATIBLE_PANELS = (
 )
 
 
-class RENDER_PT_toyrt(bpy.types.Panel):
-    bl_label = "TOYRT"
+class ToyrtPanel:
+    """What TOYRT's own panels share: the Properties editor, and shown only while TOYRT renders."""
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
-    bl_context = "render"
     COMPAT_ENGINES = {"TOYRT"}
 
     @classmethod
     def poll(cls, context):
         return context.engine in cls.COMPAT_ENGINES
+
+
+class RENDER_PT_toyrt(ToyrtPanel, bpy.types.Panel):
+    bl_label = "TOYRT"
+    bl_context = "render"
 
     def draw(self, context):
         layout = self.layout
@@ -47,18 +51,11 @@ class RENDER_PT_toyrt(bpy.types.Panel):
         layout.label(text=f"Threads: {context.scene.render.threads} (Performance settings)")
 
 
-class VIEWLAYER_PT_toyrt_passes(bpy.types.Panel):
+class VIEWLAYER_PT_toyrt_passes(ToyrtPanel, bpy.types.Panel):
     """The View Layer's own pass switches that TOYRT fills (passes.py), grouped as Cycles' Passes
     panel groups them; the others (Vector, AO, ...) are registered black when turned on elsewhere."""
     bl_label = "Passes"
-    bl_space_type = "PROPERTIES"
-    bl_region_type = "WINDOW"
     bl_context = "view_layer"
-    COMPAT_ENGINES = {"TOYRT"}
-
-    @classmethod
-    def poll(cls, context):
-        return context.engine in cls.COMPAT_ENGINES
 
     def draw(self, context):
         layout = self.layout

@@ -5,6 +5,7 @@
 // sampling and the continuation ray combined by MIS: wrong weights double or lose the light).
 #include "materials/material.h"
 #include "render/renderer.h"
+#include "render_fixtures.h"
 #include "sampling/ggx.h"
 
 #include <gtest/gtest.h>
@@ -13,36 +14,14 @@
 #include <cmath>
 
 using namespace toyrt;
+using namespace toyrt::testing;
 
 namespace {
 
 constexpr double kPiD = 3.14159265358979323846;
 
 Scene glossy_floor(float roughness, GgxShadowing shadowing) {
-  Scene scene;
-  const float h = 10.0f;
-  MeshShading sh;
-  sh.material_ids = {0, 0};
-  scene.add_instance(scene.add_mesh({{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}}, {{0, 1, 2}, {0, 2, 3}}, sh),
-                     Mat4(1.0f));
-  scene.add_material(Glossy::make(Vec3(1.0f), roughness, shadowing));
-  return scene;
-}
-
-Camera pixel_above() {
-  CameraParams p;
-  p.type = CameraType::Orthographic;
-  p.ortho_scale = 1e-3f;
-  p.resolution_x = p.resolution_y = 1;
-  p.matrix_world = glm::translate(Mat4(1.0f), Vec3(0.0f, 0.0f, 5.0f));
-  return Camera::make(p);
-}
-
-RenderSettings samples(int n) {
-  RenderSettings s;
-  s.samples = n;
-  s.threads = 1;
-  return s;
+  return floor_of(Glossy::make(Vec3(1.0f), roughness, shadowing));
 }
 
 // The lobe's directional albedo at normal incidence, by quadrature.
@@ -70,7 +49,7 @@ TEST(GlossyRender, FloorInAUniformBackgroundShowsItsDirectionalAlbedo) {
       Scene scene = glossy_floor(roughness, shadowing);
       scene.set_background(Vec3(1.0f));
       scene.commit();
-      const RenderResult r = render(scene, pixel_above(), samples(4096));
+      const RenderResult r = render(scene, pixel_above(), few_samples(4096));
       const double expected = albedo_at_normal_incidence(ggx_alpha(roughness), shadowing);
       EXPECT_NEAR(r.rgba[0], expected, 5e-3) << "roughness " << roughness;
       EXPECT_LT(expected, 1.0);
@@ -86,7 +65,7 @@ TEST(GlossyRender, FloorUnderASmallLampIsItsBrdfTimesTheIrradiance) {
     hidden.camera = false;  // the lamp is between the camera and the floor
     scene.add_light(PointLight::make(Vec3(0.0f, 0.0f, 1.0f), power, Vec3(1.0f), radius), hidden);
     scene.commit();
-    const RenderResult r = render(scene, pixel_above(), samples(1024));
+    const RenderResult r = render(scene, pixel_above(), few_samples(1024));
     const Vec3 z(0.0f, 0.0f, 1.0f);
     // I / d^2 at d = 1 m; over the lamp's 0.03 rad the rough lobe's value changes by < 0.1 %.
     const double expected = ggx_reflection_eval(1.0f, GgxShadowing::Separable, z, z).f * power / (4.0 * kPiD);
@@ -102,7 +81,7 @@ TEST(GlossyRender, SharpFloorReflectsTheLampWithoutNaN) {
   hidden.camera = false;
   scene.add_light(PointLight::make(Vec3(0.0f, 0.0f, 1.0f), 100.0f, Vec3(1.0f), 0.1f), hidden);
   scene.commit();
-  const RenderResult r = render(scene, pixel_above(), samples(64));
+  const RenderResult r = render(scene, pixel_above(), few_samples(64));
   EXPECT_TRUE(std::isfinite(r.rgba[0]));
   // A mirror under a disc of radiance L that fills the reflected direction shows L.
   const double lamp_radiance = 100.0 / (4.0 * kPiD) / (kPiD * 0.1 * 0.1);
@@ -124,7 +103,7 @@ TEST(GlossyRender, DiffuseAndGlossySideBySideAddTheirLight) {
   const float power = 100.0f;
   scene.add_light(PointLight::make(Vec3(0.0f, 0.0f, 1.0f), power, Vec3(1.0f)));
   scene.commit();
-  const RenderResult r = render(scene, pixel_above(), samples(16));
+  const RenderResult r = render(scene, pixel_above(), few_samples(16));
   const double irradiance = power / (4.0 * kPiD);
   const double expected = (0.75 * 0.5 / kPiD + 0.25 / (4.0 * kPiD)) * irradiance;
   EXPECT_NEAR(r.rgba[0], expected, 1e-4 * expected);

@@ -10,9 +10,11 @@
 #include <new>
 #include <stdexcept>
 
+#include "render_fixtures.h"
 #include "test_scenes.h"
 
 using namespace toyrt;
+using namespace toyrt::testing;
 
 // Bytes allocated through operator new in this binary: ReadsTheSceneInPlace checks that a render
 // allocates nothing the size of the scene's shading (a per-render copy of it did, tens of MB).
@@ -30,33 +32,7 @@ namespace {
 constexpr double kPiD = 3.14159265358979323846;
 
 // A 20 x 20 m Lambert floor at z = 0 with albedo `albedo`.
-Scene floor_scene(float albedo) {
-  Scene scene;
-  const float h = 10.0f;
-  MeshShading sh;
-  sh.material_ids = {0, 0};
-  scene.add_instance(scene.add_mesh({{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}}, {{0, 1, 2}, {0, 2, 3}}, sh),
-                     Mat4(1.0f));
-  scene.add_material(Lambert{Vec3(albedo), -1});
-  return scene;
-}
-
-// One pixel of an orthographic camera 5 m above the origin looking down, `size` m wide.
-Camera pixel_above(float size) {
-  CameraParams p;
-  p.type = CameraType::Orthographic;
-  p.ortho_scale = size;
-  p.resolution_x = p.resolution_y = 1;
-  p.matrix_world = glm::translate(Mat4(1.0f), Vec3(0.0f, 0.0f, 5.0f));
-  return Camera::make(p);
-}
-
-RenderSettings few_samples(int samples) {
-  RenderSettings s;
-  s.samples = samples;
-  s.threads = 1;
-  return s;
-}
+Scene floor_scene(float albedo) { return floor_of(Lambert{Vec3(albedo), -1}); }
 
 }  // namespace
 
