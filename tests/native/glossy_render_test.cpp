@@ -91,15 +91,9 @@ TEST(GlossyRender, SharpFloorReflectsTheLampWithoutNaN) {
 TEST(GlossyRender, DiffuseAndGlossySideBySideAddTheirLight) {
   // A Mix Shader of a Diffuse and a Glossy BSDF at factor 0.25 under a delta lamp 1 m above:
   // (0.75 albedo / pi + 0.25 colour / (4 pi)) I / d^2 at roughness 1, normal incidence.
-  Scene scene;
-  const float h = 10.0f;
-  MeshShading sh;
-  sh.material_ids = {0, 0};
-  scene.add_instance(scene.add_mesh({{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}}, {{0, 1, 2}, {0, 2, 3}}, sh),
-                     Mat4(1.0f));
   Params p;
   p.set("color", Vec3(0.5f)).set("diffuse_weight", 0.75).set("glossy_color", Vec3(0.25f)).set("roughness", 1.0);
-  scene.add_material(make_material("diffuse_glossy", p));
+  Scene scene = floor_of(make_material("diffuse_glossy", p));
   const float power = 100.0f;
   scene.add_light(PointLight::make(Vec3(0.0f, 0.0f, 1.0f), power, Vec3(1.0f)));
   scene.commit();
