@@ -14,6 +14,7 @@
 #   make bench        speed against accuracy vs Cycles, Mitsuba 3, Embree, Open3D -> docs/results.md (BENCH_QUICK=1: smoke run)
 #   make fuzz         libFuzzer over scene building and ray queries (FUZZ_SECONDS=60) -> docs/robustness.md
 #   make sanitize     C++ and Python tests on an AddressSanitizer + UBSan build (build-asan/)
+#   make test-levels  the watertight, oracle, BVH, query and fuzz suites at each x86-64 level of the wheels (build-levels/)
 #   make clean        remove build/ (and its stamps), build-fuzz/, build-asan/;  make distclean: also .venv
 
 SHELL := /bin/bash
@@ -32,7 +33,7 @@ CMAKE_ARGS ?=
 APT_PACKAGES := cmake g++ make libglm-dev pybind11-dev python3-dev python3-numpy python3-venv \
 	libembree-dev libtbb-dev libgtest-dev googletest ocl-icd-opencl-dev opencl-headers \
 	pocl-opencl-icd clinfo blender python3-matplotlib clang clang-format-14 libclang-rt-14-dev \
-	xvfb xauth libgl1-mesa-dri assimp-testmodels python3-openimageio
+	xvfb xauth libgl1-mesa-dri assimp-testmodels python3-openimageio ccache
 # The stamp's name carries a hash of the list, so adding a package re-runs the check.
 APT_STAMP   := $(BUILD)/.stamp-apt-$(firstword $(shell printf '%s' '$(APT_PACKAGES)' | md5sum))
 VENV_STAMP  := $(VENV)/.stamp-requirements
@@ -52,7 +53,7 @@ VERSION     := $(shell sed -n 's/^project(toyrt LANGUAGES CXX VERSION \([0-9.]*\
 BLENDER_TESTS := $(sort $(wildcard tests/blender/test_*.py))
 
 .PHONY: bench help setup apt venv configure native addon test test-native test-python test-blender test-bpy bench-blender \
-	demo bench-trace bench-lbvh clean distclean fuzz sanitize lint format test-quick venv-package package test-package
+	demo bench-trace bench-lbvh clean distclean fuzz sanitize test-levels lint format test-quick venv-package package test-package
 
 help:
 	@sed -n '2,17p' Makefile | sed 's/^# \{0,1\}//'
@@ -107,19 +108,23 @@ native: $(BUILD)/CMakeCache.txt
 addon: native
 	@BLENDER=$(BLENDER) BUILD_DIR=$(BUILD) scripts/install-addon.sh
 
+# The per-level builds (three wheels and build-levels) compile the same core for the same three
+# CPU levels four times: under ccache (from APT_PACKAGES) all but the first are cache hits. Only
+# for them: their flags name the level, where -march=native (the main build) would not say which CPU.
+LEVELS_CCACHE = CCACHE_BASEDIR=$(CURDIR) CMAKE_CXX_COMPILER_LAUNCHER=$(shell command -v ccache)
 # The release files (docs/install.md): a portable wheel per Python, repaired by auditwheel
 # (scripts/build-wheel.sh; incremental in build/wheel/), then the extension zip, built and
 # validated by Blender's own tool, and the legacy zip (scripts/build-extension.py).
 package: venv-package
 	@rm -f $(DIST)/toyrt-*.whl $(DIST)/render_toyrt-*.zip
-	@JOBS=$(JOBS) scripts/build-wheel.sh $(VENV)/bin/python $(DIST)
-	@JOBS=$(JOBS) scripts/build-wheel.sh $(VENV313)/bin/python $(DIST)
-	@JOBS=$(JOBS) scripts/build-wheel.sh $(VENV310)/bin/python $(DIST)
+	@$(LEVELS_CCACHE) JOBS=$(JOBS) scripts/build-wheel.sh $(VENV)/bin/python $(DIST)
+	@$(LEVELS_CCACHE) JOBS=$(JOBS) scripts/build-wheel.sh $(VENV313)/bin/python $(DIST)
+	@$(LEVELS_CCACHE) JOBS=$(JOBS) scripts/build-wheel.sh $(VENV310)/bin/python $(DIST)
 	@$(VENV)/bin/python scripts/build-extension.py --dist $(DIST)
 
 # ---- tests ------------------------------------------------------------------------------------------
 test: setup
-	@$(MAKE) --no-print-directory lint test-native test-python test-blender test-bpy test-package fuzz sanitize
+	@$(MAKE) --no-print-directory lint test-native test-python test-blender test-bpy test-package fuzz test-levels sanitize
 
 test-quick: native venv
 	@$(MAKE) --no-print-directory lint test-native test-python
@@ -249,6 +254,24 @@ fuzz: apt
 	TOYRT_OPENCL=off $(FUZZ_BUILD)/scene_fuzzer -max_total_time=$(FUZZ_SECONDS) -seed=$(FUZZ_SEED) -print_final_stats=1 \
 		-artifact_prefix=$(FUZZ_BUILD)/ $(FUZZ_BUILD)/corpus tests/fuzz/corpus
 
+# The wheels run one of three builds of the core (v2 SSE4.2, v3 AVX2, v4 AVX-512; native/CMakeLists.txt):
+# each level this CPU runs builds the suites of tests/levels against its own core and runs them, with
+# the corpus `make fuzz` grew when it is there (make test runs fuzz first). The suites' LBVH variants
+# are left to the native build: PoCL compiles the LBVH kernels for this CPU whatever the level, and the
+# host code they would add (traversal, triangle tests) is what the SAH variants run at every level.
+LEVELS_BUILD ?= $(BUILD)-levels
+space := $(subst ,, )
+test-levels: apt
+	@[ -f $(LEVELS_BUILD)/CMakeCache.txt ] || $(LEVELS_CCACHE) cmake -S . -B $(LEVELS_BUILD) -DCMAKE_BUILD_TYPE=Release \
+		-DTOYRT_CPU_DISPATCH=ON -DTOYRT_NATIVE_ARCH=OFF -DTOYRT_TEST_LEVELS="$(subst $(space),;,$(strip $(CPU_LEVELS)))" \
+		|| { rm -f $(LEVELS_BUILD)/CMakeCache.txt; exit 1; }
+	@env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL cmake --build $(LEVELS_BUILD) -j$(JOBS) --target toyrt_level_tests
+	@corpus=$(abspath $(FUZZ_BUILD))/corpus; if [ -d $$corpus ]; then export TOYRT_FUZZ_CORPUS=$$corpus; fi; \
+		ctest --test-dir $(LEVELS_BUILD) -E '/Lbvh' --output-on-failure --no-tests=error -j$(JOBS) > $(LEVELS_BUILD)/ctest.log \
+		|| { cat $(LEVELS_BUILD)/ctest.log; exit 1; }
+	@grep -h 'corpus_replay: .* inputs, every' $(LEVELS_BUILD)/Testing/Temporary/LastTest.log | sed 's/^/test-levels: /'
+	@tail -n 3 $(LEVELS_BUILD)/ctest.log
+
 sanitize: apt venv
 	@[ -f $(SAN_BUILD)/CMakeCache.txt ] || cmake -S . -B $(SAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 		-DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
@@ -263,7 +286,7 @@ sanitize: apt venv
 		PYTHONPATH=$(SAN_BUILD)/python $(VENV)/bin/python -m pytest tests/python -q --noconftest -p no:cacheprovider
 
 clean:
-	rm -rf $(BUILD) $(FUZZ_BUILD) $(SAN_BUILD)
+	rm -rf $(BUILD) $(FUZZ_BUILD) $(SAN_BUILD) $(LEVELS_BUILD)
 
 distclean: clean
 	rm -rf $(VENV) $(VENV313) $(VENV310) $(DIST)

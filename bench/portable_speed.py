@@ -4,6 +4,7 @@ same state of a shared machine, and the medians of TOYRT's Mrays/s per row of it
 (docs/install.md). The render side is bench/render_overhead.py with one --module per build.
 
     .venv/bin/python bench/portable_speed.py --native build --portable build-portable [--runs 5]
+    .venv/bin/python bench/portable_speed.py --native build --portable build-levels/tests/levels/bench_trace_v4
 """
 import argparse
 import math
@@ -32,8 +33,10 @@ def main():
     parser.add_argument("--portable", default="build-portable", help="build folder with TOYRT_NATIVE_ARCH=OFF")
     parser.add_argument("--runs", type=int, default=5)
     args = parser.parse_args()
-    builds = {name: Path(folder) / "bench" / "bench_trace"
-              for name, folder in (("native", args.native), ("portable", args.portable))}
+    # A build folder (its bench/bench_trace) or a bench_trace binary itself, e.g. one CPU level of the
+    # wheels: build-levels/tests/levels/bench_trace_v4 (make test-levels' folder, target toyrt_level_benches).
+    builds = {name: Path(path) if Path(path).is_file() else Path(path) / "bench" / "bench_trace"
+              for name, path in (("native", args.native), ("portable", args.portable))}
     rates = {name: [] for name in builds}
     for run in range(args.runs):
         for name, bench in builds.items():  # interleaved: a busy spell of the machine hits both

@@ -54,6 +54,13 @@ def to_array(matrix) -> np.ndarray:
     return np.fromiter(chain.from_iterable(matrix), np.float64, 16).reshape(4, 4)
 
 
+def casts_shadow(inst, obj) -> bool:
+    """Object.visible_shadow (Blender 3.0+; on by default), inherited from the instancer as in
+    Cycles: an instance casts shadows when it and the object instancing it both do."""
+    parent = inst.parent if inst.is_instance else None
+    return bool(getattr(obj, "visible_shadow", True) and (parent is None or getattr(parent, "visible_shadow", True)))
+
+
 def singular(matrix: np.ndarray) -> bool:
     """True when the core would refuse an instance's matrix: not finite, or (nearly) no volume,
     as an object scaled to zero along an axis has (a common way to hide an object in an

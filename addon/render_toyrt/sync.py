@@ -37,7 +37,17 @@ from . import materials, passes
 from .camera import export_camera
 from .lights import LightSpec, light_spec
 from .materials import ImageKey
-from .mesh import RENDERABLE, ExportCancelled, evaluated_geometry, fingerprint, mesh_key, singular, stop_if, to_array
+from .mesh import (
+    RENDERABLE,
+    ExportCancelled,
+    casts_shadow,
+    evaluated_geometry,
+    fingerprint,
+    mesh_key,
+    singular,
+    stop_if,
+    to_array,
+)
 from .sync_materials import MaterialSync
 from .world import WorldSpec, world_spec
 
@@ -62,7 +72,7 @@ class SceneSync(MaterialSync):
         self.approximated: list[str] = []      # what the converters approximated (for one warning)
         self.meshes: dict[tuple, list] = {}    # mesh key -> [mesh id or -1, triangles, fingerprint]
         self.free_ids: list[int] = []          # emptied meshes, reused by the next new mesh
-        self.placed: list | None = []          # [(mesh id, matrix as bytes)] in instance order
+        self.placed: list | None = []          # [(mesh id, matrix as bytes, visible_shadow)] in instance order
         self.owner_keys: dict[int, tuple] = {}         # object pointer -> the mesh key it showed last
         self.owner_instances: dict[int, list] = {}     # object pointer -> its instance ids (plain objects)
         # Keyed by name, not pointer: a final render's depsgraph may hand out new copies of the same
@@ -165,7 +175,7 @@ class SceneSync(MaterialSync):
         for i, matrix in changes:
             if self.placed[i][1] != matrix.tobytes():
                 self.scene.set_instance_transform(i, matrix)
-                self.placed[i] = (self.placed[i][0], matrix.tobytes())
+                self.placed[i] = (self.placed[i][0], matrix.tobytes(), self.placed[i][2])
                 self.counters["transforms_set"] += 1
         self.counters["fast_moves"] += 1
         return True
@@ -246,7 +256,7 @@ class SceneSync(MaterialSync):
             if entry[0] >= 0:
                 if owner is not None and bake is None:
                     owners.setdefault(owner, []).append(len(placed))
-                placed.append((entry[0], _IDENTITY if bake is not None else matrix))
+                placed.append((entry[0], _IDENTITY if bake is not None else matrix, casts_shadow(inst, obj)))
                 pass_index.append(obj.pass_index)
                 tri_instanced += entry[1]
 
@@ -345,17 +355,18 @@ class SceneSync(MaterialSync):
     def _place(self, placed) -> None:
         """Instances: matrices only when the same meshes are placed in the same order, else all again."""
         old = self.placed
-        if old is not None and len(old) == len(placed) and all(a[0] == b[0] for a, b in zip(old, placed)):
-            for i, ((_, before), (_, now)) in enumerate(zip(old, placed)):
+        if old is not None and len(old) == len(placed) and all(a[0] == b[0] and a[2] == b[2]
+                                                               for a, b in zip(old, placed)):
+            for i, ((_, before, _), (_, now, _)) in enumerate(zip(old, placed)):
                 if before != now.tobytes():
                     self.scene.set_instance_transform(i, now)
                     self.counters["transforms_set"] += 1
         else:
             self.scene.clear_instances()
-            for mid, matrix in placed:
-                self.scene.add_instance(mid, matrix)
+            for mid, matrix, shadow in placed:
+                self.scene.add_instance(mid, matrix, visible_shadow=shadow)
             self.counters["instance_resets"] += 1
-        self.placed = [(mid, matrix.tobytes()) for mid, matrix in placed]
+        self.placed = [(mid, matrix.tobytes(), shadow) for mid, matrix, shadow in placed]
 
     # ---- lights, world ---------------------------------------------------------------------
     def _send_lights(self, specs: tuple[LightSpec, ...]) -> None:

@@ -276,7 +276,11 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       .def("clear_instances", &PyScene::clear_instances,
            "Removes every instance (meshes stay, with their BVHs), to place them again.")
       .def("add_instance", &PyScene::add_instance, py::arg("mesh"), py::arg("transform"),
-           "Places mesh `mesh` again with a (4, 4) row-major affine world matrix; returns the instance id.")
+           py::arg("visible_shadow") = Instance{}.visible_shadow,
+           "Places mesh `mesh` again with a (4, 4) row-major affine world matrix; returns the instance id.\n"
+           "visible_shadow: Blender's Object.visible_shadow; False, the instance casts no shadow in a render\n"
+           "(its light-sampled shadow rays pass it), while camera, glossy and glass rays and the ray queries\n"
+           "(intersect, occluded, ...) still see it.")
       .def("commit", &PyScene::commit, py::arg("builder") = builder_name(CommitOptions{}.builder),
            py::arg("threads") = CommitOptions{}.threads, py::arg("expected_rays") = py::none(),
            py::arg("should_cancel") = py::none(),

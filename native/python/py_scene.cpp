@@ -32,9 +32,9 @@ void PyScene::replace_mesh(int64_t mesh, py::handle vertices, py::handle triangl
   write([&] { scene_.replace_mesh(mesh, std::move(verts), std::move(tris), std::move(shading)); });
 }
 
-uint32_t PyScene::add_instance(int64_t mesh, py::handle transform) {
+uint32_t PyScene::add_instance(int64_t mesh, py::handle transform, bool visible_shadow) {
   const Mat4 m = to_matrix(transform, "transform");
-  return write([&] { return scene_.add_instance(mesh, m); });
+  return write([&] { return scene_.add_instance(mesh, m, visible_shadow); });
 }
 
 void PyScene::set_instance_transform(int64_t instance, py::handle transform) {

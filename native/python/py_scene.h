@@ -24,7 +24,7 @@ class PyScene {
                     py::handle material_ids, bool instance);
   void replace_mesh(int64_t mesh, py::handle vertices, py::handle triangles, py::handle normals, py::handle uvs,
                     py::handle material_ids);
-  uint32_t add_instance(int64_t mesh, py::handle transform);
+  uint32_t add_instance(int64_t mesh, py::handle transform, bool visible_shadow);
   void set_instance_transform(int64_t instance, py::handle transform);
   void clear_instances();
 

@@ -26,7 +26,7 @@ Vec3 glossy_direct_lighting(const Scene& scene, const Vec3& p, const Vec3& origi
     if (v.shadow) {
       const Ray shadow =
           std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
-      if (scene.occluded(shadow)) continue;
+      if (scene.shadowed(shadow)) continue;
     }
     // A delta lamp cannot be hit by the continuation ray: its sample is the only strategy.
     const float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, e.pdf);

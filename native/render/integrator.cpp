@@ -97,10 +97,12 @@ float mis_cos_over_pdf(float cos, float pdf, float other) { return cos * pdf / (
       env, image, sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 2), settings.seed));
   if (es.pdf > 0.0f) {
     const float cos_s = glm::dot(at.ns, es.wi);
-    if (cos_s > 0.0f && glm::dot(at.ng, es.wi) > 0.0f && !scene.occluded(Ray{at.origin, 0.0f, es.wi, kInfinity})) {
+    if (cos_s > 0.0f && glm::dot(at.ng, es.wi) > 0.0f && !scene.shadowed(Ray{at.origin, 0.0f, es.wi, kInfinity})) {
       sum += at.f * es.radiance * mis_cos_over_pdf(cos_s, es.pdf, cos_s * kInvPi);
     }
   }
+  // A BSDF-sampled direction is a path ray, not a shadow ray: an object with visible_shadow off
+  // still stops it, as Cycles' does (docs/lights.md).
   const CosineDirection c = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings);
   if (glm::dot(at.ng, c.wi) > 0.0f && c.cos > 0.0f && !scene.occluded(Ray{at.origin, 0.0f, c.wi, kInfinity}))
     sum += at.f * environment_radiance(env, image, c.wi) *
@@ -142,7 +144,7 @@ EmissiveTriangle emissive_triangle_at(const Scene& scene, const Hit& hit, const 
     if (ls.valid()) {
       const float cos_s = glm::dot(at.ns, ls.wi);
       if (cos_s > 0.0f && glm::dot(at.ng, ls.wi) > 0.0f &&
-          !scene.occluded(Ray{at.origin, 0.0f, ls.point - at.origin, 1.0f})) {
+          !scene.shadowed(Ray{at.origin, 0.0f, ls.point - at.origin, 1.0f})) {
         sum += at.f * ls.radiance * mis_cos_over_pdf(cos_s, ls.pdf, cos_s * kInvPi);
       }
     }
@@ -180,7 +182,7 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
       // light at infinity (the sun) leaves the scene along wi.
       const Ray shadow =
           std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
-      if (scene.occluded(shadow)) return;
+      if (scene.shadowed(shadow)) return;
     }
     sum += f * ls.radiance * (cos_s / (ls.pdf * select_probability));
   };
@@ -190,7 +192,7 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     sum += environment_lighting(scene, at, pixel, sample, settings);
   else if (world.background_lights_surfaces && world.background != Vec3(0.0f)) {
     // A constant background: a cosine-distributed direction makes the estimate f L cos / pdf =
-    // albedo L when nothing blocks it, exactly.
+    // albedo L when nothing blocks it, exactly. A BSDF-sampled ray: every object stops it.
     const Vec3 wi = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings).wi;
     if (glm::dot(ng, wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, wi, kInfinity}))
       sum += f * world.background * kPi;  // f = albedo / pi

@@ -12,6 +12,9 @@ struct Instance {
   Mat4 to_object{1.0f};  // its inverse: rays are carried into object space, t is unchanged
   bool identity = true;  // skips the ray transform for the common untransformed case
   BBox world_bounds;     // of the mesh's box corners, transformed
+  // Blender's Object.visible_shadow: whether the instance blocks the render's shadow rays
+  // (Scene::shadowed). Camera, glossy and glass rays and the ray API's queries see it regardless.
+  bool visible_shadow = true;
 };
 
 }  // namespace toyrt

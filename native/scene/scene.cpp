@@ -48,7 +48,7 @@ Mat4 Scene::checked_inverse(const Mat4& to_world) {
   return to_object;
 }
 
-uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world) {
+uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world, bool visible_shadow) {
   check_mesh_id(mesh);
   const Mat4 to_object = checked_inverse(to_world);
   Instance inst;
@@ -56,6 +56,7 @@ uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world) {
   inst.to_world = to_world;
   inst.to_object = to_object;
   inst.identity = to_world == Mat4(1.0f);
+  inst.visible_shadow = visible_shadow;
   instances_.push_back(inst);
   committed_ = false;
   return uint32_t(instances_.size() - 1);
@@ -272,6 +273,8 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
     for (uint32_t& id : top_.prim_ids) id = placed[id];
   });
   single_identity_ = instances_.size() == 1 && instances_[0].identity;
+  all_cast_shadows_ =
+      std::all_of(instances_.begin(), instances_.end(), [](const Instance& i) { return i.visible_shadow; });
   const auto gather_start = std::chrono::steady_clock::now();
   gather_emitters();
   stats_.emissive_triangles = emitters_.triangles.size();
@@ -281,7 +284,7 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-template <bool AnyHit>
+template <bool AnyHit, bool ShadowCastersOnly>
 bool Scene::trace(const Ray& ray, Hit& hit) const {
   if (!is_finite(ray.org) || !is_finite(ray.dir) || ray.dir == Vec3(0.0f) || std::isnan(ray.tnear) ||
       std::isnan(ray.tfar) || !(ray.tnear <= ray.tfar))
@@ -289,6 +292,9 @@ bool Scene::trace(const Ray& ray, Hit& hit) const {
   float tfar = ray.tfar;
   auto trace_instance = [&](uint32_t id, float& t_max) {
     const Instance& inst = instances_[id];
+    if constexpr (ShadowCastersOnly) {
+      if (!inst.visible_shadow) return false;
+    }
     const Mesh& mesh = *meshes_[inst.mesh];
     Vec3 org = ray.org, dir = ray.dir;
     if (!inst.identity) {
@@ -333,6 +339,11 @@ Hit Scene::intersect(const Ray& ray) const {
 bool Scene::occluded(const Ray& ray) const {
   Hit unused;
   return trace<true>(ray, unused);
+}
+
+bool Scene::occluded_by_shadow_casters(const Ray& ray) const {
+  Hit unused;
+  return trace<true, true>(ray, unused);
 }
 
 namespace {

@@ -91,7 +91,8 @@ class Scene {
   // Places mesh `mesh` with the affine object-to-world matrix `to_world`; returns the instance
   // id. Throws std::invalid_argument for an unknown mesh, a non-finite, non-affine (last row not
   // 0 0 0 1) or singular matrix.
-  uint32_t add_instance(int64_t mesh, const Mat4& to_world);
+  // `visible_shadow` false: the instance casts no shadow in a render (Instance::visible_shadow).
+  uint32_t add_instance(int64_t mesh, const Mat4& to_world, bool visible_shadow = true);
   // Edits for interactive updates (the viewport), each leaving the scene uncommitted; ids stay
   // valid. replace_mesh swaps a mesh's geometry and shading (its BVH is rebuilt by the next
   // commit, the instances placing it stay); set_instance_transform moves one instance (the next
@@ -137,6 +138,9 @@ class Scene {
   // non-finite origin, or tnear > tfar finds nothing.
   Hit intersect(const Ray& ray) const;
   bool occluded(const Ray& ray) const;
+  // The render's shadow rays: occluded() by the instances that cast shadows. Inline, so that a
+  // scene where every instance casts shadows calls occluded() as before (a flag test more).
+  bool shadowed(const Ray& ray) const { return all_cast_shadows_ ? occluded(ray) : occluded_by_shadow_casters(ray); }
 
   // Throws std::logic_error (naming commit()) unless the scene is committed.
   void check_committed() const;
@@ -166,8 +170,9 @@ class Scene {
   size_t memory_bytes() const;
 
  private:
-  template <bool AnyHit>
+  template <bool AnyHit, bool ShadowCastersOnly = false>
   bool trace(const Ray& ray, Hit& hit) const;
+  bool occluded_by_shadow_casters(const Ray& ray) const;
   // commit()'s work; throws BuildCancelled when *cancel turns true.
   void build(const CommitOptions& options, const std::atomic<bool>* cancel);
   void check_mesh_id(int64_t mesh) const;
@@ -185,6 +190,7 @@ class Scene {
   std::vector<Instance> instances_;
   Bvh top_;                       // over instances with a non-empty world box
   bool single_identity_ = false;  // one untransformed instance: skip the top level
+  bool all_cast_shadows_ = true;  // no instance with visible_shadow off: shadowed() is occluded()
   bool committed_ = false;
   CommitStats stats_;
 };

@@ -12,7 +12,9 @@ import bpy
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit (see harness)
-from closed_form import build_scene, render_error  # noqa: E402  (closed_form imports the kit)
+import kit  # noqa: E402
+import numpy as np  # noqa: E402
+from closed_form import build_scene, expected_image, render_error  # noqa: E402  (closed_form imports the kit)
 from harness import check, run_script  # noqa: E402
 
 
@@ -50,4 +52,49 @@ def main():
     check("camera" in (run.stdout + run.stderr).lower(), "the error says what is wrong")
 
 
-run_script([main], "engine")
+def objects_without_shadows():
+    """Object.visible_shadow off: a 0.2 m square 0.75 m above the plane, under the point light at
+    1 m, shades a 0.8 m square of the plane, of which the camera sees all but the middle 0.2 m
+    (the square itself). On that ring of pixels the render is black when the square casts shadows
+    and the open plane's closed form when it does not, also when the square is instanced by an
+    empty (a collection instance) whose own visible_shadow is off: Cycles' instances inherit it."""
+    c = (np.arange(32) + 0.5) / 32 * 2.0 - 1.0
+    x, y = np.meshgrid(c, c)
+    ring = (np.maximum(abs(x), abs(y)) > 0.15) & (np.maximum(abs(x), abs(y)) < 0.35)
+
+    def ring_of(name):
+        path = os.path.join(tempfile.mkdtemp(), name + ".exr")
+        bpy.context.scene.render.filepath = path
+        bpy.context.scene.render.image_settings.file_format = "OPEN_EXR"
+        bpy.ops.render.render(write_still=True)
+        return kit.read_image(path)[..., 0][ring]
+
+    build_scene()
+    blocker = kit.plane("blocker", 0.2, kit.diffuse("blocker_white", (1, 1, 1)), location=(0, 0, 0.75))
+    lit = expected_image()[ring]
+    dark = ring_of("casting")
+    check(dark.max() < 1e-6 * lit.max(), f"casting shadows, the ring is black (max {dark.max():.3g})")
+    blocker.visible_shadow = False
+    bright = ring_of("not_casting")
+    err = abs(bright - lit).max() / lit.max()
+    check(err < 0.01, f"with visible_shadow off the ring is the open plane's I cos / r^2 (max error {err:.4f})")
+
+    # The same square in a collection placed by an empty; the square casts shadows, the empty not.
+    blocker.visible_shadow = True
+    group = bpy.data.collections.new("shadowless_group")
+    for coll in blocker.users_collection:
+        coll.objects.unlink(blocker)
+    group.objects.link(blocker)
+    empty = kit.link(bpy.data.objects.new("instancer", None))
+    empty.instance_type = "COLLECTION"
+    empty.instance_collection = group
+    empty.visible_shadow = False
+    inherited = ring_of("instanced")
+    err = abs(inherited - lit).max() / lit.max()
+    check(err < 0.01, f"an instance of it under an empty without shadows casts none either (max error {err:.4f})")
+    empty.visible_shadow = True
+    dark = ring_of("instanced_casting")
+    check(dark.max() < 1e-6 * lit.max(), f"the empty casting shadows, the ring is black again ({dark.max():.3g})")
+
+
+run_script([main, objects_without_shadows], "engine")

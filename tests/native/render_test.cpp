@@ -47,6 +47,27 @@ TEST(Render, LambertFloorUnderAPointLightIsAlbedoOverPiTimesIntensityOverDistanc
   EXPECT_EQ(r.rgba[3], 1.0f);
 }
 
+TEST(Render, AnObjectWithoutShadowsLeavesTheFloorLitAsIfItWereNotThere) {
+  // A point light at (1, 0, 1) and a small triangle halfway to it, out of the camera ray's way:
+  // casting shadows it darkens the pixel entirely; with visible_shadow off the pixel is the
+  // closed form of the open floor (cos 45 degrees, r^2 = 2).
+  const float power = 100.0f;
+  const double expected = 0.5 / kPiD * power / (4.0 * kPiD) * (1.0 / std::sqrt(2.0)) / 2.0;
+  for (bool visible_shadow : {true, false}) {
+    Scene scene = floor_scene(0.5f);
+    const uint32_t blocker =
+        scene.add_mesh({{0.4f, -0.1f, 0.5f}, {0.6f, -0.1f, 0.5f}, {0.5f, 0.1f, 0.5f}}, {{0, 1, 2}});
+    scene.add_instance(blocker, Mat4(1.0f), visible_shadow);
+    scene.add_light(PointLight::make(Vec3(1.0f, 0.0f, 1.0f), power, Vec3(1.0f)));
+    scene.commit();
+    const RenderResult r = render(scene, pixel_above(1e-3f), few_samples(4));
+    if (visible_shadow)
+      EXPECT_EQ(r.rgba[0], 0.0f);
+    else
+      EXPECT_NEAR(r.rgba[0], expected, 1e-4 * expected);
+  }
+}
+
 TEST(Render, AutoLightSamplingSamplesEveryLightUpToFourThenOne) {
   Scene scene = floor_scene(0.5f);
   scene.commit();

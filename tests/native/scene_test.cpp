@@ -98,6 +98,29 @@ TEST(Scene, OccludedAgreesWithIntersect) {
   }
 }
 
+TEST(Scene, ShadowRaysPassInstancesWithoutShadowsThatEveryOtherQuerySees) {
+  // Two instances of one triangle on the ray's path, at z = 1 and z = 2; the one at z = 1
+  // casts no shadow.
+  Scene scene;
+  const uint32_t id = scene.add_mesh({{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}}, {{0, 1, 2}});
+  scene.add_instance(id, glm::translate(Mat4(1.0f), Vec3(0, 0, 1)), /*visible_shadow=*/false);
+  scene.add_instance(id, glm::translate(Mat4(1.0f), Vec3(0, 0, 2)));
+  scene.commit();
+  const Ray to_both{Vec3(0.0f), 0.0f, Vec3(0, 0, 1), 3.0f};
+  const Ray to_first{Vec3(0.0f), 0.0f, Vec3(0, 0, 1), 1.5f};
+  EXPECT_EQ(scene.intersect(to_both).instance, 0);  // the camera still sees the nearer one
+  EXPECT_TRUE(scene.occluded(to_first));            // and so do the ray API's queries
+  EXPECT_FALSE(scene.shadowed(to_first));           // a shadow ray passes it
+  EXPECT_TRUE(scene.shadowed(to_both));             // and stops at the one that casts shadows
+  // With every instance casting shadows, shadowed() is occluded() on every ray.
+  Scene all;
+  const uint32_t m = all.add_mesh(triangle_soup(2000, 0.05f, 5).vertices, triangle_soup(2000, 0.05f, 5).triangles);
+  all.add_instance(m, Mat4(1.0f));
+  all.add_instance(m, glm::translate(Mat4(1.0f), Vec3(0.3f, 0, 0)));
+  all.commit();
+  for (const Ray& r : random_rays(5000, 1.5f, 4)) EXPECT_EQ(all.shadowed(r), all.occluded(r));
+}
+
 TEST(Scene, TenThousandInstancesStoreTheMeshOnce) {
   const MeshData m = uv_sphere(100, 200);  // 39,600 triangles
   Scene scene;

@@ -75,6 +75,25 @@ def the_extension_installs_and_renders():
     check(err < 0.01, f"the render matches I cos / r^2 (max error {err:.4f} of the peak)")
 
 
+def the_farm_recipe_enables_it_with_addons():
+    """`blender -b --addons bl_ext.user_default.render_toyrt ...` (docs/farm.md) on a worker where the
+    extension is installed but not enabled: Blender hands the argument to
+    _bpy_internal.addons.cli.set_from_cli, called here as the command line does."""
+    from _bpy_internal.addons.cli import set_from_cli
+
+    addon_utils.disable(EXT_MODULE, default_set=True)
+    check(toyrt_engines() == [], "the extension installed but disabled: no TOYRT engine")
+    set_from_cli(EXT_MODULE)
+    check(toyrt_engines() == [f"{EXT_MODULE}.engine"], f"--addons {EXT_MODULE} enables it ({toyrt_engines()})")
+    build_scene()
+    err = render_error(home / "addons.exr")
+    check(err < 0.01, f"and it renders the closed form (max error {err:.4f})")
+    # The rest runs as a user left it: enabled in the preferences (--addons does not save it there).
+    addon_utils.disable(EXT_MODULE)
+    addon_utils.enable(EXT_MODULE, default_set=True)
+    check(toyrt_engines() == [f"{EXT_MODULE}.engine"], "enabled again from the preferences")
+
+
 def installing_it_again_keeps_one_working_copy():
     result, log = install_extension()
     check(result == {"FINISHED"}, f"the second install finished ({result})")
@@ -142,6 +161,7 @@ def the_legacy_addon_alone_enables_after_the_extension():
 
 
 run_script([the_legacy_addon_for_another_python_says_so, the_extension_installs_and_renders,
-            installing_it_again_keeps_one_working_copy, the_legacy_addon_beside_it_is_refused,
+            the_farm_recipe_enables_it_with_addons, installing_it_again_keeps_one_working_copy,
+            the_legacy_addon_beside_it_is_refused,
             the_legacy_addon_alone_enables_after_the_extension],
            f"extension (Blender {bpy.app.version_string}, Python {PYTHON})")
