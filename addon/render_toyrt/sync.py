@@ -389,6 +389,7 @@ class SceneSync(MaterialSync):
             self.scene.background = spec.background
             if spec.background_lighting is not None:
                 self.scene.background_lighting = spec.background_lighting
+            self.scene.background_visible_camera = spec.visible_camera
             if spec.environment is None:
                 self.scene.set_environment(-1)
             else:

@@ -26,6 +26,7 @@ class WorldSpec:
     background_lighting: bool | None         # None: no world, the scene's setting is left as it is
     notes: tuple[str, ...] = ()
     environment: EnvironmentSpec | None = None
+    visible_camera: bool = True              # camera rays see it (world.cycles_visibility.camera)
 
 
 def world_spec(bl_scene) -> WorldSpec:
@@ -39,8 +40,9 @@ def world_spec(bl_scene) -> WorldSpec:
     # Cycles lights diffuse surfaces with the world unless its diffuse ray visibility is off.
     visibility = getattr(world, "cycles_visibility", None)
     lighting = bool(getattr(visibility, "diffuse", True))
+    camera = bool(getattr(visibility, "camera", True))
     if not getattr(world, "use_nodes", False) or world.node_tree is None:
-        return WorldSpec(rgb(world.color), lighting)
+        return WorldSpec(rgb(world.color), lighting, visible_camera=camera)
     out = output_node(world.node_tree, "OUTPUT_WORLD")
     node = linked_node(input_socket(out, "Surface")) if out is not None else None
     if node is not None and node.type == "BACKGROUND":
@@ -48,13 +50,14 @@ def world_spec(bl_scene) -> WorldSpec:
         if not strength.is_linked:
             s = float(strength.default_value)
             if not color.is_linked:
-                return WorldSpec(tuple(c * s for c in rgb(color.default_value)), lighting)
+                return WorldSpec(tuple(c * s for c in rgb(color.default_value)), lighting, visible_camera=camera)
             source = linked_node(color)
             if source is not None and source.type == "TEX_ENVIRONMENT":
                 notes: list[str] = []
                 env = _environment(world.name, source, s, notes)
-                return WorldSpec((0.0, 0.0, 0.0), lighting, tuple(notes), env)
-    return WorldSpec((0.0, 0.0, 0.0), lighting, (f"world '{world.name}': not a plain colour (black)",))
+                return WorldSpec((0.0, 0.0, 0.0), lighting, tuple(notes), env, visible_camera=camera)
+    return WorldSpec((0.0, 0.0, 0.0), lighting, (f"world '{world.name}': not a plain colour (black)",),
+                     visible_camera=camera)
 
 
 def _environment(name, node, strength, notes) -> EnvironmentSpec:

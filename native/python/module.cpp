@@ -236,6 +236,11 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
            "centre column looks along -X, its top row up (+Z). texture=-1 removes the environment.")
       .def_property("background_lighting", &PyScene::background_lighting, &PyScene::set_background_lighting,
                     "Whether the background also lights diffuse surfaces, as Cycles' world does (default True).")
+      .def_property("background_visible_camera", &PyScene::background_visible_camera,
+                    &PyScene::set_background_visible_camera,
+                    "Whether camera rays that leave the scene see the background (default True; Blender's\n"
+                    "world.cycles_visibility.camera). Off, they see black, still opaque, as in Cycles; rays through\n"
+                    "glass or off glossy surfaces, and the lighting, are unchanged.")
       .def("render", &PyScene::render, py::arg("camera"), py::arg("samples") = RenderSettings{}.samples,
            py::arg("seed") = IntegratorSettings{}.seed,
            py::arg("max_specular_depth") = IntegratorSettings{}.max_specular_depth,

@@ -134,6 +134,14 @@ bool PyScene::background_lighting() {
   return read([&] { return scene_.world().background_lights_surfaces; });
 }
 
+void PyScene::set_background_visible_camera(bool on) {
+  write([&] { scene_.set_background_visible_camera(on); });
+}
+
+bool PyScene::background_visible_camera() {
+  return read([&] { return scene_.world().background_visible_camera; });
+}
+
 bool PyScene::commit(const std::string& builder, int threads, py::handle expected_rays, py::object should_cancel) {
   CommitOptions options;
   options.builder = parse_builder(builder);

@@ -40,6 +40,8 @@ class PyScene {
   py::tuple background();
   void set_background_lighting(bool on);
   bool background_lighting();
+  void set_background_visible_camera(bool on);
+  bool background_visible_camera();
   void set_environment(int64_t texture, py::handle strength, py::handle matrix);
 
   bool commit(const std::string& builder, int threads, py::handle expected_rays, py::object should_cancel);

@@ -254,6 +254,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
                                               settings.area_sampling, bsdf_pdf);
     }
     if (!hit.found()) {
+      if (depth == 0 && !world.background_visible_camera) break;
       const Environment& env = world.environment;
       const Vec3 seen = env.active()
                             ? environment_radiance(env, scene.textures()[size_t(env.texture)], glm::normalize(ray.dir))

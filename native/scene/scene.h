@@ -117,6 +117,7 @@ class Scene {
   void clear_lights();                        // lights are re-sent as a whole on an edit: they are few and cheap
   void set_background(const Vec3& radiance);  // finite and >= 0
   void set_background_lighting(bool on) { world_.background_lights_surfaces = on; }
+  void set_background_visible_camera(bool on) { world_.background_visible_camera = on; }
   // The world's Environment Texture: texture `texture` (an equirectangular image) times strength,
   // looked up along to_map * direction (scene/environment.h); it replaces the background colour
   // for rays that leave the scene. texture -1 removes it. Throws std::invalid_argument for an

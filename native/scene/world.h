@@ -29,6 +29,10 @@ struct World {
   // Whether the background also lights diffuse surfaces (Cycles samples the world as a light;
   // Blender's world ray visibility for diffuse rays turns it off).
   bool background_lights_surfaces = true;
+  // Whether camera rays that leave the scene see it (Blender's world ray visibility for camera
+  // rays, world.cycles_visibility.camera): off, they see black, still opaque, as in Cycles
+  // (transparency is the film's setting). Rays through glass and off glossy surfaces see it.
+  bool background_visible_camera = true;
 };
 
 }  // namespace toyrt

@@ -130,6 +130,23 @@ def test_one_pixel_environment_is_a_uniform_world():
           f"a 1 x 1 environment of 0.6 lights a floor of albedo 0.5 with {got:.4f} (0.3)")
 
 
+def test_a_world_hidden_from_the_camera_still_lights_the_floor():
+    """World > Ray Visibility > Camera off (world.cycles_visibility.camera): the camera sees black
+    where it sees the sky, while the world lights the floor with albedo x L as before."""
+    scene_with_floor(0.5)
+    environment(np.full((1, 1, 3), 0.6, np.float32), "hidden_sky")
+    kit.toyrt(bpy.context.scene, samples=64, seed=0)
+    bpy.context.scene.world.cycles_visibility.camera = False
+    result, floor_px, _ = render("hidden_sky_floor")
+    kit.camera((0, 0, 0), rotation=(math.pi, 0, 0), ortho_scale=1.0)   # looking straight up at the sky
+    _, sky_px, _ = render("hidden_sky_up")
+    floor = float(floor_px[..., 0].mean()) if floor_px is not None else float("nan")
+    sky = sky_px[..., :4].reshape(-1, 4) if sky_px is not None else np.ones((1, 4))
+    check(result == {"FINISHED"} and abs(floor - 0.3) <= 0.01 * 0.3 and (sky[:, :3] == 0).all()
+          and (sky[:, 3] == 1).all(), f"the floor is still lit ({floor:.4f}, 0.3); the sky is opaque black "
+          f"(max {sky[:, :3].max():.3g})")
+
+
 def test_principled_emission_is_seen_as_colour_times_strength():
     scene_with_floor()
     mat = kit.principled("glowing", (0.5, 0.5, 0.5))
@@ -146,5 +163,6 @@ def test_principled_emission_is_seen_as_colour_times_strength():
 PARTS = [test_sun_over_a_floor_gives_strength_cos_over_pi, test_portal_is_not_a_light,
          test_shadow_switch_removes_the_shadow, test_missing_environment_image_is_magenta_with_one_note,
          test_non_finite_texels_are_noted_and_the_image_stays_finite, test_one_pixel_environment_is_a_uniform_world,
+         test_a_world_hidden_from_the_camera_still_lights_the_floor,
          test_principled_emission_is_seen_as_colour_times_strength]
 run_script(PARTS, "lights and world", TMP)

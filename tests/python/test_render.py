@@ -233,6 +233,34 @@ def test_a_uniform_background_lights_an_open_plane_with_albedo_times_its_radianc
     assert (s.render(camera_above(size=0.5, resolution=4), samples=4)[..., :3] == 0).all()
 
 
+def test_a_world_hidden_from_the_camera_is_black_behind_objects_but_still_lights_and_shows_through_glass():
+    """background_visible_camera=False (Blender's world camera ray visibility): camera rays that
+    leave the scene see opaque black; the floor's world lighting (albedo * L) and the world seen
+    through a refracting slab (exactly L, as above) are unchanged."""
+    s = floor_scene(albedo=0.6, half=1.0)  # a 2 m floor: the 4 m view sees past its edges
+    s.background = (0.5, 1.0, 2.0)
+    s.add_material("refraction", ior=1.5)
+    v = np.array([[x, y, z] for x in (1.2, 1.8) for y in (-0.3, 0.3) for z in (0.1, 0.4)], np.float32)
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    s.add_mesh(v, [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))], material_ids=1)
+    s.commit()
+    cam = camera_above(size=4.0, resolution=40)
+    shown = s.render(cam, samples=64)
+    assert s.background_visible_camera
+    s.background_visible_camera = False
+    hidden = s.render(cam, samples=64)
+    c = (np.arange(40) + 0.5) / 40 * 4.0 - 2.0  # pixel centres, 0.1 m apart
+    x, y = np.meshgrid(c, -c)  # rows from the top
+    on_floor = (abs(x) < 0.9) & (abs(y) < 0.9)
+    off_floor = (np.maximum(abs(x), abs(y)) > 1.1) & ~((abs(x - 1.5) < 0.4) & (abs(y) < 0.4))
+    through_glass = (abs(x - 1.5) < 0.2) & (abs(y) < 0.2)
+    np.testing.assert_allclose(shown[off_floor][:, :3], np.broadcast_to([0.5, 1.0, 2.0], (off_floor.sum(), 3)))
+    assert (hidden[off_floor][:, :3] == 0).all() and (hidden[off_floor][:, 3] == 1).all()
+    np.testing.assert_array_equal(hidden[on_floor], shown[on_floor])  # the same lighting, sample for sample
+    np.testing.assert_allclose(hidden[through_glass][:, :3], np.broadcast_to([0.5, 1.0, 2.0], (through_glass.sum(), 3)),
+                               rtol=1e-6)
+
+
 def glass_plane_under_a_light(split_depth_scene_power=40.0, size=20.0):
     """A glass (Fresnel) plane at z = 0 seen straight down by an ortho camera at z = 5, and a large
     area light at z = 3 facing down, which camera rays pass (visible_camera=False) but the
