@@ -185,8 +185,13 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             for name, values in zip(cryptomatte.pass_names(kind, len(rgba)), rgba):
                 if layer.get(name) is not None:
                     _set_rect(layer[name].rect, np.ascontiguousarray(values[::-1]))
-            cryptomatte.stamp(result, layer_name, kind, tables.names(kind.native), tables.hashes)
         self.end_result(result)
+        if tables.cryptomatte:
+            # Into the engine's whole result, as Cycles does: a partial result's metadata is not
+            # merged by end_result.
+            full = self.get_result()
+            for kind in tables.cryptomatte:
+                cryptomatte.stamp(full, layer_name, kind, tables.names(kind.native), tables.hashes)
 
     @staticmethod
     def _threads(scene):
