@@ -2,8 +2,9 @@
 and any reader of the specification (Psyop's Cryptomatte 1.2) pick mattes from TOYRT's renders:
 
 - the View Layer's switches (use_pass_cryptomatte_object / _material / _asset, pass_cryptomatte_depth)
-  turn them on; each kind is (depth + 1) // 2 RGBA passes named CryptoObject00, CryptoObject01, ...
-  (CryptoMaterial.., CryptoAsset..), each holding two (id, coverage) pairs: Cycles' layout;
+  turn them on; each kind is (depth + 1) // 2 passes of channels r, g, b, a named CryptoObject00,
+  CryptoObject01, ... (CryptoMaterial.., CryptoAsset..), each holding two (id, coverage) pairs:
+  Cycles' layout;
 - an id is MurmurHash3_32 (seed 0) of the UTF-8 name, its 32 bits read as a float32 whose exponent
   is kept off 0 and 255 (no denormal, infinity or NaN): the specification's uint32_to_float32;
 - the names are Cycles': the object's name (an instance's: the instanced object's), the material's
@@ -125,10 +126,12 @@ def pass_names(kind: Kind, count: int) -> list[str]:
 
 
 def register(engine, scene, view_layer) -> None:
-    """update_render_passes' part: the RGBA passes of every kind turned on."""
+    """update_render_passes' part: the RGBA passes of every kind turned on. Their channels are
+    lower-case r, g, b, a as Cycles names them (the specification's names, which OpenEXR's DWA
+    compression also keeps lossless)."""
     for kind in enabled(view_layer):
         for name in pass_names(kind, layers(view_layer)):
-            engine.register_pass(scene, view_layer, name, 4, "RGBA", "COLOR")
+            engine.register_pass(scene, view_layer, name, 4, "rgba", "COLOR")
 
 
 def asset_name(obj) -> str:

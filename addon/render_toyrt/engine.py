@@ -57,7 +57,7 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             report.error(f"render failed: {err}", self.report)
 
     def _render(self, depsgraph, toyrt):
-        from . import cryptomatte, denoise, passes, report, sync
+        from . import denoise, passes, report, sync
         from .camera import export_camera
 
         scene = depsgraph.scene
@@ -141,7 +141,7 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             object_index=np.array(tables.object_pass_index, np.float32),
             material_index=np.array(tables.material_pass_index, np.float32),
             cryptomatte=tables.cryptomatte_ids(),
-            cryptomatte_depth=cryptomatte.depth(depsgraph.view_layer) if crypto else 0)
+            cryptomatte_depth=tables.cryptomatte_depth)
         info = t_scene.last_render
         if info["cancelled"]:
             return
@@ -181,7 +181,11 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
                 values = np.zeros((height, width, len(p.channels)), np.float32)  # a pass TOYRT leaves black
             _set_rect(target.rect, np.ascontiguousarray(values[::-1]))
         for kind in tables.cryptomatte:
-            rgba = cryptomatte.split(computed["cryptomatte_" + kind.native])
+            # None for a kind with no id to look up (a scene without objects): no id anywhere.
+            pairs = computed.get("cryptomatte_" + kind.native)
+            if pairs is None:
+                pairs = np.zeros((height, width, tables.cryptomatte_depth * 2), np.float32)
+            rgba = cryptomatte.split(pairs)
             for name, values in zip(cryptomatte.pass_names(kind, len(rgba)), rgba):
                 if layer.get(name) is not None:
                     _set_rect(layer[name].rect, np.ascontiguousarray(values[::-1]))
@@ -191,7 +195,7 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             # merged by end_result.
             full = self.get_result()
             for kind in tables.cryptomatte:
-                cryptomatte.stamp(full, layer_name, kind, tables.names(kind.native), tables.hashes)
+                cryptomatte.stamp(full, layer_name, kind, tables.manifest_names(kind.native), tables.hashes)
 
     @staticmethod
     def _threads(scene):

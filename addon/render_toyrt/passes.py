@@ -109,12 +109,14 @@ class PassTables:
 
     def __init__(self, view_layer=None, hashes: cryptomatte.Hashes | None = None) -> None:
         self.cryptomatte = cryptomatte.enabled(view_layer)
+        self.cryptomatte_depth = cryptomatte.depth(view_layer) if self.cryptomatte else 0  # pairs per pixel
         self.hashes = hashes if hashes is not None else cryptomatte.Hashes()  # kept from frame to frame
         self.object_pass_index: list[int] = []
         self.material_pass_index: list[int] = []
         self.object_names: list[str] = []   # per instance (Cryptomatte asked for)
         self.asset_names: list[str] = []
         self.material_names: list[str] = []  # per material id
+        self.material_manifest: list[str] = []  # the materials this walk saw, and Cycles' default shader
 
     def add(self, obj) -> None:
         """The next instance, showing the (evaluated) object `obj`."""
@@ -128,9 +130,16 @@ class PassTables:
         self.material_pass_index = per_material_id(materials, used)
         if self.cryptomatte:
             self.material_names = cryptomatte.material_names(materials, used)
+            self.material_manifest = [cryptomatte.DEFAULT_SURFACE] + [mat.name for mat in used.values()]
 
     def names(self, kind: str) -> list[str]:
+        """The name of each instance ('object', 'asset') or material id ('material')."""
         return {"object": self.object_names, "material": self.material_names, "asset": self.asset_names}[kind]
+
+    def manifest_names(self, kind: str) -> list[str]:
+        """The names the manifest lists: every instance's (Cycles lists every object), the materials
+        this frame uses (sync keeps the ids of earlier frames' too) beside Cycles' default shader."""
+        return self.material_manifest if kind == "material" else self.names(kind)
 
     def cryptomatte_ids(self) -> dict | None:
         """render()'s `cryptomatte`: the float32 ids per instance / material id of each kind asked for."""

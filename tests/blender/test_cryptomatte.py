@@ -73,8 +73,8 @@ def multilayer_exr(scene):
 
 def read_exr(path):
     """({pass name: (h, w, channels) float32} of the ViewLayer, channels in file order r, g, b, a;
-    {metadata key: value} of the cryptomatte/ keys) of a multilayer EXR (3.4: one part, 5.x: a
-    part per pass)."""
+    {metadata key: value} of the cryptomatte/ keys, and 'channels': the Crypto channels' full names)
+    of a multilayer EXR (3.4: one part, 5.x: a part per pass)."""
     import OpenImageIO as oiio
 
     inp = oiio.ImageInput.open(path)
@@ -92,6 +92,7 @@ def read_exr(path):
                 if layer == "ViewLayer":
                     grouped.setdefault(name, []).append((chan, pixels[:, :, k]))
             meta.update({a.name: a.value for a in spec.extra_attribs if a.name.startswith("cryptomatte/")})
+            meta.setdefault("channels", []).extend(n for n in spec.channelnames if ".Crypto" in n)
             part += 1
     finally:
         inp.close()
@@ -129,7 +130,7 @@ def manifests(meta):
     """{'Object' | 'Material' | 'Asset': {name: hex}} and the keys, from the cryptomatte/ metadata."""
     out = {}
     for key, value in meta.items():
-        if key.endswith("/name") and value.startswith("ViewLayer.Crypto"):
+        if key != "channels" and key.endswith("/name") and value.startswith("ViewLayer.Crypto"):
             prefix = key[:-len("name")]
             out[value[len("ViewLayer.Crypto"):]] = json.loads(meta.get(prefix + "manifest", "{}"))
     return out
@@ -202,7 +203,8 @@ def toyrt_cryptomatte_equals_cycles():
     check(result == {"FINISHED"}, "Cycles renders the same scene")
     crypto = sorted(n for n in c if n.startswith("Crypto"))
     check(crypto == sorted(n for n in t if n.startswith("Crypto")), f"the same Cryptomatte passes as Cycles ({crypto})")
-    check(all(t[n].shape == c[n].shape for n in crypto if n in t), "the same channels (r, g, b, a) per pass")
+    check(sorted(t_meta.get("channels", [])) == sorted(c_meta.get("channels", [])),
+          f"the same channels, named as Cycles' ({c_meta.get('channels', [])[:4]} ...)")
     for kind in KINDS:
         tp, cp = pairs(t, kind), pairs(c, kind)
         if tp.shape != cp.shape:
@@ -223,7 +225,7 @@ def toyrt_cryptomatte_equals_cycles():
         a, b = tm.get(kind, {}), cm.get(kind, {})
         check(a and all(b.get(n) == h for n, h in a.items()), f"{kind} manifest: each name has Cycles' id ({a})")
     check({k.rsplit("/", 1)[0] for k in t_meta} == {k.rsplit("/", 1)[0] for k in c_meta}
-          and all(t_meta[k] == c_meta[k] for k in t_meta if not k.endswith("/manifest")),
+          and all(t_meta[k] == c_meta[k] for k in t_meta if k != "channels" and not k.endswith("/manifest")),
           "the metadata keys, layer names, hash and conversion equal Cycles'")
 
 
@@ -295,6 +297,24 @@ def largest_and_odd_depths_are_cycles_layers():
               f"depth {depth}: {layers} layers per kind, as Cycles ({got})")
 
 
+def a_scene_without_objects_renders_empty_mattes():
+    s = kit.clear_scene()
+    kit.camera((0.0, 0.0, 5.0))
+    kit.world((0.1, 0.1, 0.1))
+    kit.output(s, 16, 12)
+    layer = bpy.context.view_layer
+    layer.use_pass_cryptomatte_object = layer.use_pass_cryptomatte_material = True
+    layer.use_pass_cryptomatte_asset = True
+    layer.pass_cryptomatte_depth = 6
+    t, meta, result = render("TOYRT", samples=2, tag="_empty")
+    check(result == {"FINISHED"}, f"F12 of a scene with no object and Cryptomatte on finishes ({result})")
+    check(all(np.all(pairs(t, k) == 0.0) and pairs(t, k).shape[2] == 6 for k in KINDS),
+          "its Cryptomatte passes are there, with no id")
+    # Cycles lists its default shader whatever the scene: so does TOYRT.
+    check(manifests(meta) == {"Object": {}, "Asset": {}, "Material": {"default_surface": "78d05529"}},
+          f"and empty manifests but for Cycles' default shader ({manifests(meta)})")
+
+
 def many_objects_manifest_time_and_memory():
     """10,000 objects, each its own name: the sync's names and the manifests' cost, measured."""
     from render_toyrt import cryptomatte, passes
@@ -347,4 +367,4 @@ def many_objects_manifest_time_and_memory():
 
 run_script([toyrt_cryptomatte_against_known_answers, toyrt_cryptomatte_equals_cycles,
             blenders_cryptomatte_node_picks_the_matte, largest_and_odd_depths_are_cycles_layers,
-            many_objects_manifest_time_and_memory], "cryptomatte", TMP)
+            a_scene_without_objects_renders_empty_mattes, many_objects_manifest_time_and_memory], "cryptomatte", TMP)
