@@ -157,6 +157,9 @@ STATE = {}
 
 
 def toyrt_cryptomatte_against_known_answers():
+    panel = getattr(bpy.types, "VIEWLAYER_PT_toyrt_passes_cryptomatte", None)
+    check(panel is not None and panel.bl_parent_id == "VIEWLAYER_PT_toyrt_passes",
+          "a Cryptomatte panel under TOYRT's Passes (View Layer tab), as Cycles has")
     build_scene()
     t, meta, result = render("TOYRT")
     STATE["toyrt"] = (t, meta)
