@@ -130,14 +130,18 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             report.note(denoise.available(), self.report)  # the frame is still rendered, not denoised
         if denoising:
             computed += [a for a in denoise.AUXILIARIES if a not in computed]
+        tables = cache.pass_tables
+        crypto = tables.cryptomatte  # the Cryptomatte kinds asked for (cryptomatte.py)
         progress.rendering()
         image = t_scene.render(
             camera, samples=samples, seed=settings.seed + frame, max_specular_depth=settings.max_specular_depth,
             area_light_sampling=settings.area_light_sampling, light_sampling=settings.light_sampling,
             threads=self._threads(scene), tile_size=tile, on_tile=on_tile, should_cancel=progress.poll,
             passes=computed, mist=passes.mist(scene.world),
-            object_index=np.array(cache.object_pass_index, np.float32),
-            material_index=np.array(cache.material_pass_index, np.float32))
+            object_index=np.array(tables.object_pass_index, np.float32),
+            material_index=np.array(tables.material_pass_index, np.float32),
+            cryptomatte=tables.cryptomatte_ids(),
+            cryptomatte_depth=tables.cryptomatte_depth)
         info = t_scene.last_render
         if info["cancelled"]:
             return
@@ -146,18 +150,20 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             noisy, image = image, denoise.denoise(image, t_scene.last_passes)
         else:
             noisy = image
-        if wanted or settings.use_denoising:
+        if wanted or settings.use_denoising or crypto:
             self._write_passes(image, t_scene.last_passes, wanted, noisy if settings.use_denoising else None,
-                               layer_name)
+                               layer_name, tables)
         elapsed = time.perf_counter() - started
         progress.finished(f"Export {stats['export_s'] * 1000:.0f} ms, BVH {build_ms:.0f} ms, "
                           f"Render {info['render_ms'] / 1000:.2f} s, {stats.get('triangles', 0):,} triangles")
         print(f"TOYRT: frame {frame} done in {elapsed:.2f} s ({image.shape[1]}x{image.shape[0]}, {samples} samples)",
               flush=True)
 
-    def _write_passes(self, image, computed, wanted, noisy, layer_name):
+    def _write_passes(self, image, computed, wanted, noisy, layer_name, tables):
         """The whole frame once more, every pass beside Combined (tiles stream Combined only) and,
-        when denoising, the render before it as the Noisy Image pass."""
+        when denoising, the render before it as the Noisy Image pass; the Cryptomatte layers and
+        their manifests in the result's metadata."""
+        from . import cryptomatte
         from .passes import NOISY
 
         height, width = image.shape[:2]
@@ -174,7 +180,22 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             if values is None:
                 values = np.zeros((height, width, len(p.channels)), np.float32)  # a pass TOYRT leaves black
             _set_rect(target.rect, np.ascontiguousarray(values[::-1]))
+        for kind in tables.cryptomatte:
+            # None for a kind with no id to look up (a scene without objects): no id anywhere.
+            pairs = computed.get("cryptomatte_" + kind.native)
+            if pairs is None:
+                pairs = np.zeros((height, width, tables.cryptomatte_depth * 2), np.float32)
+            rgba = cryptomatte.split(pairs)
+            for name, values in zip(cryptomatte.pass_names(kind, len(rgba)), rgba):
+                if layer.get(name) is not None:
+                    _set_rect(layer[name].rect, np.ascontiguousarray(values[::-1]))
         self.end_result(result)
+        if tables.cryptomatte:
+            # Into the engine's whole result, as Cycles does: a partial result's metadata is not
+            # merged by end_result.
+            full = self.get_result()
+            for kind in tables.cryptomatte:
+                cryptomatte.stamp(full, layer_name, kind, tables.manifest_names(kind.native), tables.hashes)
 
     @staticmethod
     def _threads(scene):

@@ -10,6 +10,8 @@ from typing import NamedTuple
 
 import bpy
 
+from . import cryptomatte
+
 
 class Pass(NamedTuple):
     prop: str       # the View Layer property that turns it on
@@ -66,6 +68,7 @@ def register(engine, scene, view_layer) -> None:
     engine.register_pass(scene, view_layer, "Combined", 4, "RGBA", "COLOR")
     for p in enabled(view_layer):
         engine.register_pass(scene, view_layer, p.name, len(p.channels), p.channels, p.kind)
+    cryptomatte.register(engine, scene, view_layer)
     if denoising(scene):
         engine.register_pass(scene, view_layer, NOISY, 4, "RGBA", "COLOR")
 
@@ -96,3 +99,48 @@ def per_material_id(materials: dict, used: dict) -> list[int]:
     Blender materials the walk saw (0 for an id none of them has)."""
     ids = {materials[name][0]: mat.pass_index for name, mat in used.items() if name in materials}
     return [ids.get(k, 0) for k in range(max(ids, default=-1) + 1)]
+
+
+class PassTables:
+    """What the index and Cryptomatte passes need to know of each instance (in the native scene's
+    instance order) and each material id, gathered by sync's walk of a final render. The names
+    are read only when the View Layer asks for a Cryptomatte pass: a scene of many objects pays
+    for them only then."""
+
+    def __init__(self, view_layer=None, hashes: cryptomatte.Hashes | None = None) -> None:
+        self.cryptomatte = cryptomatte.enabled(view_layer)
+        self.cryptomatte_depth = cryptomatte.depth(view_layer) if self.cryptomatte else 0  # pairs per pixel
+        self.hashes = hashes if hashes is not None else cryptomatte.Hashes()  # kept from frame to frame
+        self.object_pass_index: list[int] = []
+        self.material_pass_index: list[int] = []
+        self.object_names: list[str] = []   # per instance (Cryptomatte asked for)
+        self.asset_names: list[str] = []
+        self.material_names: list[str] = []  # per material id
+        self.material_manifest: list[str] = []  # the materials this walk saw, and Cycles' default shader
+
+    def add(self, obj) -> None:
+        """The next instance, showing the (evaluated) object `obj`."""
+        self.object_pass_index.append(obj.pass_index)
+        if self.cryptomatte:
+            self.object_names.append(obj.name)
+            self.asset_names.append(cryptomatte.asset_name(obj))
+
+    def finish(self, materials: dict, used: dict) -> None:
+        """The per-material-id tables, from sync's name -> (id, spec) table and the materials seen."""
+        self.material_pass_index = per_material_id(materials, used)
+        if self.cryptomatte:
+            self.material_names = cryptomatte.material_names(materials, used)
+            self.material_manifest = [cryptomatte.DEFAULT_SURFACE] + [mat.name for mat in used.values()]
+
+    def names(self, kind: str) -> list[str]:
+        """The name of each instance ('object', 'asset') or material id ('material')."""
+        return {"object": self.object_names, "material": self.material_names, "asset": self.asset_names}[kind]
+
+    def manifest_names(self, kind: str) -> list[str]:
+        """The names the manifest lists: every instance's (Cycles lists every object), the materials
+        this frame uses (sync keeps the ids of earlier frames' too) beside Cycles' default shader."""
+        return self.material_manifest if kind == "material" else self.names(kind)
+
+    def cryptomatte_ids(self) -> dict | None:
+        """render()'s `cryptomatte`: the float32 ids per instance / material id of each kind asked for."""
+        return {k.native: self.hashes.ids(self.names(k.native)) for k in self.cryptomatte} or None

@@ -82,9 +82,8 @@ class SceneSync(MaterialSync):
         self.texture_notes: dict[ImageKey, tuple[str, ...]] = {}
         self.lights: tuple[LightSpec, ...] | None = None   # the light specs last sent
         self.world: WorldSpec | None = None
-        # Object / Material Index passes (final-render walks): pass_index per instance, per material id.
-        self.object_pass_index: list[int] = []
-        self.material_pass_index: list[int] = []
+        # Index and Cryptomatte passes (final-render walks): per instance, per material id.
+        self.pass_tables = passes.PassTables()
         self._should_cancel: Callable[[], bool] | None = None   # set by sync() for a full walk
         self._converted_now: set[str] = set()  # materials converted during the current walk
         self.synced = False
@@ -185,7 +184,8 @@ class SceneSync(MaterialSync):
         instances, lights and the world compared with what the native scene has."""
         t0 = time.perf_counter()
         self.counters["walks"] += 1
-        placed, seen, exported_now, light_specs, pass_index = [], set(), set(), [], []
+        placed, seen, exported_now, light_specs = [], set(), set(), []
+        tables = passes.PassTables(depsgraph.view_layer if fingerprints else None, self.pass_tables.hashes)
         used_materials = {}
         tri_instanced = 0
         pool, by_fingerprint, owners = {}, {}, {}
@@ -257,7 +257,7 @@ class SceneSync(MaterialSync):
                 if owner is not None and bake is None:
                     owners.setdefault(owner, []).append(len(placed))
                 placed.append((entry[0], _IDENTITY if bake is not None else matrix, casts_shadow(inst, obj)))
-                pass_index.append(obj.pass_index)
+                tables.add(obj)
                 tri_instanced += entry[1]
 
         for entry in pool.values():
@@ -274,8 +274,8 @@ class SceneSync(MaterialSync):
             for name, mat in used_materials.items():
                 if name not in self._converted_now:
                     self.counters["materials_converted"] += self._reconvert(mat)
-            self.object_pass_index = pass_index
-            self.material_pass_index = passes.per_material_id(self.materials, used_materials)
+            tables.finish(self.materials, used_materials)
+            self.pass_tables = tables
         live = [e for e in self.meshes.values() if e[0] >= 0]
         tri_stored = sum(e[1] for e in live)
         self.stats = dict(export_s=time.perf_counter() - t0, meshes=len(live), instances=len(placed),

@@ -4,6 +4,8 @@ import textwrap
 
 import bpy
 
+from . import cryptomatte
+
 # Blender's own panels that work unchanged with TOYRT (as Blender's custom-engine example does).
 COMPATIBLE_PANELS = (
     "RENDER_PT_format", "RENDER_PT_frame_range", "RENDER_PT_output", "RENDER_PT_encoding",
@@ -72,6 +74,27 @@ class VIEWLAYER_PT_toyrt_passes(ToyrtPanel, bpy.types.Panel):
         col.prop(view_layer, "use_pass_emit", text="Emission")
 
 
+class VIEWLAYER_PT_toyrt_passes_cryptomatte(ToyrtPanel, bpy.types.Panel):
+    """The View Layer's Cryptomatte switches (cryptomatte.py), under Passes as in Cycles, with
+    Blender's labels (3.4's Accurate Mode is EEVEE's: not shown)."""
+    bl_label = "Cryptomatte"
+    bl_context = "view_layer"
+    bl_parent_id = "VIEWLAYER_PT_toyrt_passes"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        view_layer = context.view_layer
+        col = layout.column()
+        col.prop(view_layer, "use_pass_cryptomatte_object", text="Object")
+        col.prop(view_layer, "use_pass_cryptomatte_material", text="Material")
+        col.prop(view_layer, "use_pass_cryptomatte_asset", text="Asset")
+        col = layout.column()
+        col.active = bool(cryptomatte.enabled(view_layer))
+        col.prop(view_layer, "pass_cryptomatte_depth", text="Levels")
+
+
 def _panels():
     for name in COMPATIBLE_PANELS:
         panel = getattr(bpy.types, name, None)
@@ -82,6 +105,7 @@ def _panels():
 def register() -> None:
     bpy.utils.register_class(RENDER_PT_toyrt)
     bpy.utils.register_class(VIEWLAYER_PT_toyrt_passes)
+    bpy.utils.register_class(VIEWLAYER_PT_toyrt_passes_cryptomatte)
     for panel in _panels():
         panel.COMPAT_ENGINES.add("TOYRT")
 
@@ -89,5 +113,6 @@ def register() -> None:
 def unregister() -> None:
     for panel in _panels():
         panel.COMPAT_ENGINES.discard("TOYRT")
+    bpy.utils.unregister_class(VIEWLAYER_PT_toyrt_passes_cryptomatte)
     bpy.utils.unregister_class(VIEWLAYER_PT_toyrt_passes)
     bpy.utils.unregister_class(RENDER_PT_toyrt)

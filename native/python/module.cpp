@@ -136,7 +136,13 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       "(first sample), 'normal' (world, averaged), 'diffuse_color' (albedo, averaged),\n"
       "'emission', 'object_index', 'material_index' (first sample). mist: (start, depth, falloff exponent) in\n"
       "metres, as world.mist_settings (falloff QUADRATIC 2, LINEAR 1, INVERSE_QUADRATIC 0.5). object_index:\n"
-      "a value per instance (object pass_index), material_index: per material id (material pass_index).");
+      "a value per instance (object pass_index), material_index: per material id (material pass_index).\n"
+      "cryptomatte: {'object' | 'asset': an id per instance, 'material': an id per material id} (float32\n"
+      "Cryptomatte ids: MurmurHash3_32 of the name as a float; 0 = no id), filling last_passes\n"
+      "'cryptomatte_<kind>': (height, width, 2 * cryptomatte_depth), per pixel the (id, coverage) pairs\n"
+      "ranked by coverage (the share of samples whose first hit has the id; misses have none), zeros after.\n"
+      "cryptomatte_depth: the pairs per pixel, 1 to " +
+      std::to_string(kCryptomatteMaxDepth) + ".");
 
   // The types and their parameters, read from the core's tables (each type documents its own).
   static const std::string light_doc =
@@ -251,6 +257,7 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
            py::arg("first_sample") = RenderSettings{}.first_sample,
            py::arg("split_depth") = IntegratorSettings{}.split_depth, py::arg("passes") = py::none(),
            py::arg("mist") = py::none(), py::arg("object_index") = py::none(), py::arg("material_index") = py::none(),
+           py::arg("cryptomatte") = py::none(), py::arg("cryptomatte_depth") = CryptomatteRequest{}.depth,
            render_doc.c_str())
       .def_property_readonly(
           "last_render", &PyScene::last_render,

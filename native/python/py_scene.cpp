@@ -189,8 +189,10 @@ py::dict PyScene::last_commit() {
 
 namespace {
 // render()'s pass arguments as the core's request: names, the mist settings (start, depth,
-// falloff exponent) and the pass-index tables (per instance, per material id).
-AovRequest aov_request(py::handle passes, py::handle mist, py::handle object_index, py::handle material_index) {
+// falloff exponent), the pass-index tables (per instance, per material id) and the Cryptomatte
+// id tables (kind name -> ids per instance or material id) with their depth.
+AovRequest aov_request(py::handle passes, py::handle mist, py::handle object_index, py::handle material_index,
+                       py::handle cryptomatte, int cryptomatte_depth) {
   AovRequest r;
   if (!passes.is_none())
     for (py::handle name : passes) r.mask |= 1u << uint32_t(parse_aov(py::cast<std::string>(name)));
@@ -206,6 +208,10 @@ AovRequest aov_request(py::handle passes, py::handle mist, py::handle object_ind
   };
   r.object_index = table(object_index);
   r.material_index = table(material_index);
+  r.cryptomatte.depth = cryptomatte_depth;
+  if (!cryptomatte.is_none())
+    for (auto [kind, ids] : py::cast<py::dict>(cryptomatte))
+      r.cryptomatte.ids[size_t(parse_crypto_kind(py::cast<std::string>(kind)))] = table(ids);
   return r;
 }
 }  // namespace
@@ -214,8 +220,9 @@ py::array_t<float> PyScene::render(const py::dict& camera_settings, int samples,
                                    const std::string& area_light_sampling, const std::string& light_sampling,
                                    int threads, int tile_size, py::object on_tile, py::object should_cancel,
                                    int first_sample, int split_depth, py::handle passes, py::handle mist,
-                                   py::handle object_index, py::handle material_index) {
-  const AovRequest request = aov_request(passes, mist, object_index, material_index);
+                                   py::handle object_index, py::handle material_index, py::handle cryptomatte,
+                                   int cryptomatte_depth) {
+  const AovRequest request = aov_request(passes, mist, object_index, material_index, cryptomatte, cryptomatte_depth);
   const Camera camera = Camera::make(to_camera(camera_settings));
   RenderSettings settings;
   settings.samples = samples;
@@ -260,6 +267,14 @@ py::array_t<float> PyScene::render(const py::dict& camera_settings, int samples,
     py::array_t<float> pass({py::ssize_t(result.height), py::ssize_t(result.width), py::ssize_t(aov_channels(Aov(k)))});
     std::memcpy(pass.mutable_data(), d.data(), d.size() * sizeof(float));
     last_passes_[aov_name(Aov(k))] = pass;
+  }
+  for (size_t k = 0; k < kCryptoKindCount; ++k) {
+    const std::vector<float>& d = result.passes.cryptomatte[k];
+    if (d.empty()) continue;
+    py::array_t<float> pass(
+        {py::ssize_t(result.height), py::ssize_t(result.width), py::ssize_t(request.cryptomatte.channels())});
+    std::memcpy(pass.mutable_data(), d.data(), d.size() * sizeof(float));
+    last_passes_[py::str(std::string("cryptomatte_") + crypto_kind_name(CryptoKind(k)))] = pass;
   }
   last_render_ = py::dict();
   last_render_["cancelled"] = result.cancelled;

@@ -60,6 +60,9 @@ void AovBuffers::allocate(const AovRequest& request, int w, int h) {
     const float fill = aov == Aov::Depth ? 1e10f : aov == Aov::Mist ? 1.0f : 0.0f;
     if (request.has(aov)) data[k].assign(size_t(w) * size_t(h) * size_t(aov_channels(aov)), fill);
   }
+  for (size_t k = 0; k < kCryptoKindCount; ++k)
+    if (request.cryptomatte.has(CryptoKind(k)))
+      cryptomatte[k].assign(size_t(w) * size_t(h) * size_t(request.cryptomatte.channels()), 0.0f);
 }
 
 void AovPixel::add(const FirstHit& hit, bool first_sample) {

@@ -8,9 +8,11 @@
 //   mist: 1 - mean over samples of (1 - mist(distance)), so 1 where nothing is hit.
 // Only the first surface a camera ray hits counts, as in Cycles for opaque surfaces. A render that
 // asks for no pass allocates and computes none of this (the integrator gets a null FirstHit).
+// The Cryptomatte passes (cryptomatte.h) read the same first hit.
 #pragma once
 
 #include "core/math.h"
+#include "render/cryptomatte.h"
 
 #include <array>
 #include <cstdint>
@@ -42,7 +44,8 @@ struct AovRequest {
   uint32_t mask = 0;  // bit (1 << Aov) per pass asked for
   MistSettings mist;
   std::vector<float> object_index, material_index;
-  bool any() const { return mask != 0; }
+  CryptomatteRequest cryptomatte;
+  bool any() const { return mask != 0 || cryptomatte.any(); }
   bool has(Aov aov) const { return (mask >> uint32_t(aov)) & 1u; }
 };
 
@@ -61,6 +64,9 @@ struct FirstHit {
 struct AovBuffers {
   int width = 0, height = 0;
   std::array<std::vector<float>, kAovCount> data;
+  // Per Cryptomatte kind asked for: width * height * cryptomatte.channels() floats, the pixel's
+  // (id, coverage) pairs in rank order.
+  std::array<std::vector<float>, kCryptoKindCount> cryptomatte;
   void allocate(const AovRequest& request, int w, int h);
 };
 

@@ -47,6 +47,8 @@ size_t render_memory_estimate(const Camera& camera, const RenderSettings& settin
   double channels = 4;
   for (size_t k = 0; k < kAovCount; ++k)
     if (passes.has(Aov(k))) channels += aov_channels(Aov(k));
+  for (size_t k = 0; k < kCryptoKindCount; ++k)
+    if (passes.cryptomatte.has(CryptoKind(k))) channels += passes.cryptomatte.channels();
   const double bytes = pixels * channels * sizeof(float) * 2 + tiles * (sizeof(Tile) + sizeof(size_t)) + threads * 1e6;
   return bytes >= 1.8e19 ? SIZE_MAX : size_t(bytes);
 }
@@ -67,6 +69,7 @@ size_t available_memory_bytes() {
 RenderResult render(const Scene& scene, const Camera& camera, const RenderSettings& requested, const TileSink& on_tile,
                     const CancelPoll& should_cancel, const AovRequest& passes) {
   requested.check();
+  passes.cryptomatte.check();
   scene.check_renderable();
   // The settings with "auto" light sampling resolved for this scene: a copy of a few ints, the
   // scene itself is read in place.
@@ -104,6 +107,8 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
     const float inv = 1.0f / float(settings.samples);
     const int first = settings.first_sample, last = settings.first_sample + settings.samples;
     const bool with_passes = passes.any();  // read once: the plain loop below must stay as it was
+    const bool with_cryptomatte = passes.cryptomatte.any();
+    std::vector<CryptomattePixel::Entry> crypto_scratch;  // grows once per tile, only if asked for
     for (int j = t.y; j < t.y + t.height; ++j) {
       if (cancel.load(std::memory_order_relaxed)) return false;
       for (int i = t.x; i < t.x + t.width; ++i) {
@@ -116,6 +121,7 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
         if (with_passes) {
           // Passes asked for: the same samples, each reporting its first surface (aovs.h).
           AovPixel aov(passes, camera);
+          CryptomattePixel crypto(passes.cryptomatte, crypto_scratch);
           for (int s = first; s < last; ++s) {
             if ((s - first) % kCancelCheckSamples == kCancelCheckSamples - 1 && cancel.load(std::memory_order_relaxed))
               return false;
@@ -124,8 +130,10 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
             sum += trace_path(scene, camera.generate(float(px) + jitter.x, float(py) + jitter.y), pixel, uint32_t(s),
                               settings.integrator, &hit);
             aov.add(hit, s == first);
+            if (with_cryptomatte) crypto.add(hit.found ? hit.instance : -1, hit.material);
           }
           aov.store(result.passes, index, inv);
+          if (with_cryptomatte) crypto.store(result.passes.cryptomatte, index, inv);
         }
         for (int s = with_passes ? last : first; s < last; ++s) {
           // A relaxed load every few samples costs nothing next to a path, and bounds the cancel

@@ -113,6 +113,67 @@ TEST(AovBuffers, OnlyThePassesAskedForAreAllocated) {
 TEST(Aov, NamesParseBackAndAnUnknownOneIsRefused) {
   for (size_t k = 0; k < kAovCount; ++k) EXPECT_EQ(parse_aov(aov_name(Aov(k))), Aov(k));
   EXPECT_THROW(parse_aov("vector"), std::invalid_argument);
+  for (size_t k = 0; k < kCryptoKindCount; ++k)
+    EXPECT_EQ(parse_crypto_kind(crypto_kind_name(CryptoKind(k))), CryptoKind(k));
+  EXPECT_THROW(parse_crypto_kind("light"), std::invalid_argument);
+}
+
+// Cryptomatte (render/cryptomatte.h): instances 0, 1, 2 with ids 1.5, 2.5, 3.5; asset ids group
+// instances 0 and 1 under 7.5; material ids 0, 1 as 4.5, 5.5.
+CryptomatteRequest crypto_request(int depth) {
+  CryptomatteRequest r;
+  r.depth = depth;
+  r.ids[size_t(CryptoKind::Object)] = {1.5f, 2.5f, 3.5f};
+  r.ids[size_t(CryptoKind::Material)] = {4.5f, 5.5f};
+  r.ids[size_t(CryptoKind::Asset)] = {7.5f, 7.5f, 8.5f};
+  return r;
+}
+
+TEST(CryptomattePixel, IdsAreRankedByTheirShareOfSamplesAndMissesCountAsNoId) {
+  const CryptomatteRequest r = crypto_request(4);
+  std::array<std::vector<float>, kCryptoKindCount> out;
+  for (auto& o : out) o.assign(size_t(r.channels()), -1.0f);
+  std::vector<CryptomattePixel::Entry> scratch;
+  CryptomattePixel px(r, scratch);
+  // 8 samples: instance 1 (material 0) three times, instance 2 (material 1) twice, instance 0
+  // (material 1) twice, one miss.
+  for (auto [instance, material] : {std::pair{0, 1}, {1, 0}, {2, 1}, {-1, -1}, {1, 0}, {2, 1}, {1, 0}, {0, 1}})
+    px.add(instance, material);
+  px.store(out, 0, 1.0f / 8.0f);
+  // Equal shares keep the order in which the ids first came (instance 0 before 2), as Cycles.
+  EXPECT_EQ(out[size_t(CryptoKind::Object)], (std::vector<float>{2.5f, 0.375f, 1.5f, 0.25f, 3.5f, 0.25f, 0.0f, 0.0f}));
+  EXPECT_EQ(out[size_t(CryptoKind::Material)], (std::vector<float>{5.5f, 0.5f, 4.5f, 0.375f, 0, 0, 0, 0}));
+  // The asset sums its instances: 0 and 1 are 5 of the 8 samples.
+  EXPECT_EQ(out[size_t(CryptoKind::Asset)], (std::vector<float>{7.5f, 0.625f, 8.5f, 0.25f, 0, 0, 0, 0}));
+}
+
+TEST(CryptomattePixel, MoreIdsThanTheDepthKeepTheTopOnesExactly) {
+  CryptomatteRequest r;
+  r.depth = 2;
+  for (int k = 0; k < 6; ++k) r.ids[size_t(CryptoKind::Object)].push_back(1.0f + float(k));
+  std::array<std::vector<float>, kCryptoKindCount> out;
+  out[0].assign(4, -1.0f);
+  std::vector<CryptomattePixel::Entry> scratch;
+  CryptomattePixel px(r, scratch);
+  // Instance k is hit k + 1 times: the two most covered are 5 and 4, whatever the others add up to.
+  for (int k = 0; k < 6; ++k)
+    for (int n = 0; n <= k; ++n) px.add(k, 0);
+  px.store(out, 0, 1.0f / 21.0f);
+  EXPECT_EQ(out[0][0], 6.0f);
+  EXPECT_FLOAT_EQ(out[0][1], 6.0f / 21.0f);
+  EXPECT_EQ(out[0][2], 5.0f);
+  EXPECT_FLOAT_EQ(out[0][3], 5.0f / 21.0f);
+}
+
+TEST(CryptomatteRequest, DepthOutsideBlendersRangeIsRefused) {
+  EXPECT_NO_THROW(crypto_request(kCryptomatteMaxDepth).check());
+  EXPECT_THROW(crypto_request(kCryptomatteMaxDepth + 1).check(), std::invalid_argument);
+  EXPECT_THROW(crypto_request(0).check(), std::invalid_argument);
+  EXPECT_THROW(crypto_request(-1).check(), std::invalid_argument);
+  EXPECT_FALSE(CryptomatteRequest{}.any());
+  AovRequest passes;
+  passes.cryptomatte = crypto_request(1);
+  EXPECT_TRUE(passes.any());  // a Cryptomatte pass alone takes the passes' path of the render loop
 }
 
 }  // namespace
