@@ -7,7 +7,8 @@ and 1.5x, and a cube's integer grid points off its faces, are inside or outside;
 points are at known distances. Each library's wrong answers are counted on the same sets: TOYRT,
 Open3D's RaycastingScene (Embree 3) and trimesh (with embreex when installed).
 
-Speed: Mqueries/s on icospheres of 20K to 1.3M triangles, 1 and 2 threads, TOYRT and Open3D.
+Speed: Mqueries/s on icospheres of 5K to 5.2M triangles, 1 and 2 threads, TOYRT and Open3D side by
+side (interleaved calls, medians), with the machine's load average.
 
 Usage: python bench/queries_bench.py [--build build] [--out docs/queries-bench.md] [--quick]
 """
@@ -125,19 +126,24 @@ def wrong_counts(lib, sets):
     return out
 
 
-def speed(engine, o, d, p, threads):
-    """Mqueries/s of count, occupancy and distance (best of 3; distance on the first 10% of the points)."""
-    res = {}
-    q = p[: len(p) // 10]
-    for kind, f, n in (("count", lambda: engine.count(o, d, threads), len(o)),
-                       ("occupancy", lambda: engine.occupancy(p, threads), len(p)),
-                       ("distance", lambda: engine.distance(q, threads), len(q))):
-        best = np.inf
-        for _ in range(3):
-            t0 = time.perf_counter()
-            f()
-            best = min(best, time.perf_counter() - t0)
-        res[kind] = n / best / 1e6
+def speed_side_by_side(engines, o, d, p, q, threads, repeats):
+    """Mqueries/s of count, occupancy and distance per engine: the engines run interleaved (one
+    call each, in turn, `repeats` times after a warm-up call), so a change in the machine's load
+    hits both alike; the median of the repeats. {engine name: {kind: Mqueries/s}}."""
+    kinds = (("count", lambda e: e.count(o, d, threads), len(o)),
+             ("occupancy", lambda e: e.occupancy(p, threads), len(p)),
+             ("distance", lambda e: e.distance(q, threads), len(q)))
+    res = {name: {} for name in engines}
+    for kind, f, n in kinds:
+        times = {name: [] for name in engines}
+        for r in range(repeats + 1):
+            for name, e in engines.items():
+                t0 = time.perf_counter()
+                f(e)
+                if r:  # the first round warms caches and thread pools
+                    times[name].append(time.perf_counter() - t0)
+        for name in engines:
+            res[name][kind] = n / float(np.median(times[name])) / 1e6
     return res
 
 
@@ -146,6 +152,8 @@ def main():
     ap.add_argument("--build", default="build")
     ap.add_argument("--out", default=str(ROOT / "docs" / "queries-bench.md"))
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--levels", type=int, nargs="*", help="icosphere levels of the speed table (default 4-9)")
+    ap.add_argument("--speed-only", action="store_true", help="skip the wrong-answer table")
     args = ap.parse_args()
     sys.path.insert(0, str((ROOT / args.build / "python").resolve()))
     import toyrt
@@ -171,7 +179,7 @@ def main():
              "(answer: 1 crossing); points (cube: the integer grid off the faces; icosphere: 0.5x and 1.5x "
              "along those rays) inside or outside; the cube grid's distances (closed form, tolerance 1e-6 "
              "relative + 4 float ulps of the coordinates).", ""]
-    sets = correctness_sets()
+    sets = [] if args.speed_only else correctness_sets()
     header = "| library | " + " | ".join(name for name, *_ in sets) + " |"
     sizes = "| (rays / points) | " + " | ".join(f"{len(r[0])} / {len(p)}" for _, _, r, p, *_ in sets) + " |"
     lines += [header, "| --- " * (len(sets) + 1) + "|", sizes]
@@ -182,24 +190,39 @@ def main():
         print(lines[-1], flush=True)
     lines += ["", "Cells: wrong counts / wrong occupancies / wrong distances (cubes only)."]
     n = 50_000 if args.quick else 200_000
-    lines += ["", f"## Speed (Mqueries/s, best of 3): icospheres, {n // 1000}K random rays and points in "
-              f"[-1.2, 1.2]^3 ({n // 10000}K points for distance)", "",
-              "| triangles | library | threads | count_intersections | occupancy | distance |",
-              "| --- | --- | --- | --- | --- | --- |"]
+    repeats = 3 if args.quick else 5
+    load_before = os.getloadavg()
+    lines += ["", f"## Speed (Mqueries/s, median of {repeats}, TOYRT and Open3D interleaved): icospheres, "
+              f"{n // 1000}K random rays from [-1.5, 1.5]^3 and points in [-1.2, 1.2]^3 (2K to 20K points for "
+              "distance, fewer on the larger meshes)", "",
+              "| triangles | threads | count: TOYRT / Open3D | ratio | occupancy: TOYRT / Open3D | ratio | "
+              "distance: TOYRT / Open3D | ratio |",
+              "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     rng = np.random.default_rng(0)
-    levels = (5, 6) if args.quick else (5, 6, 7, 8)
+    levels = args.levels or ((4, 5) if args.quick else (4, 5, 6, 7, 8, 9))
+    peers = [lib for lib in libs[:2]]  # trimesh is too slow to time at these sizes
     for level in levels:
         mesh = icosphere(level)
         o = rng.uniform(-1.5, 1.5, (n, 3)).astype(np.float32)
         d = (rng.uniform(-1, 1, (n, 3))).astype(np.float32)
         p = rng.uniform(-1.2, 1.2, (n, 3)).astype(np.float32)
-        for name, make in libs[:2]:  # trimesh is too slow to time at these sizes
-            engine = make(mesh)
-            for threads in (1, 2):
-                r = speed(engine, o, d, p, threads)
-                lines.append(f"| {len(mesh[1]):,} | {name} | {threads} | {r['count']:.2f} | {r['occupancy']:.2f} | "
-                             f"{r['distance']:.3f} |")
-                print(lines[-1], flush=True)
+        q = p[: max(2000, n // 10 >> max(0, level - 6))]  # distance: little pruning near the centre
+        engines = {name: make(mesh) for name, make in peers}
+        for threads in (1, 2):
+            r = speed_side_by_side(engines, o, d, p, q, threads, repeats)
+            cells = []
+            for kind in ("count", "occupancy", "distance"):
+                vals = [r[name][kind] for name, _ in peers]
+                fmt = "{:.2f}" if kind != "distance" else "{:.3f}"
+                cells.append(" / ".join(fmt.format(v) for v in vals))
+                cells.append(f"{vals[0] / vals[1]:.2f}" if len(vals) > 1 else "-")
+            lines.append(f"| {len(mesh[1]):,} | {threads} | " + " | ".join(cells) + " |")
+            print(lines[-1], flush=True)
+        del engines
+    load_after = os.getloadavg()
+    lines += ["", "Ratio: TOYRT / Open3D (above 1: TOYRT faster). Load average (1, 5, 15 min) before: "
+              + ", ".join(f"{x:.2f}" for x in load_before) + "; after: "
+              + ", ".join(f"{x:.2f}" for x in load_after) + f" ({os.cpu_count()} cores)."]
     pathlib.Path(args.out).write_text("\n".join(lines) + "\n")
     print("wrote", args.out)
 
