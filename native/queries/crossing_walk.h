@@ -6,7 +6,7 @@
 #pragma once
 
 #include "accel/traverse.h"
-#include "accel/wide_traverse.h"
+#include "queries/all_hits_walk.h"
 #include "queries/block_crossing.h"
 #include "scene/scene.h"
 
@@ -34,17 +34,15 @@ void for_each_crossing_in_instance(const Scene& scene, uint32_t instance_id, con
   const double tnear = ray.tnear, tfar = ray.tfar;
   const ExactRay exact{DVec3(org), DVec3(dir)};
   const TriangleBlock* blocks = mesh.blocks().data();
-  float t_max = ray.tfar;
-  // The wide BVH and its leaf blocks, as tracing walks them: SIMD box tests, triangles in line.
-  traverse_wide<false>(mesh.wide_bvh(), make_ray_box_data(org, dir), ray.tnear, t_max,
-                       [&](uint32_t first, uint32_t count, float&) {
-                         const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
-                         for (uint32_t k = first; k < end; ++k)
-                           block_crossings(exact, blocks[k], [&](const Crossing& c, uint32_t prim) {
-                             if (c.t >= tnear && c.t < tfar) visit(c, prim);
-                           });
-                         return false;  // never shrink the segment: every crossing is wanted
-                       });
+  // The wide BVH and its leaf blocks that tracing walks, every leaf the segment reaches.
+  walk_all_leaves(mesh.wide_bvh(), blocks, make_ray_box_data(org, dir), ray.tnear, ray.tfar,
+                  [&](uint32_t first, uint32_t count) {
+                    const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
+                    for (uint32_t k = first; k < end; ++k)
+                      block_crossings(exact, blocks[k], [&](const Crossing& c, uint32_t prim) {
+                        if (c.t >= tnear && c.t < tfar) visit(c, prim);
+                      });
+                  });
 }
 
 // Calls visit(instance, mesh, prim, crossing) for each crossing of the scene in
