@@ -35,7 +35,7 @@ void for_each_crossing_in_instance(const Scene& scene, uint32_t instance_id, con
   const ExactRay exact{DVec3(org), DVec3(dir)};
   const TriangleBlock* blocks = mesh.blocks().data();
   // The wide BVH and its leaf blocks that tracing walks, every leaf the segment reaches.
-  walk_all_leaves(mesh.wide_bvh(), blocks, make_ray_box_data(org, dir), ray.tnear, ray.tfar,
+  walk_all_leaves(mesh.wide_bvh(), make_ray_box_data(org, dir), ray.tnear, ray.tfar,
                   [&](uint32_t first, uint32_t count) {
                     const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
                     for (uint32_t k = first; k < end; ++k)
