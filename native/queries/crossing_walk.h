@@ -34,15 +34,23 @@ void for_each_crossing_in_instance(const Scene& scene, uint32_t instance_id, con
   const double tnear = ray.tnear, tfar = ray.tfar;
   const ExactRay exact{DVec3(org), DVec3(dir)};
   const TriangleBlock* blocks = mesh.blocks().data();
+  const auto on_crossing = [&](const Crossing& c, uint32_t prim) {
+    if (c.t >= tnear && c.t < tfar) visit(c, prim);
+  };
   // The wide BVH and its leaf blocks that tracing walks, every leaf the segment reaches.
-  walk_all_leaves(mesh.wide_bvh(), make_ray_box_data(org, dir), ray.tnear, ray.tfar,
-                  [&](uint32_t first, uint32_t count) {
-                    const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
-                    for (uint32_t k = first; k < end; ++k)
-                      block_crossings(exact, blocks[k], [&](const Crossing& c, uint32_t prim) {
-                        if (c.t >= tnear && c.t < tfar) visit(c, prim);
-                      });
-                  });
+  const RayBoxData box_ray = make_ray_box_data(org, dir);
+  if (float_filter_usable()) {
+    const FloatFilterRay fr = float_filter_ray(exact);
+    walk_all_leaves(mesh.wide_bvh(), box_ray, ray.tnear, ray.tfar, [&](uint32_t first, uint32_t count) {
+      const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
+      for (uint32_t k = first; k < end; ++k) block_crossings(exact, fr, blocks[k], on_crossing);
+    });
+  } else {
+    walk_all_leaves(mesh.wide_bvh(), box_ray, ray.tnear, ray.tfar, [&](uint32_t first, uint32_t count) {
+      const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
+      for (uint32_t k = first; k < end; ++k) block_crossings(exact, blocks[k], on_crossing);
+    });
+  }
 }
 
 // Calls visit(instance, mesh, prim, crossing) for each crossing of the scene in
