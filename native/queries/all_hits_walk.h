@@ -8,14 +8,21 @@
 #pragma once
 
 #include "accel/wide_traverse.h"
+#include "geometry/triangle_block.h"
 
 namespace toyrt::queries {
+
+// Asks for every cache line of an object that the walk will read whole.
+inline void prefetch_lines(const void* p, size_t bytes) {
+  for (size_t k = 0; k < bytes; k += 64) __builtin_prefetch(static_cast<const char*>(p) + k);
+}
 
 // Calls leaf(first, count) for every leaf of `bvh` (first block, triangle count) whose box meets
 // [tnear, tfar] along `ray`, by the same conservative slab test as traverse_wide (Ize's widening,
 // core/bbox.h), so no leaf that holds a crossing in the segment is missed.
 template <class LeafFn>
-inline void walk_all_leaves(const WideBvh& bvh, const RayBoxData& ray, float tnear, float tfar, LeafFn&& leaf) {
+inline void walk_all_leaves(const WideBvh& bvh, const TriangleBlock* blocks, const RayBoxData& ray, float tnear,
+                            float tfar, LeafFn&& leaf) {
   using namespace simd;
   if (bvh.nodes.empty()) {
     if (bvh.root_leaf_count) leaf(bvh.root_leaf_first, bvh.root_leaf_count);
@@ -53,7 +60,10 @@ inline void walk_all_leaves(const WideBvh& bvh, const RayBoxData& ray, float tne
         const int i = __builtin_ctz(mask);
         mask &= mask - 1;
         const Entry e{n.child[i], n.count[i]};
-        if (e.count == 0) __builtin_prefetch(&bvh.nodes[e.child]);
+        if (e.count == 0)
+          prefetch_lines(&bvh.nodes[e.child], sizeof(WideNode));
+        else
+          prefetch_lines(&blocks[e.child], sizeof(TriangleBlock));
         stack[sp++] = e;
       }
     } else {

@@ -41,12 +41,12 @@ void for_each_crossing_in_instance(const Scene& scene, uint32_t instance_id, con
   const RayBoxData box_ray = make_ray_box_data(org, dir);
   if (float_filter_usable()) {
     const FloatFilterRay fr = float_filter_ray(exact);
-    walk_all_leaves(mesh.wide_bvh(), box_ray, ray.tnear, ray.tfar, [&](uint32_t first, uint32_t count) {
+    walk_all_leaves(mesh.wide_bvh(), blocks, box_ray, ray.tnear, ray.tfar, [&](uint32_t first, uint32_t count) {
       const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
       for (uint32_t k = first; k < end; ++k) block_crossings(exact, fr, blocks[k], on_crossing);
     });
   } else {
-    walk_all_leaves(mesh.wide_bvh(), box_ray, ray.tnear, ray.tfar, [&](uint32_t first, uint32_t count) {
+    walk_all_leaves(mesh.wide_bvh(), blocks, box_ray, ray.tnear, ray.tfar, [&](uint32_t first, uint32_t count) {
       const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
       for (uint32_t k = first; k < end; ++k) block_crossings(exact, blocks[k], on_crossing);
     });
