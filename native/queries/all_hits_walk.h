@@ -1,10 +1,11 @@
 // The walk of the multi-hit queries over a WideBvh: every leaf whose box the ray's segment
 // reaches, in no particular order. Tracing's traverse_wide (accel/wide_traverse.h) sorts the
 // children it enters by distance so that a nearer hit can prune the rest; a count prunes nothing,
-// so here the children are stacked as the slab test finds them (1.4x the sorted walk's counts at
-// 327K triangles). Stacked interior nodes are prefetched, as tracing does; prefetching the
-// stacked leaves' triangle blocks measured slower (0.65x with the block's id line, 0.75x with all
-// five lines), so it is not done.
+// so here the children are stacked as the slab test finds them. The walk is bound by memory
+// latency: a node is four cache lines (the boxes, then the child ids) and a triangle block five,
+// so every line of each stacked node and of each stacked leaf's first block is asked for
+// (prefetched) when it is stacked, not one line when it is popped (docs/queries.md: 1.4x the
+// counts at 327K triangles).
 #pragma once
 
 #include "accel/wide_traverse.h"
