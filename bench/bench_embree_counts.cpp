@@ -6,9 +6,9 @@
 //
 // Usage: bench_embree_counts SETS_FILE. Reads, per set: u32 name length, the name, u32 vertex
 // count, float32 xyz per vertex, u32 triangle count, u32 indices, u32 ray count, float32 origins
-// then directions, u32 point count, float32 points, u8 inside per point. Prints one line per set
-// scene flag and counting rule (below): "set<TAB>flags, rule<TAB>rays<TAB>wrong counts<TAB>points<TAB>wrong
-// occupancies", after a first line "version<TAB>Embree's version number" (30xxyy).
+// then directions, u32 point count, float32 points, u8 inside per point. Prints a first line
+// "version<TAB>Embree's version number (30xxyy)", then one line per set, scene flag and counting
+// rule (below): "set<TAB>flags, rule<TAB>rays<TAB>wrong counts<TAB>points<TAB>wrong occupancies".
 #include <embree3/rtcore.h>
 
 #include <cstdint>
