@@ -20,13 +20,14 @@ inline void prefetch_lines(const void* p, size_t bytes) {
 
 // Calls leaf(first, count) for every leaf of `bvh` (first block, triangle count) whose box meets
 // [tnear, tfar] along `ray`, by the same conservative slab test as traverse_wide (Ize's widening,
-// core/bbox.h), so no leaf that holds a crossing in the segment is missed.
+// core/bbox.h), so no leaf that holds a crossing in the segment is missed. A true return from
+// leaf ends the walk (an answer already decided).
 template <class LeafFn>
 inline void walk_all_leaves(const WideBvh& bvh, const TriangleBlock* blocks, const RayBoxData& ray, float tnear,
                             float tfar, LeafFn&& leaf) {
   using namespace simd;
   if (bvh.nodes.empty()) {
-    if (bvh.root_leaf_count) leaf(bvh.root_leaf_first, bvh.root_leaf_count);
+    if (bvh.root_leaf_count) (void)leaf(bvh.root_leaf_first, bvh.root_leaf_count);
     return;
   }
   const vfloat ox = splat(ray.org.x), oy = splat(ray.org.y), oz = splat(ray.org.z);
@@ -67,8 +68,8 @@ inline void walk_all_leaves(const WideBvh& bvh, const TriangleBlock* blocks, con
           prefetch_lines(&blocks[e.child], sizeof(TriangleBlock));
         stack[sp++] = e;
       }
-    } else {
-      leaf(current.child, current.count);
+    } else if (leaf(current.child, current.count)) {
+      return;
     }
     if (sp == 0) return;
     current = stack[--sp];

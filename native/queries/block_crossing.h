@@ -58,8 +58,13 @@ inline bool float_filter_usable() {
 inline constexpr float kFloatTripleErrorBound = 0x1p-20f;
 
 // A mask of the used lanes of `b` the perturbed ray may cross: every other lane has two edges
-// whose Plücker signs are certified, in float, to disagree.
-[[gnu::always_inline]] inline uint32_t float_candidates(const FloatFilterRay& r, const TriangleBlock& b) {
+// whose Plücker signs are certified, in float, to disagree. With `on_plane`, also the lanes whose
+// plane may hold the ray's origin: the others have a volume det(A, B, C) certified nonzero (the
+// same products as the edge (B, C), the same bound with A in place of the direction, and the
+// underflow term per lane), so the origin lies on none of them (compute_occupancy's on-surface
+// test runs on the rest).
+[[gnu::always_inline]] inline uint32_t float_candidates(const FloatFilterRay& r, const TriangleBlock& b,
+                                                        uint32_t* on_plane = nullptr) {
   using namespace simdb;
   vfloat x[3], y[3], z[3];
   for (int k = 0; k < 3; ++k) {
@@ -80,10 +85,19 @@ inline constexpr float kFloatTripleErrorBound = 0x1p-20f;
                          splat(r.floor);
     pos |= value > bound;  // false for NaN (inf - inf on overflow): never certified
     neg |= value < -bound;
+    if (e == 1 && on_plane) {
+      const vfloat ax = abs(x[0]), ay = abs(y[0]), az = abs(z[0]);
+      const vfloat volume = x[0] * (p0 - p1) + y[0] * (p2 - p3) + z[0] * (p4 - p5);
+      const vfloat volume_bound = splat(kFloatTripleErrorBound) *
+                                      (ax * (abs(p0) + abs(p1)) + ay * (abs(p2) + abs(p3)) + az * (abs(p4) + abs(p5))) +
+                                  splat(0x1p-140f) * (splat(1.0f) + ax + ay + az);
+      *on_plane = mask_of(~(abs(volume) > volume_bound));
+    }
   }
   vint used;
   std::memcpy(&used, b.prim, sizeof used);
   used = used != vint{} - 1;
+  if (on_plane) *on_plane &= mask_of(used);
   return mask_of(used & ~(pos & neg));
 }
 

@@ -18,39 +18,57 @@ inline bool is_valid_ray(const Ray& ray) {
          !std::isnan(ray.tfar) && ray.tnear <= ray.tfar;
 }
 
+// The ray of a query in the object space of instance `id`, as the exact model sees it: the same
+// float transform as the nearest-hit query, then converted to double without rounding. False
+// when the transformed ray is degenerate (it then crosses nothing).
+inline bool object_ray(const Scene& scene, uint32_t id, const Ray& ray, Vec3& org, Vec3& dir) {
+  const Instance& inst = scene.instance(id);
+  org = ray.org;
+  dir = ray.dir;
+  if (inst.identity) return true;
+  org = Vec3(inst.to_object * glm::vec4(org, 1.0f));
+  dir = glm::mat3(inst.to_object) * dir;
+  return is_finite(org) && is_finite(dir) && dir != Vec3(0.0f);
+}
+
+// Calls block(exact_ray, float_ray, block) for each triangle block of instance `id`'s mesh in a
+// leaf that `ray` (world space) reaches on [tnear, tfar], until it returns true. float_ray is
+// null where the float filter cannot run (float_filter_usable).
+template <class BlockFn>
+void for_each_block_in_instance(const Scene& scene, uint32_t id, const Ray& ray, BlockFn&& block) {
+  const Mesh& mesh = scene.mesh(scene.instance(id).mesh);
+  Vec3 org, dir;
+  if (!object_ray(scene, id, ray, org, dir)) return;
+  const ExactRay exact{DVec3(org), DVec3(dir)};
+  const FloatFilterRay fr = float_filter_ray(exact);
+  const FloatFilterRay* float_ray = float_filter_usable() ? &fr : nullptr;
+  const TriangleBlock* blocks = mesh.blocks().data();
+  // The wide BVH and its leaf blocks that tracing walks, every leaf the segment reaches.
+  walk_all_leaves(mesh.wide_bvh(), blocks, make_ray_box_data(org, dir), ray.tnear, ray.tfar,
+                  [&](uint32_t first, uint32_t count) {
+                    const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
+                    for (uint32_t k = first; k < end; ++k)
+                      if (block(exact, float_ray, blocks[k])) return true;
+                    return false;
+                  });
+}
+
 // Calls visit(crossing, prim) for each crossing of `ray` (world space; tnear <= t < tfar) with
 // the mesh of instance `instance_id`, in traversal order (not sorted).
 template <class Visit>
 void for_each_crossing_in_instance(const Scene& scene, uint32_t instance_id, const Ray& ray, Visit&& visit) {
-  const Instance& inst = scene.instance(instance_id);
-  const Mesh& mesh = scene.mesh(inst.mesh);
-  Vec3 org = ray.org, dir = ray.dir;
-  if (!inst.identity) {
-    // The same float transform as the nearest-hit query: the exact model starts from it.
-    org = Vec3(inst.to_object * glm::vec4(org, 1.0f));
-    dir = glm::mat3(inst.to_object) * dir;
-    if (!is_finite(org) || !is_finite(dir) || dir == Vec3(0.0f)) return;
-  }
   const double tnear = ray.tnear, tfar = ray.tfar;
-  const ExactRay exact{DVec3(org), DVec3(dir)};
-  const TriangleBlock* blocks = mesh.blocks().data();
   const auto on_crossing = [&](const Crossing& c, uint32_t prim) {
     if (c.t >= tnear && c.t < tfar) visit(c, prim);
   };
-  // The wide BVH and its leaf blocks that tracing walks, every leaf the segment reaches.
-  const RayBoxData box_ray = make_ray_box_data(org, dir);
-  if (float_filter_usable()) {
-    const FloatFilterRay fr = float_filter_ray(exact);
-    walk_all_leaves(mesh.wide_bvh(), blocks, box_ray, ray.tnear, ray.tfar, [&](uint32_t first, uint32_t count) {
-      const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
-      for (uint32_t k = first; k < end; ++k) block_crossings(exact, fr, blocks[k], on_crossing);
-    });
-  } else {
-    walk_all_leaves(mesh.wide_bvh(), blocks, box_ray, ray.tnear, ray.tfar, [&](uint32_t first, uint32_t count) {
-      const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
-      for (uint32_t k = first; k < end; ++k) block_crossings(exact, blocks[k], on_crossing);
-    });
-  }
+  for_each_block_in_instance(scene, instance_id, ray,
+                             [&](const ExactRay& exact, const FloatFilterRay* fr, const TriangleBlock& b) {
+                               if (fr)
+                                 block_crossings(exact, *fr, b, on_crossing);
+                               else
+                                 block_crossings(exact, b, on_crossing);
+                               return false;
+                             });
 }
 
 // Calls visit(instance, mesh, prim, crossing) for each crossing of the scene in

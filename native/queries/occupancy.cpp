@@ -42,20 +42,42 @@ bool on_surface(const Mesh& mesh, const Vec3& q) {
   return found;
 }
 
+// The on-surface test and the parity in one walk: a point on a triangle lies in that
+// triangle's box, which the ray from it reaches at t = 0, so the ray's walk meets every triangle
+// the point may lie on; the float filter leaves the exact on-triangle test only the lanes whose
+// plane may hold the point. A separate walk of the boxes containing the point cost 40 % of the
+// query (docs/queries.md).
 bool inside_instance(const Scene& scene, uint32_t id, const Vec3& q) {
-  const Instance& inst = scene.instance(id);
-  const Vec3 q_object = inst.identity ? q : Vec3(inst.to_object * glm::vec4(q, 1.0f));
-  if (on_surface(scene.mesh(inst.mesh), q_object)) return true;
   Ray ray;
   ray.org = q;
   ray.dir = Vec3(1.0f, 0.0f, 0.0f);  // any fixed direction: the tie-break makes every one exact
   ray.tnear = 0.0f;
   ray.tfar = kInfinity;
-  bool odd = false;
-  for_each_crossing_in_instance(scene, id, ray, [&](const Crossing& c, uint32_t) {
-    if (c.t_sign > 0) odd = !odd;  // t = 0 would be on the surface, handled above
+  if (!float_filter_usable()) {
+    const Instance& inst = scene.instance(id);
+    const Vec3 q_object = inst.identity ? q : Vec3(inst.to_object * glm::vec4(q, 1.0f));
+    if (on_surface(scene.mesh(inst.mesh), q_object)) return true;
+    bool odd = false;
+    for_each_crossing_in_instance(scene, id, ray, [&](const Crossing& c, uint32_t) {
+      if (c.t_sign > 0) odd = !odd;  // t = 0 would be on the surface, handled above
+    });
+    return odd;
+  }
+  bool odd = false, on = false;
+  for_each_block_in_instance(scene, id, ray, [&](const ExactRay& r, const FloatFilterRay* fr, const TriangleBlock& b) {
+    uint32_t plane = 0;
+    for (uint32_t m = float_candidates(*fr, b, &plane); m; m &= m - 1) {
+      const int lane = __builtin_ctz(m);
+      Crossing c;
+      if (exact_crossing(r, b.vertex(lane, 0), b.vertex(lane, 1), b.vertex(lane, 2), c) && c.t_sign > 0) odd = !odd;
+    }
+    for (; plane; plane &= plane - 1) {
+      const int lane = __builtin_ctz(plane);
+      if (on_triangle(r.org, b.vertex(lane, 0), b.vertex(lane, 1), b.vertex(lane, 2))) return on = true;
+    }
+    return false;
   });
-  return odd;
+  return on || odd;
 }
 
 }  // namespace
