@@ -2,6 +2,7 @@
 // through shared edges and vertices (convex and star-shaped meshes, whose crossing counts from an
 // interior point are known: exactly one), the BVH walks against brute force over all triangles,
 // occupancy and distances against closed forms.
+#include "queries/block_crossing.h"
 #include "queries/closest_point_triangle.h"
 #include "queries/exact_crossing.h"
 #include "queries/point_queries.h"
@@ -234,6 +235,63 @@ TEST(CountIntersections, BvhWalkMatchesBruteForceAndTheDoubleOracle) {
   EXPECT_EQ(brute_wrong, 0u);
   EXPECT_EQ(oracle_wrong, 0u);
   EXPECT_GT(oracle_checked, 2000u);  // the oracle decided most rays, so the comparison means something
+}
+
+// The float filter may only drop lanes the exact test rejects: on every block of meshes at the
+// origin, far from it and at tiny scales (where float products underflow), for rays aimed at
+// vertices and edges and random rays, each lane the exact test crosses is a candidate, and each
+// lane whose plane holds the ray's origin (exact zero volume) is left to the on-surface test.
+TEST(BlockCrossing, FloatFilterDropsOnlyLanesTheExactTestRejects) {
+  ASSERT_TRUE(queries::float_filter_usable());
+  const struct {
+    const char* name;
+    MeshData mesh;
+    Vec3 inside;
+  } cases[] = {
+      {"uv-sphere", uv_sphere(20, 40, 1.0f, 0.3f), Vec3(0.1f, 0.05f, -0.1f)},
+      {"cube", cube(2.0f), Vec3(1.0f)},
+      {"icosphere-at-1e4", transformed(icosphere(2), 1.0f, Vec3(1e4f)), Vec3(1e4f)},
+      {"icosphere-1e-6", transformed(icosphere(2), 1e-6f, Vec3(0.0f)), Vec3(0.0f)},
+      {"cube-2^-60", cube(std::ldexp(2.0f, -60)), Vec3(std::ldexp(1.0f, -60))},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    Committed scene(c.mesh);
+    const Mesh& mesh = scene.scene.mesh(0);
+    std::vector<Ray> rays = rays_at_vertices_and_edges(c.mesh, c.inside, 1, 13);
+    // Rays from the mesh's own vertices (origins on the surface: zero volumes), along +x.
+    for (const Vec3& v : c.mesh.vertices) {
+      Ray r;
+      r.org = v;
+      r.dir = Vec3(1.0f, 0.0f, 0.0f);
+      rays.push_back(r);
+    }
+    size_t dropped_crossings = 0, dropped_planes = 0, crossings = 0, planes = 0;
+    for (const Ray& r : rays) {
+      const queries::ExactRay exact{DVec3(r.org), DVec3(r.dir)};
+      const queries::FloatFilterRay fr = queries::float_filter_ray(exact);
+      for (const TriangleBlock& b : mesh.blocks()) {
+        uint32_t on_plane = 0;
+        const uint32_t candidates = queries::float_candidates(fr, b, &on_plane);
+        for (int lane = 0; lane < kBlockWidth; ++lane) {
+          if (b.prim[lane] == kNoTriangle) continue;
+          const Vec3 p0 = b.vertex(lane, 0), p1 = b.vertex(lane, 1), p2 = b.vertex(lane, 2);
+          queries::Crossing x;
+          if (queries::exact_crossing(exact, p0, p1, p2, x)) {
+            ++crossings;
+            dropped_crossings += !(candidates >> lane & 1);
+          }
+          if (queries::triple_sign(DVec3(p0) - exact.org, DVec3(p1) - exact.org, DVec3(p2) - exact.org) == 0) {
+            ++planes;
+            dropped_planes += !(on_plane >> lane & 1);
+          }
+        }
+      }
+    }
+    EXPECT_EQ(dropped_crossings, 0u) << "of " << crossings;
+    EXPECT_EQ(dropped_planes, 0u) << "of " << planes;
+    EXPECT_GT(planes, 0u);  // the origins on the surface were tested
+  }
 }
 
 TEST(ListIntersections, HitsComeInRayAndDistanceOrderWithinTheBound) {
