@@ -5,6 +5,7 @@
 #pragma once
 
 #include "accel/bvh.h"
+#include "core/huge_page_allocator.h"
 
 #include <vector>
 
@@ -25,7 +26,8 @@ struct alignas(64) WideNode {
 static_assert(sizeof(WideNode) == 256, "WideNode: 4 cache lines for 8 children");
 
 struct WideBvh {
-  std::vector<WideNode> nodes;  // root at 0 (absent for an empty tree)
+  // Root at 0 (absent for an empty tree); in huge pages, as traversal reads them at random.
+  std::vector<WideNode, HugePageAllocator<WideNode>> nodes;
   // When the whole tree is a single leaf it has no wide node: the leaf's range is kept here.
   uint32_t root_leaf_first = 0, root_leaf_count = 0;
   bool empty() const { return nodes.empty() && root_leaf_count == 0; }

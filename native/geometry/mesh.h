@@ -35,7 +35,7 @@ class Mesh {
   const Bvh& bvh() const { return bvh_; }
   // The traced form (wide nodes, leaf triangles in blocks): for queries that walk it themselves.
   const WideBvh& wide_bvh() const { return wide_; }
-  const std::vector<TriangleBlock>& blocks() const { return blocks_; }
+  const std::vector<TriangleBlock, HugePageAllocator<TriangleBlock>>& blocks() const { return blocks_; }
   const BBox& bounds() const { return bounds_; }
   // Bytes held by this mesh (input arrays, BVH and leaf triangles).
   size_t memory_bytes() const;
@@ -55,7 +55,7 @@ class Mesh {
   WideBvh wide_;  // bvh_ collapsed for tracing
   // The leaves' triangles in blocks of eight, in traversal order: a wide leaf child's `child`
   // is its first block, its `count` the number of triangles (blocks = count rounded up to 4).
-  std::vector<TriangleBlock> blocks_;
+  std::vector<TriangleBlock, HugePageAllocator<TriangleBlock>> blocks_;  // huge pages: read at random
   BBox bounds_;
   bool built_ = false;
 };
