@@ -5,7 +5,8 @@ with their vertices and edges, whose answers are known in closed form: rays from
 aimed at every vertex and edge point cross a convex mesh exactly once; points on those rays at 0.5x
 and 1.5x, and a cube's integer grid points off its faces, are inside or outside; a cube's grid
 points are at known distances. Each library's wrong answers are counted on the same sets: TOYRT,
-Open3D's RaycastingScene (Embree 3) and trimesh (with embreex when installed).
+Open3D's RaycastingScene (Embree), trimesh (with embreex when installed), and Embree 3 itself
+counting as Open3D does (bench/bench_embree_counts.cpp, which reads the sets from a file).
 
 Speed: Mqueries/s on icospheres of 5K to 5.2M triangles, 1 and 2 threads, TOYRT and Open3D side by
 side (interleaved calls, medians), with the machine's load average.
