@@ -109,9 +109,10 @@ addon: native
 	@BLENDER=$(BLENDER) BUILD_DIR=$(BUILD) scripts/install-addon.sh
 
 # The per-level builds (three wheels and build-levels) compile the same core for the same three
-# CPU levels four times: under ccache (from APT_PACKAGES) all but the first are cache hits. Only
-# for them: their flags name the level, where -march=native (the main build) would not say which CPU.
-LEVELS_CCACHE = CCACHE_BASEDIR=$(CURDIR) CMAKE_CXX_COMPILER_LAUNCHER=$(shell command -v ccache)
+# CPU levels four times: under ccache (from APT_PACKAGES) all but the first are cache hits (the core's
+# command lines name no build folder: native/CMakeLists.txt). Only for them: their flags name the
+# level, where -march=native (the main build) would not say which CPU it was compiled for.
+LEVELS_CCACHE = CMAKE_CXX_COMPILER_LAUNCHER=$(shell command -v ccache)
 # The release files (docs/install.md): a portable wheel per Python, repaired by auditwheel
 # (scripts/build-wheel.sh; incremental in build/wheel/), then the extension zip, built and
 # validated by Blender's own tool, and the legacy zip (scripts/build-extension.py).
