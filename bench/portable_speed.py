@@ -15,7 +15,7 @@ import tempfile
 from pathlib import Path
 
 # | bumpy sphere, 1.0M triangles | primary | 1 | 76800 | 2.86 | 5.42 | **0.53** |
-ROW = re.compile(r"^\| (?P<mesh>[^|]+) \| (?P<rays>primary|diffuse|shadow) \| (?P<threads>\d+) \| \d+ "
+ROW = re.compile(r"^\| (?P<mesh>[^|]+) \| (?P<rays>primary|diffuse|shadow[^|]*) \| (?P<threads>\d+) \| \d+ "
                  r"\| (?P<toyrt>[\d.]+) \|")
 
 
