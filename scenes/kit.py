@@ -403,6 +403,14 @@ def float_exr(scene):
     s.file_format, s.color_depth, s.color_mode = "OPEN_EXR", "32", "RGBA"
 
 
+def multilayer_exr(scene):
+    """Stills written as 32-bit float multilayer OpenEXR: every pass of every view layer."""
+    st = scene.render.image_settings
+    if hasattr(st, "media_type"):
+        st.media_type = "MULTI_LAYER_IMAGE"  # 5.x: before the format, which it filters
+    st.file_format, st.color_depth = "OPEN_EXR_MULTILAYER", "32"
+
+
 def toyrt(scene, **settings):
     """The TOYRT engine, with `settings` of scene.toyrt (samples=16, seed=0, builder="sah", ...)."""
     scene.render.engine = "TOYRT"

@@ -64,13 +64,6 @@ def build_scene(depth=6):
     return s
 
 
-def multilayer_exr(scene):
-    st = scene.render.image_settings
-    if hasattr(st, "media_type"):
-        st.media_type = "MULTI_LAYER_IMAGE"  # 5.x: before the format, which it filters
-    st.file_format, st.color_depth = "OPEN_EXR_MULTILAYER", "32"
-
-
 def read_exr(path):
     """({pass name: (h, w, channels) float32} of the ViewLayer, channels in file order r, g, b, a;
     {metadata key: value} of the cryptomatte/ keys, and 'channels': the Crypto channels' full names)
@@ -110,7 +103,7 @@ def render(engine, samples=32, tag=""):
         scene.cycles.seed = 0
     else:
         kit.toyrt(scene, samples=samples)
-    multilayer_exr(scene)
+    kit.multilayer_exr(scene)
     path = os.path.join(TMP, f"{engine.lower()}{tag}.exr")
     result, printed = render_still(path)
     passes, meta = read_exr(path) if os.path.exists(path) else ({}, {})
@@ -359,7 +352,7 @@ def many_objects_manifest_time_and_memory():
     check(len(ids["object"]) == count and len(json.loads(text[0])) == count, "one id and one manifest entry per object")
     check(total_s < 2.0, f"the manifest of {count:,} objects takes {total_s:.2f} s (< 2 s)")
     kit.toyrt(s, samples=1)
-    multilayer_exr(s)
+    kit.multilayer_exr(s)
     s.render.engine = "TOYRT"
     t0 = time.perf_counter()
     result, _ = render_still(os.path.join(TMP, "many.exr"))

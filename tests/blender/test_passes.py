@@ -60,13 +60,6 @@ def build_scene():
     return s
 
 
-def multilayer_exr(scene):
-    st = scene.render.image_settings
-    if hasattr(st, "media_type"):
-        st.media_type = "MULTI_LAYER_IMAGE"  # 5.x: before the format, which it filters
-    st.file_format, st.color_depth = "OPEN_EXR_MULTILAYER", "32"
-
-
 def read_layers(path):
     """{view layer: {pass name: (h, w, channels) float32, rows from the top}} of a multilayer EXR,
     each pass's channels in their registered order. Blender 3.4 writes one part holding every
@@ -102,7 +95,7 @@ def render(engine, samples=16, tag=""):
         scene.cycles.seed = 0
     else:
         kit.toyrt(scene, samples=samples)
-    multilayer_exr(scene)
+    kit.multilayer_exr(scene)
     path = os.path.join(TMP, f"{engine.lower()}{tag}.exr")
     result, printed = render_still(path)
     return (read_layers(path).get("ViewLayer", {}) if os.path.exists(path) else {}), result, printed
