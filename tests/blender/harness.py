@@ -77,6 +77,25 @@ def render_still(path):
     return result, out[0]
 
 
+def render_multilayer(engine, samples, path):
+    """The current scene rendered by `engine` ("TOYRT", or "CYCLES" restricted to TOYRT's light
+    transport: seed 0, depth 8) into the multilayer OpenEXR `path`: render_still's answer. Needs
+    the scene kit on sys.path."""
+    import bpy
+    import kit
+    from cycles_like_toyrt import configure_cycles
+
+    scene = bpy.context.scene
+    scene.render.engine = engine
+    if engine == "CYCLES":
+        configure_cycles(scene, samples, 8)
+        scene.cycles.seed = 0
+    else:
+        kit.toyrt(scene, samples=samples)
+    kit.multilayer_exr(scene)
+    return render_still(path)
+
+
 @contextmanager
 def live_sync(sync, toyrt):
     """A SceneSync (`sync`: the add-on's sync module) of the current scene, synced and committed,

@@ -20,7 +20,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit (see harness)
 import kit  # noqa: E402
 from cycles_like_toyrt import configure_cycles  # noqa: E402
-from harness import check, render_still, run_script  # noqa: E402
+from harness import check, render_multilayer, render_still, run_script  # noqa: E402
 
 TMP = tempfile.mkdtemp(prefix="toyrt-crypto-")
 W, H = 96, 72
@@ -96,16 +96,8 @@ def read_exr(path):
 
 
 def render(engine, samples=32, tag=""):
-    scene = bpy.context.scene
-    scene.render.engine = engine
-    if engine == "CYCLES":
-        configure_cycles(scene, samples, 8)
-        scene.cycles.seed = 0
-    else:
-        kit.toyrt(scene, samples=samples)
-    kit.multilayer_exr(scene)
     path = os.path.join(TMP, f"{engine.lower()}{tag}.exr")
-    result, printed = render_still(path)
+    result, printed = render_multilayer(engine, samples, path)
     passes, meta = read_exr(path) if os.path.exists(path) else ({}, {})
     return passes, meta, result
 

@@ -16,8 +16,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit (see harness)
 import kit  # noqa: E402
-from cycles_like_toyrt import configure_cycles  # noqa: E402
-from harness import check, render_still, run_script  # noqa: E402
+from harness import check, render_multilayer, run_script  # noqa: E402
 
 TMP = tempfile.mkdtemp(prefix="toyrt-passes-")
 W, H = 64, 48
@@ -88,16 +87,8 @@ def read_layers(path):
 
 
 def render(engine, samples=16, tag=""):
-    scene = bpy.context.scene
-    scene.render.engine = engine
-    if engine == "CYCLES":
-        configure_cycles(scene, samples, 8)
-        scene.cycles.seed = 0
-    else:
-        kit.toyrt(scene, samples=samples)
-    kit.multilayer_exr(scene)
     path = os.path.join(TMP, f"{engine.lower()}{tag}.exr")
-    result, printed = render_still(path)
+    result, printed = render_multilayer(engine, samples, path)
     return (read_layers(path).get("ViewLayer", {}) if os.path.exists(path) else {}), result, printed
 
 
