@@ -5,6 +5,11 @@
 // setting, "madvise", gives them to nothing else), and only when the mark comes before the
 // pages are first touched: so the mark is made here, at allocation, on 2 MB-aligned memory.
 // Measured: the exact count queries 1.2x at 1.3M triangles (docs/queries.md).
+//
+// The large arrays are mapped and unmapped directly (mmap/munmap), not taken from malloc: glibc
+// serves a freed mmap-sized block's successors from its heap (its mmap threshold rises to the
+// freed size), where freed huge pages stay resident; a 100-frame animation that rebuilt one
+// 10 MB mesh per frame grew by 60 MB that way (tests/blender/test_animation_memory.py).
 #pragma once
 
 #include <cstddef>
@@ -35,10 +40,23 @@ struct HugePageAllocator {
 
   T* allocate(size_t n) {
     if (!is_large(n)) return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(alignof(T))));
-    void* p = std::aligned_alloc(kHugePageBytes, rounded_bytes(n));
+    const size_t bytes = rounded_bytes(n);
+#if defined(__linux__)
+    // Map one huge page more than needed and unmap the unaligned head and the tail beyond.
+    void* raw = mmap(nullptr, bytes + kHugePageBytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (raw == MAP_FAILED) throw std::bad_alloc();
+    const size_t start = reinterpret_cast<size_t>(raw);
+    const size_t aligned = (start + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
+    if (aligned > start) munmap(raw, aligned - start);
+    const size_t tail = start + bytes + kHugePageBytes - (aligned + bytes);
+    if (tail) munmap(reinterpret_cast<void*>(aligned + bytes), tail);
+    void* p = reinterpret_cast<void*>(aligned);
+#if defined(MADV_HUGEPAGE)
+    madvise(p, bytes, MADV_HUGEPAGE);  // a hint: ignored where huge pages are off
+#endif
+#else
+    void* p = std::aligned_alloc(kHugePageBytes, bytes);
     if (!p) throw std::bad_alloc();
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    madvise(p, rounded_bytes(n), MADV_HUGEPAGE);  // a hint: ignored where huge pages are off
 #endif
     return static_cast<T*>(p);
   }
@@ -47,7 +65,11 @@ struct HugePageAllocator {
     if (!is_large(n))
       ::operator delete(p, std::align_val_t(alignof(T)));
     else
+#if defined(__linux__)
+      munmap(p, rounded_bytes(n));
+#else
       std::free(p);
+#endif
   }
 
   template <class U>
