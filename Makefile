@@ -33,7 +33,7 @@ CMAKE_ARGS ?=
 APT_PACKAGES := cmake g++ make libglm-dev pybind11-dev python3-dev python3-numpy python3-venv \
 	libembree-dev libtbb-dev libgtest-dev googletest ocl-icd-opencl-dev opencl-headers \
 	pocl-opencl-icd clinfo blender python3-matplotlib clang clang-format-14 libclang-rt-14-dev \
-	xvfb xauth libgl1-mesa-dri assimp-testmodels python3-openimageio ccache
+	xvfb xauth libgl1-mesa-dri assimp-testmodels python3-openimageio ccache ninja-build
 # The stamp's name carries a hash of the list, so adding a package re-runs the check.
 APT_STAMP   := $(BUILD)/.stamp-apt-$(firstword $(shell printf '%s' '$(APT_PACKAGES)' | md5sum))
 VENV_STAMP  := $(VENV)/.stamp-requirements
@@ -110,9 +110,10 @@ addon: native
 
 # The per-level builds (three wheels and build-levels) compile the same core for the same three
 # CPU levels four times: under ccache (from APT_PACKAGES) later builds reuse earlier compiles (the
-# core's command lines name no build folder: native/CMakeLists.txt). Measured from a fresh clone:
-# the cp310 wheel in 99 s after 210 s and 226 s for cp311 and cp313, which hit far less often than
-# a second build folder by hand does (34 of 35 sources): not yet understood. Only for these builds:
+# core's command lines name no build folder: native/CMakeLists.txt). ccache hashes the compiler's
+# name too, and each Python's sysconfig named another (Debian's 3.11 x86_64-linux-gnu-g++, pyenv's
+# g++): so every one of these builds runs g++ through Ninja, the same command lines, and a later
+# build hits 35 of 39 compiles (scripts/build-wheel.sh; test-levels below). Only for these builds:
 # their flags name the level, where -march=native (the main build) would not say which CPU.
 LEVELS_CCACHE = CMAKE_CXX_COMPILER_LAUNCHER=$(shell command -v ccache)
 # The release files (docs/install.md): a portable wheel per Python, repaired by auditwheel
@@ -126,8 +127,12 @@ package: venv-package
 	@$(VENV)/bin/python scripts/build-extension.py --dist $(DIST)
 
 # ---- tests ------------------------------------------------------------------------------------------
+TEST_STAGES := lint test-native test-python test-blender test-bpy test-package fuzz test-levels sanitize
+# Each stage's wall time is printed as it ends ("make test: <stage> took N s"), so a slow one shows.
 test: setup
-	@$(MAKE) --no-print-directory lint test-native test-python test-blender test-bpy test-package fuzz test-levels sanitize
+	@for stage in $(TEST_STAGES); do start=$$(date +%s); \
+		$(MAKE) --no-print-directory $$stage || exit 1; \
+		echo "make test: $$stage took $$(( $$(date +%s) - start )) s"; done
 
 test-quick: native venv
 	@$(MAKE) --no-print-directory lint test-native test-python
@@ -145,7 +150,7 @@ format:
 	clang-format-14 -i $(CXX_SOURCES)
 
 test-native:
-	ctest --test-dir $(BUILD) --output-on-failure --no-tests=error
+	ctest --test-dir $(BUILD) --output-on-failure --no-tests=error -j$(JOBS)
 
 test-python:
 	PYTHONPATH=$(BUILD)/python $(VENV)/bin/python -m pytest tests/python -q
@@ -265,7 +270,7 @@ fuzz: apt
 LEVELS_BUILD ?= $(BUILD)-levels
 space := $(subst ,, )
 test-levels: apt
-	@[ -f $(LEVELS_BUILD)/CMakeCache.txt ] || $(LEVELS_CCACHE) cmake -S . -B $(LEVELS_BUILD) -DCMAKE_BUILD_TYPE=Release \
+	@[ -f $(LEVELS_BUILD)/CMakeCache.txt ] || $(LEVELS_CCACHE) CXX=g++ cmake -G Ninja -S . -B $(LEVELS_BUILD) -DCMAKE_BUILD_TYPE=Release \
 		-DTOYRT_CPU_DISPATCH=ON -DTOYRT_NATIVE_ARCH=OFF -DTOYRT_TEST_LEVELS="$(subst $(space),;,$(strip $(CPU_LEVELS)))" \
 		|| { rm -f $(LEVELS_BUILD)/CMakeCache.txt; exit 1; }
 	@env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL cmake --build $(LEVELS_BUILD) -j$(JOBS) --target toyrt_level_tests
@@ -280,7 +285,7 @@ sanitize: apt venv
 		-DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
 		-DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" $(CMAKE_ARGS) || { rm -f $(SAN_BUILD)/CMakeCache.txt; exit 1; }
 	@env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL cmake --build $(SAN_BUILD) -j$(JOBS)
-	$(SAN_ENV) ctest --test-dir $(SAN_BUILD) --output-on-failure --no-tests=error
+	$(SAN_ENV) ctest --test-dir $(SAN_BUILD) --output-on-failure --no-tests=error -j$(JOBS)
 	@# The interpreter is not built with ASan: its runtime must be loaded first, and libstdc++ with
 	@# it (else ASan cannot find __cxa_throw and aborts on the first C++ exception). --noconftest:
 	@# the conftest would put build/python (not the sanitized module) first on the path.

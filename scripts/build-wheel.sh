@@ -16,6 +16,9 @@ OUT=$2
 RAW=build/wheel/raw
 rm -rf "$RAW" && mkdir -p "$RAW" "$OUT"
 
+# One compiler name for every Python (each one's sysconfig names another, and ccache, which
+# `make package` runs the compiles under, counts the name: docs in the Makefile).
+export CXX=${CXX:-g++}
 start=${EPOCHREALTIME/./}  # microseconds
 CMAKE_BUILD_PARALLEL_LEVEL=${JOBS:-2} "$PYTHON" -m pip wheel . --no-build-isolation --no-deps -q -w "$RAW"
 built=${EPOCHREALTIME/./}

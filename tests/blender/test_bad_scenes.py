@@ -281,9 +281,11 @@ def test_100k_objects():
     me = kit.box("cube", 0.5, (0, 0, 0)).data
     bpy.data.objects.remove(bpy.data.objects["cube"])
     t0 = time.perf_counter()
-    # Linked duplicates of one 12-triangle cube on a 400 x 250 grid (one unit apart).
+    # Linked duplicates of one 12-triangle cube on a 400 x 250 grid (one unit apart). Each its own
+    # name: Blender makes a repeated name unique by trying suffixes, 2.4x slower here than names
+    # that are already unique (20,000 objects in 3.4: 8.5 s against 3.6 s).
     for i in range(n):
-        obj = bpy.data.objects.new("c", me)
+        obj = bpy.data.objects.new(f"c{i:06d}", me)
         obj.location = (i % 400 - 200.0, i // 400 - 125.0, 0.0)
         coll.objects.link(obj)
     made = time.perf_counter() - t0

@@ -55,7 +55,10 @@ TEST_P(Watertight, SphereHasNoGapsAtEdgesOrVertices) {
 
 TEST_P(Watertight, FanOfThousandsSharingOneVertexHasNoGaps) {
   // 2 apexes, each shared by 5000 triangles: rays at the apex meet 5000 candidate triangles.
-  expect_watertight(GetParam(), "bicone-fan", bicone_fan(5000), Vec3(0.01f, 0.02f, 0.0f), 8);
+  // Every sliver's box holds the centre the rays start from, so each of the 55,000 rays tests
+  // thousands of triangles: 2 random points per edge (beside its midpoint) keep this the suite's
+  // longest test at about 10 s, where 8 took 27 s (2 minutes under the sanitizers).
+  expect_watertight(GetParam(), "bicone-fan", bicone_fan(5000), Vec3(0.01f, 0.02f, 0.0f), 2);
 }
 
 TEST_P(Watertight, BumpyMeshHasNoGaps) {
