@@ -112,13 +112,17 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         # layers[0] is the first layer, and a second layer's pixels would land on it).
         layer_name = depsgraph.view_layer.name
 
+        time_limit = settings.time_limit
+        progress.time_limit = time_limit
+
         def on_tile(x, y, w, h, pixels):
             bottom = height - (y + h)
             result = self.begin_result(x, bottom, w, h, layer=layer_name)
             _set_rect(result.layers[0].passes["Combined"].rect, np.ascontiguousarray(pixels[::-1]))
             self.end_result(result)
-            tiles_done[0] += 1
-            progress.tiles(tiles_done[0], tiles_total)
+            if not time_limit:
+                tiles_done[0] += 1
+                progress.tiles(tiles_done[0], tiles_total)
 
         wanted = passes.enabled(depsgraph.view_layer)
         if passes.black(wanted):
@@ -141,7 +145,11 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             object_index=np.array(tables.object_pass_index, np.float32),
             material_index=np.array(tables.material_pass_index, np.float32),
             cryptomatte=tables.cryptomatte_ids(),
-            cryptomatte_depth=tables.cryptomatte_depth)
+            cryptomatte_depth=tables.cryptomatte_depth,
+            use_adaptive_sampling=settings.use_adaptive_sampling, adaptive_threshold=settings.adaptive_threshold,
+            adaptive_min_samples=settings.adaptive_min_samples, time_limit=time_limit,
+            # A time limit renders passes over the whole image: the native count of samples done.
+            on_progress=progress.samples_done if time_limit else None)
         info = t_scene.last_render
         if info["cancelled"]:
             return
@@ -154,9 +162,14 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             self._write_passes(image, t_scene.last_passes, wanted, noisy if settings.use_denoising else None,
                                layer_name, tables)
         elapsed = time.perf_counter() - started
+        done = info["samples_done"]
         progress.finished(f"Export {stats['export_s'] * 1000:.0f} ms, BVH {build_ms:.0f} ms, "
-                          f"Render {info['render_ms'] / 1000:.2f} s, {stats.get('triangles', 0):,} triangles")
-        print(f"TOYRT: frame {frame} done in {elapsed:.2f} s ({image.shape[1]}x{image.shape[0]}, {samples} samples)",
+                          f"Render {info['render_ms'] / 1000:.2f} s, {stats.get('triangles', 0):,} triangles",
+                          samples_done=done)
+        taken = f"{samples} samples" if done == samples else f"{done} of {samples} samples: time limit"
+        if settings.use_adaptive_sampling:
+            taken += f", adaptive: {info['mean_samples']:.1f} per pixel"
+        print(f"TOYRT: frame {frame} done in {elapsed:.2f} s ({image.shape[1]}x{image.shape[0]}, {taken})",
               flush=True)
 
     def _write_passes(self, image, computed, wanted, noisy, layer_name, tables):

@@ -6,6 +6,21 @@ class TOYRTRenderSettings(bpy.types.PropertyGroup):
     samples: bpy.props.IntProperty(
         name="Samples", description="Samples per pixel (Sobol-Owen pattern, box filter of one pixel)",
         default=16, min=1, soft_max=4096)
+    # Cycles' names and meaning (scene.cycles.use_adaptive_sampling, adaptive_threshold,
+    # adaptive_min_samples, time_limit), so users find them where they expect.
+    use_adaptive_sampling: bpy.props.BoolProperty(
+        name="Noise Threshold", description="Stop sampling a pixel once its noise estimate is below the "
+        "threshold (Cycles' adaptive sampling)", default=False)
+    adaptive_threshold: bpy.props.FloatProperty(
+        name="Noise Threshold", description="Noise level at which a pixel stops being sampled; 0 for an "
+        "automatic value from the sample count", default=0.01, min=0.0, max=1.0, soft_min=0.001, precision=4)
+    adaptive_min_samples: bpy.props.IntProperty(
+        name="Min Samples", description="Samples every pixel takes before adaptive sampling may stop it; 0 for "
+        "an automatic count from the threshold", default=0, min=0, max=4096)
+    time_limit: bpy.props.FloatProperty(
+        name="Time Limit", description="Stop rendering a frame after this time (scene export and BVH build "
+        "not counted); the frame is complete for the samples taken. 0 for no limit",
+        default=0.0, min=0.0, subtype="TIME_ABSOLUTE", unit="TIME_ABSOLUTE")
     viewport_samples: bpy.props.IntProperty(
         name="Viewport Samples",
         description="Samples per pixel the 3D viewport's Rendered mode accumulates before it stops using the CPU",

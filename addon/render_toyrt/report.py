@@ -125,6 +125,7 @@ class Progress:
         self.fraction = 0.0
         self.shown_samples = -1
         self.last_shown = 0.0
+        self.time_limit = 0.0  # seconds of rendering (the scene's time_limit), 0: none
 
     def phase(self, status: str, locked: bool = False) -> None:
         """A new phase; locked: its polls come from native code that holds the scene's lock."""
@@ -151,11 +152,21 @@ class Progress:
         self.engine.update_progress(self.fraction)
         self._show_samples(force=done == total)
 
-    def finished(self, summary: str) -> None:
-        """The render is complete: a last Sample N/N line, then `Finished | summary`."""
-        self.fraction = 1.0
-        if self.shown_samples != self.samples:
+    def samples_done(self, samples: float) -> None:
+        """The native render's own count of the samples done over the whole image (its
+        on_progress): what a time-limited render, rendered in passes, reports."""
+        self.fraction = min(max(samples / self.samples, 0.0), 1.0)
+        self.engine.update_progress(self.fraction)
+        self._show_samples(force=False)
+
+    def finished(self, summary: str, samples_done: int | None = None) -> None:
+        """The render is complete: a last Sample k/N line (k = N, or the samples a time limit
+        left it), then `Finished | summary`."""
+        done = self.samples if samples_done is None else min(int(samples_done), self.samples)
+        self.fraction = done / self.samples
+        if self.shown_samples != done:
             self._show_samples(force=True)
+        self.fraction = 1.0
         self.phase(f"Finished | {summary}")  # after the render: the lock is free again
 
     # ---------------------------------------------------------------------------------------
@@ -178,6 +189,9 @@ class Progress:
         info = f"Mem:{self.memory_mb:.2f}M, Peak:{self.peak_mb:.2f}M | {self.where} | {self.status}"
         if self.render_started is not None and 0.0 < self.fraction < 1.0:
             spent = now - self.render_started
-            info = f"Remaining:{timecode(spent * (1.0 - self.fraction) / self.fraction)} | {info}"
+            remaining = spent * (1.0 - self.fraction) / self.fraction
+            if self.time_limit > 0.0:
+                remaining = min(remaining, max(self.time_limit - spent, 0.0))
+            info = f"Remaining:{timecode(remaining)} | {info}"
         self.engine.update_stats("", info)
         self.last_shown = now

@@ -42,7 +42,16 @@ class RENDER_PT_toyrt(ToyrtPanel, bpy.types.Panel):
         problem = sys.modules[__package__].load_error
         for i, line in enumerate(textwrap.wrap(problem, 70)):
             layout.label(text=line, icon="ERROR" if i == 0 else "BLANK1")
-        layout.prop(settings, "samples")
+        row = layout.row(heading="Noise Threshold")
+        row.prop(settings, "use_adaptive_sampling", text="")
+        sub = row.row()
+        sub.active = settings.use_adaptive_sampling
+        sub.prop(settings, "adaptive_threshold", text="")
+        layout.prop(settings, "samples", text="Max Samples" if settings.use_adaptive_sampling else "Samples")
+        col = layout.column()
+        col.active = settings.use_adaptive_sampling
+        col.prop(settings, "adaptive_min_samples")
+        layout.prop(settings, "time_limit")
         layout.prop(settings, "viewport_samples")
         layout.prop(settings, "area_light_sampling")
         layout.prop(settings, "light_sampling")

@@ -50,6 +50,10 @@ py::dict core_defaults() {
   d["area_light_sampling"] = area_sampling_name(render.integrator.area_sampling);
   d["light_sampling"] = light_sampling_name(render.integrator.light_sampling);
   d["all_lights_up_to"] = kAllLightsUpTo;
+  d["use_adaptive_sampling"] = render.adaptive.use;
+  d["adaptive_threshold"] = tidy(render.adaptive.threshold);
+  d["adaptive_min_samples"] = render.adaptive.min_samples;
+  d["time_limit"] = render.time_limit;
   d["builder"] = builder_name(commit.builder);
   d["material_color"] = as_tuple(Lambert{}.albedo);
   d["ior"] = tidy(PerfectRefraction{}.ior);
@@ -142,7 +146,13 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       "'cryptomatte_<kind>': (height, width, 2 * cryptomatte_depth), per pixel the (id, coverage) pairs\n"
       "ranked by coverage (the share of samples whose first hit has the id; misses have none), zeros after.\n"
       "cryptomatte_depth: the pairs per pixel, 1 to " +
-      std::to_string(kCryptomatteMaxDepth) + ".");
+      std::to_string(kCryptomatteMaxDepth) +
+      ".\n"
+      "use_adaptive_sampling, adaptive_threshold, adaptive_min_samples: Cycles' adaptive sampling (a pixel\n"
+      "stops once its noise estimate is below the threshold; 0 = automatic for both numbers).\n"
+      "time_limit: seconds of rendering (0 = none); the image is rendered in passes over the whole window\n"
+      "and the last pass is sized to end before the limit. on_progress(samples): called on this thread\n"
+      "after each tile with the samples done over the whole image so far (a float).");
 
   // The types and their parameters, read from the core's tables (each type documents its own).
   static const std::string light_doc =
@@ -258,11 +268,16 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
            py::arg("split_depth") = IntegratorSettings{}.split_depth, py::arg("passes") = py::none(),
            py::arg("mist") = py::none(), py::arg("object_index") = py::none(), py::arg("material_index") = py::none(),
            py::arg("cryptomatte") = py::none(), py::arg("cryptomatte_depth") = CryptomatteRequest{}.depth,
-           render_doc.c_str())
+           py::arg("use_adaptive_sampling") = AdaptiveSettings{}.use,
+           py::arg("adaptive_threshold") = AdaptiveSettings{}.threshold,
+           py::arg("adaptive_min_samples") = AdaptiveSettings{}.min_samples,
+           py::arg("time_limit") = RenderSettings{}.time_limit, py::arg("on_progress") = py::none(), render_doc.c_str())
       .def_property_readonly(
           "last_render", &PyScene::last_render,
           "What the last render did: cancelled, cancel_latency_ms, tiles_done, tiles_total, render_ms,\n"
-          "samples, light_sampling.")
+          "samples, samples_done (every pixel's: below samples when the time limit stopped it), mean_samples\n"
+          "(per pixel: below samples_done where adaptive sampling stopped pixels), time_limit_reached,\n"
+          "light_sampling.")
       .def_property_readonly("last_passes", &PyScene::last_passes,
                              "The passes the last render was asked for: name -> (height, width, channels) float32,\n"
                              "rows from the top (see render's `passes`).")

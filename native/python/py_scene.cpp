@@ -221,7 +221,8 @@ py::array_t<float> PyScene::render(const py::dict& camera_settings, int samples,
                                    int threads, int tile_size, py::object on_tile, py::object should_cancel,
                                    int first_sample, int split_depth, py::handle passes, py::handle mist,
                                    py::handle object_index, py::handle material_index, py::handle cryptomatte,
-                                   int cryptomatte_depth) {
+                                   int cryptomatte_depth, bool use_adaptive_sampling, float adaptive_threshold,
+                                   int adaptive_min_samples, double time_limit, py::object on_progress) {
   const AovRequest request = aov_request(passes, mist, object_index, material_index, cryptomatte, cryptomatte_depth);
   const Camera camera = Camera::make(to_camera(camera_settings));
   RenderSettings settings;
@@ -234,18 +235,25 @@ py::array_t<float> PyScene::render(const py::dict& camera_settings, int samples,
   settings.integrator.split_depth = split_depth;
   settings.integrator.area_sampling = parse_area_sampling(area_light_sampling);
   settings.integrator.light_sampling = parse_light_sampling(light_sampling);
+  settings.adaptive.use = use_adaptive_sampling;
+  settings.adaptive.threshold = adaptive_threshold;
+  settings.adaptive.min_samples = adaptive_min_samples;
+  settings.time_limit = time_limit;
 
   // Tiles and cancel polls arrive on this thread with the GIL released: take it for Python.
   TileSink sink;
-  if (!on_tile.is_none()) {
+  if (!on_tile.is_none() || !on_progress.is_none()) {
     sink = [&](const Tile& t, const RenderResult& r) {
       py::gil_scoped_acquire gil;
-      py::array_t<float> pixels({py::ssize_t(t.height), py::ssize_t(t.width), py::ssize_t(4)});
-      float* out = pixels.mutable_data();
-      for (int j = 0; j < t.height; ++j)
-        std::memcpy(out + size_t(j) * t.width * 4, &r.rgba[(size_t(t.y + j) * r.width + t.x) * 4],
-                    size_t(t.width) * 4 * sizeof(float));
-      on_tile(t.x, t.y, t.width, t.height, pixels);
+      if (!on_tile.is_none()) {
+        py::array_t<float> pixels({py::ssize_t(t.height), py::ssize_t(t.width), py::ssize_t(4)});
+        float* out = pixels.mutable_data();
+        for (int j = 0; j < t.height; ++j)
+          std::memcpy(out + size_t(j) * t.width * 4, &r.rgba[(size_t(t.y + j) * r.width + t.x) * 4],
+                      size_t(t.width) * 4 * sizeof(float));
+        on_tile(t.x, t.y, t.width, t.height, pixels);
+      }
+      if (!on_progress.is_none()) on_progress(r.progress_samples);
     };
   }
   CancelPoll poll = [&]() {
@@ -283,6 +291,9 @@ py::array_t<float> PyScene::render(const py::dict& camera_settings, int samples,
   last_render_["render_ms"] = result.render_ms;
   last_render_["cancel_latency_ms"] = result.cancel_latency_ms;
   last_render_["samples"] = samples;
+  last_render_["samples_done"] = result.samples_done;
+  last_render_["mean_samples"] = result.mean_samples;
+  last_render_["time_limit_reached"] = result.time_limit_reached;
   last_render_["first_sample"] = first_sample;
   last_render_["light_sampling"] = light_sampling_name(result.light_sampling);
   py::array_t<float> image({py::ssize_t(result.height), py::ssize_t(result.width), py::ssize_t(4)});

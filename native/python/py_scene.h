@@ -50,7 +50,9 @@ class PyScene {
                             const std::string& area_light_sampling, const std::string& light_sampling, int threads,
                             int tile_size, py::object on_tile, py::object should_cancel, int first_sample,
                             int split_depth, py::handle passes, py::handle mist, py::handle object_index,
-                            py::handle material_index, py::handle cryptomatte, int cryptomatte_depth);
+                            py::handle material_index, py::handle cryptomatte, int cryptomatte_depth,
+                            bool use_adaptive_sampling, float adaptive_threshold, int adaptive_min_samples,
+                            double time_limit, py::object on_progress);
   py::dict last_render() { return last_render_; }
   py::dict last_passes() { return last_passes_; }
 

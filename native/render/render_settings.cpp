@@ -2,6 +2,7 @@
 
 #include "core/parallel.h"
 
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 
@@ -39,6 +40,11 @@ void RenderSettings::check() const {
   if (tile_size < 1) throw std::invalid_argument("tile_size must be at least 1");
   if (integrator.max_specular_depth < 0) throw std::invalid_argument("max_specular_depth must be >= 0");
   if (integrator.split_depth < 0) throw std::invalid_argument("split_depth must be >= 0");
+  if (!(adaptive.threshold >= 0.0f) || !std::isfinite(adaptive.threshold))
+    throw std::invalid_argument("adaptive_threshold must be a finite number >= 0");
+  if (adaptive.min_samples < 0) throw std::invalid_argument("adaptive_min_samples must be >= 0");
+  if (!(time_limit >= 0.0) || !std::isfinite(time_limit))
+    throw std::invalid_argument("time_limit must be a finite number of seconds >= 0");
   check_threads(threads);
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "lights/area_light.h"
+#include "render/adaptive_sampling.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -48,6 +49,12 @@ struct RenderSettings {
   int tile_size = 32;  // pixels
   int threads = 0;     // 0: all cores
   IntegratorSettings integrator;
+  AdaptiveSettings adaptive;  // per-pixel stopping (render/adaptive_sampling.h)
+  // Seconds of rendering after which no further pass starts (Cycles' time_limit: the scene's
+  // export and BVH build are not counted); 0: none. With a limit the image is rendered in passes
+  // over the whole window (1, 1, 2, 4... samples), each sized to end before the limit, so the
+  // image is always a complete render of every sample taken.
+  double time_limit = 0.0;
 
   // Throws std::invalid_argument naming the first setting out of its bounds.
   void check() const;

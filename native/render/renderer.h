@@ -29,6 +29,13 @@ struct RenderResult {
   size_t tiles_done = 0, tiles_total = 0;
   double render_ms = 0.0;
   double cancel_latency_ms = 0.0;  // from the cancel request to every worker stopped (when cancelled)
+  // Samples: those every pixel was given (fewer when the time limit stopped the render), their
+  // mean over the pixels (below samples_done where adaptive sampling stopped pixels early), and
+  // the progress so far, in samples over the whole image (what "Sample k/N" shows).
+  int samples_done = 0;
+  double mean_samples = 0.0;
+  double progress_samples = 0.0;
+  bool time_limit_reached = false;
   LightSampling light_sampling = LightSampling::All;  // the estimator used ("auto" resolved)
 };
 
@@ -44,7 +51,8 @@ size_t render_memory_estimate(const Camera& camera, const RenderSettings& settin
 size_t available_memory_bytes();
 
 // Called on the calling thread (never on a worker) for each finished tile, with the image so far:
-// the tile's pixels are final. `should_cancel` is polled on the calling thread every few
+// the tile's pixels are final (with a time limit: final for the passes done so far, the tile is
+// handed over again after each pass). `should_cancel` is polled on the calling thread every few
 // milliseconds; when it returns true, workers stop within a few samples (the flag is read every
 // kCancelCheckSamples samples inside a pixel, so even 100,000 samples per pixel stop at once)
 // and render() returns with cancelled set; the pixels they were on are left unfinished. Either callback may be empty.

@@ -250,6 +250,42 @@ def test_session():
     check(not alive, f"no non-daemon thread is left after the renders: {alive}")
 
 
+def test_time_limit():
+    """Cycles' time limit and adaptive sampling under their Cycles names: a frame of 2^20 samples with
+    a 0.5 s limit finishes, written, its last Sample line says the samples it took (k/N with k < N),
+    and TOYRT's own line says the same count; nothing in it trips a strict farm. With adaptive
+    sampling on too, the line says the mean samples per pixel."""
+    build_scene("TOYRT", os.path.join(TMP, "time_limit.blend"))
+    s = bpy.context.scene
+    s.toyrt.samples = 1 << 20
+    s.toyrt.time_limit = 0.5
+    s.render.filepath = os.path.join(TMP, "time_limit")
+    with captured_output() as out:
+        result = bpy.ops.render.render(write_still=True)
+    lines = out[0].splitlines()
+    check(result == {"FINISHED"} and os.path.exists(s.render.filepath + ".png"), f"time limit: {result}, written")
+    samples = [re.search(r"Sample (\d+)/(\d+)", line) for line in lines]
+    samples = [(int(m.group(1)), int(m.group(2))) for m in samples if m]
+    done = [re.search(r"\((\d+)x(\d+), (\d+) of (\d+) samples: time limit", line) for line in lines]
+    done = [int(m.group(3)) for m in done if m]
+    check(samples and done and samples[-1] == (done[0], 1 << 20) and 1 <= done[0] < 1 << 20,
+          f"the last Sample line {samples[-1] if samples else None} says the samples taken ({done})")
+    strict = [line for line in lines if re.search(r"Warning|Error|Exception", line)]
+    check(not strict, f"no line a strict farm fails on: {strict[:3]}")
+    # Adaptive sampling: this flat scene's pixels all stop at the first test (the automatic minimum
+    # for Cycles' default threshold, 64, then the test after sample 79), long before 2^20.
+    s.toyrt.use_adaptive_sampling = True
+    with captured_output() as out:
+        result = bpy.ops.render.render(write_still=True)
+    mean = [re.search(r"\(\d+x\d+, (\d+) samples, adaptive: ([0-9.]+) per pixel\)", line)
+            for line in out[0].splitlines()]
+    mean = [float(m.group(2)) for m in mean if m]
+    check(result == {"FINISHED"} and mean and 80 <= mean[0] < 1 << 20,
+          f"adaptive sampling with the limit: {mean} samples per pixel of {1 << 20}")
+    s.toyrt.time_limit = 0.0
+    s.toyrt.use_adaptive_sampling = False
+
+
 def report():
     for key, value in MEASURED.items():
         print(f"  measured: {key}: {value}", flush=True)
@@ -257,5 +293,6 @@ def report():
 
 if NO_BINARY:
     print("test_farm: the command lines are skipped (bpy module: no blender executable of this version)", flush=True)
-PARTS = [test_session] + ([] if NO_BINARY else [test_flamenco, test_deadline, test_exit_codes, test_silence_gap])
+PARTS = [test_session, test_time_limit]
+PARTS += [] if NO_BINARY else [test_flamenco, test_deadline, test_exit_codes, test_silence_gap]
 run_script(PARTS + [report], "test_farm", TMP)
