@@ -22,6 +22,11 @@
 namespace toyrt {
 
 namespace {
+// The thin lens's 2D sample dimension. Dimensions are hashed into the scramble (sobol_owen.h), so
+// any number is as good as another; this one is past every path vertex's block of 64 up to a
+// depth of 2^26.
+constexpr uint32_t kLensDimension = 0xFFFFFFFFu;
+
 std::string format_bytes(size_t bytes) {
   char buf[32];
   const double b = double(bytes);
@@ -103,6 +108,18 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
   bool done = false;
   std::exception_ptr failure;
 
+  // The camera ray of one sample: dimension 0 jitters it in the pixel; a thin lens draws its
+  // aperture point from a dimension of its own, far past the path vertices' blocks
+  // (integrator.cpp) so it never shares one. A pinhole draws nothing more: its rays, and so its
+  // image, are those it had before depth of field existed.
+  const bool pinhole = camera.lens.pinhole();
+  auto primary_ray = [&](int px, int py, uint32_t pixel, uint32_t s) {
+    const Vec2 jitter = sobol_owen_2d(pixel, s, 0, settings.integrator.seed);
+    if (pinhole) return camera.generate(float(px) + jitter.x, float(py) + jitter.y);
+    return camera.generate(float(px) + jitter.x, float(py) + jitter.y,
+                           sobol_owen_2d(pixel, s, kLensDimension, settings.integrator.seed));
+  };
+
   auto render_tile = [&](const Tile& t) {
     const float inv = 1.0f / float(settings.samples);
     const int first = settings.first_sample, last = settings.first_sample + settings.samples;
@@ -125,10 +142,9 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
           for (int s = first; s < last; ++s) {
             if ((s - first) % kCancelCheckSamples == kCancelCheckSamples - 1 && cancel.load(std::memory_order_relaxed))
               return false;
-            const Vec2 jitter = sobol_owen_2d(pixel, uint32_t(s), 0, settings.integrator.seed);
             FirstHit hit;
-            sum += trace_path(scene, camera.generate(float(px) + jitter.x, float(py) + jitter.y), pixel, uint32_t(s),
-                              settings.integrator, &hit);
+            sum += trace_path(scene, primary_ray(px, py, pixel, uint32_t(s)), pixel, uint32_t(s), settings.integrator,
+                              &hit);
             aov.add(hit, s == first);
             if (with_cryptomatte) crypto.add(hit.found ? hit.instance : -1, hit.material);
           }
@@ -140,9 +156,7 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
           // latency by a few samples whatever the sample count.
           if ((s - first) % kCancelCheckSamples == kCancelCheckSamples - 1 && cancel.load(std::memory_order_relaxed))
             return false;
-          const Vec2 jitter = sobol_owen_2d(pixel, uint32_t(s), 0, settings.integrator.seed);
-          sum += trace_path(scene, camera.generate(float(px) + jitter.x, float(py) + jitter.y), pixel, uint32_t(s),
-                            settings.integrator);
+          sum += trace_path(scene, primary_ray(px, py, pixel, uint32_t(s)), pixel, uint32_t(s), settings.integrator);
         }
         float* out = &result.rgba[index * 4];
         out[0] = sum.x * inv;
