@@ -1,7 +1,7 @@
 """Blender's scene camera -> the camera dict toyrt.Scene.render(camera=...) takes.
 
 The camera is read at render time, never stored in the native scene: a camera move costs the
-sync nothing. (The 3D viewport's camera is viewport.view_camera.)"""
+sync nothing. (The 3D viewport's camera is viewport.view_camera; it has no depth of field.)"""
 from __future__ import annotations
 
 import numpy as np
@@ -34,8 +34,34 @@ def export_camera(depsgraph, camera_object=None) -> dict:
                  sensor_width=float(c.sensor_width), sensor_height=float(c.sensor_height),
                  sensor_fit=c.sensor_fit, shift_x=float(c.shift_x), shift_y=float(c.shift_y),
                  clip_start=float(c.clip_start), clip_end=float(c.clip_end), ortho_scale=float(c.ortho_scale))
+        d.update(depth_of_field(depsgraph, cam, c.dof))
     else:
         # Blender renders through a non-camera object with the default camera settings.
         d.update(type="PERSP", lens=50.0, sensor_width=36.0, sensor_height=24.0, sensor_fit="AUTO",
                  shift_x=0.0, shift_y=0.0, clip_start=0.1, clip_end=1000.0, ortho_scale=6.0)
     return d
+
+
+def depth_of_field(depsgraph, cam, dof) -> dict:
+    """Blender's camera.dof (the same properties in 3.4 and 5.x) as the core's settings; the core
+    turns the f-stop into the aperture radius and clamps as Cycles does."""
+    if not dof.use_dof:
+        return dict(use_dof=False)
+    return dict(use_dof=True, focus_distance=focus_distance(depsgraph, cam, dof),
+                aperture_fstop=float(dof.aperture_fstop), aperture_blades=int(dof.aperture_blades),
+                aperture_rotation=float(dof.aperture_rotation), aperture_ratio=float(dof.aperture_ratio))
+
+
+def focus_distance(depsgraph, cam, dof) -> float:
+    """The focus object's depth along the camera's view axis, as Cycles computes it (|view axis .
+    (camera - object)| between the world positions), else dof.focus_distance. A bone named by
+    4.x's dof.focus_subtarget is not looked up: the armature object's own position is used."""
+    target = dof.focus_object
+    if target is None:
+        return float(dof.focus_distance)
+    target = getattr(target, "original", target)
+    target = target.evaluated_get(depsgraph) if hasattr(target, "evaluated_get") else target
+    m = np.array(cam.matrix_world, np.float64)
+    t = np.array(target.matrix_world, np.float64)
+    axis = m[:3, 2] / np.linalg.norm(m[:3, 2])
+    return float(abs(axis @ (m[:3, 3] - t[:3, 3])))

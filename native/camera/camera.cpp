@@ -4,6 +4,7 @@
 // fraction of the fitted dimension.
 #include "camera/camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -40,6 +41,16 @@ Camera Camera::make(const CameraParams& p) {
               p.matrix_world[3][3] == 1.0f,
           "matrix_world must be affine: its last row must be 0 0 0 1");
 
+  if (p.use_dof) {
+    require(std::isfinite(p.focus_distance) && p.focus_distance >= 0.0f,
+            "focus_distance must be finite and not negative");
+    require(std::isfinite(p.aperture_fstop) && p.aperture_fstop >= 0.0f,
+            "aperture_fstop must be finite and not negative");
+    require(p.aperture_blades >= 0, "aperture_blades must not be negative");
+    require(std::isfinite(p.aperture_rotation), "aperture_rotation must be finite");
+    require(finite_positive(p.aperture_ratio), "aperture_ratio must be positive and finite");
+  }
+
   Camera cam;
   cam.type = p.type;
   // Blender's BKE_render_resolution: integer arithmetic, truncating.
@@ -75,6 +86,18 @@ Camera Camera::make(const CameraParams& p) {
   cam.clip_start = p.clip_start;
   cam.clip_end = p.clip_end;
 
+  if (p.use_dof) {
+    // Cycles' rules (blender/camera.cpp, scene/camera.cpp): the lens in mm over twice the f-stop,
+    // in metres; an orthographic camera has no focal length, so 1 m stands in for it. A zero
+    // f-stop or focus distance is clamped to 1e-5, never refused, as Blender allows both.
+    const float fstop = std::max(p.aperture_fstop, 1e-5f);
+    cam.lens.radius = (p.type == CameraType::Perspective ? p.lens * 1e-3f : 1.0f) / (2.0f * fstop);
+    cam.lens.focus_distance = std::max(p.focus_distance, 1e-5f);
+    cam.lens.blades = p.aperture_blades < 3 ? 0 : p.aperture_blades;
+    cam.lens.rotation = p.aperture_rotation;
+    cam.lens.inv_ratio = 1.0f / p.aperture_ratio;
+  }
+
   cam.window = {0, 0, cam.width, cam.height};
   if (p.use_border) {
     require(std::isfinite(p.border_min_x) && std::isfinite(p.border_max_x) && std::isfinite(p.border_min_y) &&
@@ -109,6 +132,36 @@ Ray Camera::generate(float px, float py) const {
     ray.dir = -axis_z;
     ray.tnear = 0.0f;
     ray.tfar = clip_end - clip_start;
+  }
+  return ray;
+}
+
+Ray Camera::generate(float px, float py, const Vec2& lens_u) const {
+  if (lens.pinhole()) return generate(px, py);
+  const float sx = plane_min.x + (px / float(width)) * (plane_max.x - plane_min.x);
+  const float sy = plane_max.y - (py / float(height)) * (plane_max.y - plane_min.y);
+  const Vec2 a = lens.sample(lens_u);
+  // Camera space, the view along -z. The pinhole ray through (sx, sy) reaches depth f at
+  // (sx f, sy f) (perspective) or (sx, sy) (orthographic, from the plane point (sx, sy, 0)).
+  const float f = lens.focus_distance;
+  const bool perspective = type == CameraType::Perspective;
+  const Vec3 start = perspective ? Vec3(a.x, a.y, 0.0f) : Vec3(sx + a.x, sy + a.y, 0.0f);
+  const Vec3 focus = perspective ? Vec3(sx * f, sy * f, -f) : Vec3(sx, sy, -f);
+  const Vec3 d = glm::normalize(focus - start);
+  // 1 / cos(angle to the view axis) turns the clip planes' depths into distances along d.
+  const float per_depth = 1.0f / -d.z;
+  Ray ray;
+  ray.dir = d.x * axis_x + d.y * axis_y + d.z * axis_z;
+  const Vec3 org = position + start.x * axis_x + start.y * axis_y;
+  if (perspective) {
+    ray.org = org;
+    ray.tnear = clip_start * per_depth;
+    ray.tfar = clip_end * per_depth;
+  } else {
+    // As the pinhole orthographic ray, it starts on the near plane.
+    ray.org = org + (clip_start * per_depth) * ray.dir;
+    ray.tnear = 0.0f;
+    ray.tfar = (clip_end - clip_start) * per_depth;
   }
   return ray;
 }

@@ -1,7 +1,7 @@
 // Blender's camera: primary rays from Blender's camera and render settings, in Blender's units
 // and conventions (the view plane of BKE_camera_params_compute_viewplane, which Cycles' sync
 // reproduces). Perspective and orthographic; sensor fit, shift, clipping, resolution percentage,
-// pixel aspect and the render border.
+// pixel aspect, the render border, and depth of field (a thin lens: camera/thin_lens.h).
 //
 // Pixel coordinates: continuous (px, py) with px in [0, width) from the left and py in
 // [0, height) from the TOP row, the order images are stored in memory here; pixel (i, j) covers
@@ -10,6 +10,7 @@
 // them (addon/render_toyrt/engine.py and viewport.py, pixels[::-1]) when it hands them over.
 #pragma once
 
+#include "camera/thin_lens.h"
 #include "core/math.h"
 #include "core/ray.h"
 
@@ -37,6 +38,13 @@ struct CameraParams {
   bool use_border = false;  // render only the border region (Blender's border_min/max, y from the bottom)
   float border_min_x = 0.0f, border_min_y = 0.0f, border_max_x = 1.0f, border_max_y = 1.0f;
   Mat4 matrix_world = Mat4(1.0f);  // the camera object's world matrix; it looks down local -Z, +Y up
+  // Depth of field, Blender's camera.dof (the add-on turns a focus object into focus_distance).
+  bool use_dof = false;
+  float focus_distance = 10.0f;    // m, along the view axis; 0 is clamped to 1e-5 m as Cycles does
+  float aperture_fstop = 2.8f;     // radius = lens / (2 fstop) (orthographic: 1 m / (2 fstop)); 0 as 1e-5
+  int aperture_blades = 0;         // below 3: a round aperture
+  float aperture_rotation = 0.0f;  // radians
+  float aperture_ratio = 1.0f;     // anamorphic: the aperture's x is divided by it
 };
 
 // A rectangle of pixels [x0, x1) x [y0, y1), rows counted from the top.
@@ -56,6 +64,7 @@ struct Camera {
   // for perspective (tangents), in metres for orthographic. Shift is already applied.
   glm::vec2 plane_min{-1.0f}, plane_max{1.0f};
   float clip_start = 0.1f, clip_end = 100.0f;
+  ThinLens lens;  // a pinhole unless use_dof and a positive aperture
 
   // Checks the settings (throws std::invalid_argument naming the bad one) and precomputes the
   // view plane. The matrix's scale is ignored, as Cycles does: only rotation and position count.
@@ -67,6 +76,10 @@ struct Camera {
   // orthographic rays start on the near plane (tnear = 0) and end on the far one
   // (tfar = clip_end - clip_start).
   Ray generate(float px, float py) const;
+  // The same through the point of the aperture that lens_u in [0, 1)^2 picks (ThinLens::sample):
+  // the ray crosses the plane of focus where generate(px, py) does. Clipping stays by planes,
+  // measured from the lens plane along this ray. A pinhole lens gives generate(px, py).
+  Ray generate(float px, float py, const Vec2& lens_u) const;
 };
 
 }  // namespace toyrt

@@ -244,7 +244,13 @@ CameraParams to_camera(const py::dict& camera) {
                                               "border_min_y",
                                               "border_max_x",
                                               "border_max_y",
-                                              "matrix_world"};
+                                              "matrix_world",
+                                              "use_dof",
+                                              "focus_distance",
+                                              "aperture_fstop",
+                                              "aperture_blades",
+                                              "aperture_rotation",
+                                              "aperture_ratio"};
   CameraParams p;
   for (auto item : camera) {
     const std::string key = py::str(item.first);
@@ -287,6 +293,10 @@ CameraParams to_camera(const py::dict& camera) {
       p.matrix_world = to_matrix(v, "camera matrix_world");
     } else if (key == "use_border") {
       p.use_border = PyObject_IsTrue(v.ptr()) == 1;
+    } else if (key == "use_dof") {
+      p.use_dof = PyObject_IsTrue(v.ptr()) == 1;
+    } else if (key == "aperture_blades") {
+      p.aperture_blades = count();
     } else if (key == "resolution_x") {
       p.resolution_x = count();
     } else if (key == "resolution_y") {
@@ -323,6 +333,14 @@ CameraParams to_camera(const py::dict& camera) {
         p.border_max_x = x;
       else if (key == "border_max_y")
         p.border_max_y = x;
+      else if (key == "focus_distance")
+        p.focus_distance = x;
+      else if (key == "aperture_fstop")
+        p.aperture_fstop = x;
+      else if (key == "aperture_rotation")
+        p.aperture_rotation = x;
+      else if (key == "aperture_ratio")
+        p.aperture_ratio = x;
     }
   }
   return p;

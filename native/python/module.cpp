@@ -121,7 +121,9 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       "camera: a dict of Blender's camera and render settings: type ('PERSP', 'ORTHO'), lens, sensor_width,\n"
       "sensor_height, sensor_fit ('AUTO', 'HORIZONTAL', 'VERTICAL'), shift_x, shift_y, clip_start, clip_end,\n"
       "ortho_scale, resolution_x, resolution_y, resolution_percentage, pixel_aspect_x, pixel_aspect_y,\n"
-      "use_border, border_min_x/y, border_max_x/y, matrix_world (4, 4).\n"
+      "use_border, border_min_x/y, border_max_x/y, matrix_world (4, 4); depth of field as Blender's camera.dof:\n"
+      "use_dof, focus_distance (m along the view axis), aperture_fstop, aperture_blades (below 3: round),\n"
+      "aperture_rotation (radians), aperture_ratio (anamorphic).\n"
       "area_light_sampling: 'solid_angle' (spherical rectangles) or 'area'. light_sampling: 'all' (every\n"
       "light at every hit), 'one' (one light chosen by expected contribution) or 'auto' ('all' up to " +
       std::to_string(kAllLightsUpTo) +

@@ -13,7 +13,8 @@
 namespace toyrt {
 namespace {
 
-// Sample dimensions: 0 is the pixel jitter (the renderer's); each path vertex takes a block.
+// Sample dimensions: 0 is the pixel jitter and the last one (2^32 - 1) the thin lens's (the
+// renderer's); each path vertex takes a block.
 constexpr uint32_t kDimsPerVertex = 64;
 uint32_t vertex_dimension(int depth, uint32_t k) { return 1 + uint32_t(depth) * kDimsPerVertex + k; }
 

@@ -23,6 +23,11 @@
 namespace toyrt {
 
 namespace {
+// The thin lens's 2D sample dimension. Dimensions are hashed into the scramble (sobol_owen.h), so
+// any number is as good as another; this one is past every path vertex's block of 64 up to a
+// depth of 2^26.
+constexpr uint32_t kLensDimension = 0xFFFFFFFFu;
+
 std::string format_bytes(size_t bytes) {
   char buf[32];
   const double b = double(bytes);
@@ -106,6 +111,18 @@ void render_pass(const Scene& scene, const Camera& camera, const RenderSettings&
   bool done = false;
   std::exception_ptr failure;
 
+  // The camera ray of one sample: dimension 0 jitters it in the pixel; a thin lens draws its
+  // aperture point from a dimension of its own, far past the path vertices' blocks
+  // (integrator.cpp) so it never shares one. A pinhole draws nothing more: its rays, and so its
+  // image, are those it had before depth of field existed.
+  const bool pinhole = camera.lens.pinhole();
+  auto primary_ray = [&](int px, int py, uint32_t pixel, uint32_t s) {
+    const Vec2 jitter = sobol_owen_2d(pixel, s, 0, settings.integrator.seed);
+    if (pinhole) return camera.generate(float(px) + jitter.x, float(py) + jitter.y);
+    return camera.generate(float(px) + jitter.x, float(py) + jitter.y,
+                           sobol_owen_2d(pixel, s, kLensDimension, settings.integrator.seed));
+  };
+
   // The samples of one pixel: `trace_one(s)` returns sample s's radiance. Returns the count
   // taken, or -1 when cancelled. Without adaptive sampling the loop is the plain one.
   auto sample_pixel = [&](auto adaptive, size_t index, Vec3& sum, auto&& trace_one) -> int {
@@ -155,10 +172,9 @@ void render_pass(const Scene& scene, const Camera& camera, const RenderSettings&
           AovPixel aov(passes, camera);
           CryptomattePixel crypto(passes.cryptomatte, crypto_scratch);
           taken = sample_pixel(adaptive, index, sum, [&](int s) {
-            const Vec2 jitter = sobol_owen_2d(pixel, uint32_t(s), 0, settings.integrator.seed);
             FirstHit hit;
-            const Vec3 L = trace_path(scene, camera.generate(float(px) + jitter.x, float(py) + jitter.y), pixel,
-                                      uint32_t(s), settings.integrator, &hit);
+            const Vec3 L = trace_path(scene, primary_ray(px, py, pixel, uint32_t(s)), pixel, uint32_t(s),
+                                      settings.integrator, &hit);
             aov.add(hit, s == first);
             if (with_cryptomatte) crypto.add(hit.found ? hit.instance : -1, hit.material);
             return L;
@@ -170,9 +186,7 @@ void render_pass(const Scene& scene, const Camera& camera, const RenderSettings&
           }
         } else {
           taken = sample_pixel(adaptive, index, sum, [&](int s) {
-            const Vec2 jitter = sobol_owen_2d(pixel, uint32_t(s), 0, settings.integrator.seed);
-            return trace_path(scene, camera.generate(float(px) + jitter.x, float(py) + jitter.y), pixel, uint32_t(s),
-                              settings.integrator);
+            return trace_path(scene, primary_ray(px, py, pixel, uint32_t(s)), pixel, uint32_t(s), settings.integrator);
           });
           if (taken < 0) return false;
         }

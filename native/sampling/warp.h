@@ -62,6 +62,23 @@ inline Vec2 sample_uniform_triangle(const Vec2& u) {
   return Vec2(1.0f - s, u.y * s);
 }
 
+// Uniform on the regular polygon with `corners` >= 3 corners inscribed in the unit circle, its
+// corners at angles rotation + (2k + 1) pi / corners, so with rotation 0 an edge's midpoint lies
+// on +x (Blender's aperture blades). Density 1 / area, area = corners sin(2 pi / corners) / 2. The
+// polygon is a fan of congruent triangles around the centre: u.x picks triangle k = floor(u.x n),
+// equally likely since they have equal areas, and its fraction is reused (still uniform on [0, 1)
+// given k), so the map keeps u's stratification within each triangle.
+inline Vec2 sample_uniform_regular_polygon(const Vec2& u, int corners, float rotation) {
+  const float n = float(corners);
+  const float scaled = u.x * n;
+  const float k = std::min(std::floor(scaled), n - 1.0f);
+  const Vec2 b = sample_uniform_triangle(Vec2(scaled - k, u.y));
+  // The triangle (centre, corner k, corner k + 1), barycentrics b of the two corners.
+  const float a0 = rotation + (2.0f * k - 1.0f) * kPi / n, a1 = a0 + 2.0f * kPi / n;
+  return b.x * Vec2(std::cos(a0), std::sin(a0)) + b.y * Vec2(std::cos(a1), std::sin(a1));
+}
+inline float regular_polygon_area(int corners) { return 0.5f * float(corners) * std::sin(2.0f * kPi / float(corners)); }
+
 // Directions in the cone of half-angle theta_max around +z, density 1 / (2 pi (1 - cos theta_max)).
 // The cone is given by one_minus_cos_max = 1 - cos(theta_max), which callers compute without
 // cancellation (sin^2 / (1 + cos)); a small light far away has a cap of 1e-10 that

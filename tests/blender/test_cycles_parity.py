@@ -111,6 +111,21 @@ def scene_glass(p):
     kit.world(p["world"], lights_diffuse=p["world_lights_diffuse"])
 
 
+def scene_depth_of_field(p):
+    """Three boxes at 3, 6 and 9 m on a checker floor, the camera focused on the middle one (its
+    focus object) through a bladed, turned aperture: the near and far boxes and the floor blur."""
+    floor = checker("checker", 8, 0.15, 0.85)
+    kit.plane("floor", 30.0, floor, uv_repeat=p["uv_repeat"])
+    grey = kit.diffuse("grey", (0.7, 0.7, 0.7))
+    boxes = [kit.box(f"box{i}", 0.6, (x, y, 0.3), grey) for i, (x, y) in enumerate(p["boxes"])]
+    kit.point_light("lamp", (1.0, -2.0, 4.0), 600.0, radius=0.2)
+    cam = camera(p["camera"], (0.0, 0.0, 0.3))
+    dof = cam.data.dof
+    dof.use_dof, dof.focus_object = True, boxes[1]
+    dof.aperture_fstop, dof.aperture_blades, dof.aperture_rotation = p["fstop"], p["blades"], p["rotation"]
+    kit.world((0.05, 0.05, 0.05))
+
+
 def scene_sun(p):
     kit.plane("floor", 8.0, kit.diffuse("white", (0.8, 0.8, 0.8)))
     kit.box("occluder", 0.6, (0.0, 0.0, 0.6), kit.diffuse("grey", (0.5, 0.5, 0.5)))
@@ -295,6 +310,10 @@ SCENES_SPEC = [
     # grazing brightening and, on 4.x/5.x, the multiscatter energy; docs/blender.md).
     ("metal_sweep", scene_metal_sweep, dict(roughness=[0.05, 0.2, 0.4, 0.7, 1.0], color=(0.9, 0.75, 0.5),
                                             asserted_before=(0, 0, 0), sample_factor=2), 8),
+    # Depth of field: a hexagonal aperture focused on a focus object (docs/render.md).
+    ("depth_of_field", scene_depth_of_field, dict(boxes=[(-1.0, -3.0), (0.0, 0.0), (1.2, 3.0)], uv_repeat=12.0,
+                                                  fstop=0.1, blades=6, rotation=0.3, camera=(0.0, -6.0, 1.0),
+                                                  sample_factor=2), 0),
     # Cycles' defaults: the light is seen through and in the glass (camera, glossy and transmission
     # rays see it), and the world lights the floor, as in TOYRT.
     ("glass_sphere_visible_light", scene_glass, dict(light=(1.0, -1.0, 3.0), power=120.0, ior=1.45, uv_repeat=4.0,

@@ -7,8 +7,10 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <stdexcept>
+#include <vector>
 
 using namespace toyrt;
 
@@ -290,4 +292,176 @@ TEST(Camera, RejectsInvalidSettings) {
     p.border_max_y = 0.501f;
   });  // no pixel
   EXPECT_NO_THROW(Camera::make(landscape()));
+}
+
+// Depth of field (camera/thin_lens.h). The thin lens's defining property: every ray of a pixel,
+// whatever its aperture point, passes through the point where the pinhole ray crosses the plane
+// of focus; and the aperture points fill the aperture's shape uniformly.
+namespace {
+
+CameraParams with_dof(CameraParams p, float focus, float fstop, int blades = 0, float rotation = 0.0f,
+                      float ratio = 1.0f) {
+  p.use_dof = true;
+  p.focus_distance = focus;
+  p.aperture_fstop = fstop;
+  p.aperture_blades = blades;
+  p.aperture_rotation = rotation;
+  p.aperture_ratio = ratio;
+  return p;
+}
+
+// The aperture point of a lens ray in the camera's (x, y): where it crosses the lens plane (the
+// plane through the camera position, perpendicular to the view axis).
+Vec2 lens_point(const Camera& cam, const Ray& ray) {
+  const float t = glm::dot(cam.position - ray.org, cam.axis_z) / glm::dot(ray.dir, cam.axis_z);
+  const Vec3 q = ray.org + t * ray.dir - cam.position;
+  return {glm::dot(q, cam.axis_x), glm::dot(q, cam.axis_y)};
+}
+
+std::vector<Vec2> aperture_points(const Camera& cam, int n) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::vector<Vec2> out;
+  // Relative to the pinhole ray's crossing: the camera position, or an orthographic pixel's point.
+  const Vec2 centre = lens_point(cam, cam.generate(100.5f, 80.5f));
+  for (int i = 0; i < n; ++i)
+    out.push_back(lens_point(cam, cam.generate(100.5f, 80.5f, Vec2(u(rng), u(rng)))) - centre);
+  return out;
+}
+
+}  // namespace
+
+TEST(ThinLens, EveryLensRayCrossesThePinholeRaysPointOnThePlaneOfFocus) {
+  for (CameraType type : {CameraType::Perspective, CameraType::Orthographic}) {
+    for (int blades : {0, 6}) {
+      CameraParams p = with_dof(landscape(), 3.5f, 0.4f, blades, 0.3f, 1.7f);
+      p.type = type;
+      p.matrix_world = some_camera_matrix();
+      const Camera cam = Camera::make(p);
+      ASSERT_GT(cam.lens.radius, 0.0f);
+      std::mt19937 rng(3);
+      std::uniform_real_distribution<float> u(0.0f, 1.0f);
+      for (int i = 0; i < 200; ++i) {
+        const float px = 640.0f * u(rng), py = 480.0f * u(rng);
+        const Ray pin = cam.generate(px, py);
+        // Where the pinhole ray reaches depth 3.5 along the view axis.
+        const float t = (3.5f - glm::dot(pin.org - cam.position, -cam.axis_z)) / glm::dot(pin.dir, -cam.axis_z);
+        const Vec3 focus = pin.org + t * pin.dir;
+        for (int k = 0; k < 8; ++k) {
+          const Ray ray = cam.generate(px, py, Vec2(u(rng), u(rng)));
+          EXPECT_NEAR(glm::length(ray.dir), 1.0f, 1e-5f);
+          const Vec3 to_focus = focus - ray.org;
+          // Distance from the focus point to the lens ray's line.
+          EXPECT_LT(glm::length(to_focus - glm::dot(to_focus, ray.dir) * ray.dir), 2e-5f * 3.5f);
+          // Clipping stays by planes: the ray starts and ends at the clip depths.
+          const Vec3 near = ray.org + ray.tnear * ray.dir, far = ray.org + ray.tfar * ray.dir;
+          EXPECT_NEAR(glm::dot(near - cam.position, -cam.axis_z), p.clip_start, 1e-4f);
+          EXPECT_NEAR(glm::dot(far - cam.position, -cam.axis_z), p.clip_end, 1e-3f);
+        }
+      }
+    }
+  }
+}
+
+TEST(ThinLens, RoundApertureIsUniformOnTheDiskOfRadiusLensOverTwiceFstop) {
+  // Perspective: 35 mm / (2 x 0.7) = 25 mm; orthographic: 1 m / (2 x 0.7) (Cycles' rules).
+  for (CameraType type : {CameraType::Perspective, CameraType::Orthographic}) {
+    for (float ratio : {1.0f, 2.0f}) {
+      CameraParams p = with_dof(landscape(), 2.0f, 0.7f, 0, 0.0f, ratio);
+      p.type = type;
+      const Camera cam = Camera::make(p);
+      const double r = (type == CameraType::Perspective ? 0.035 : 1.0) / (2.0 * 0.7);
+      ASSERT_NEAR(cam.lens.radius, r, 1e-6 * r);
+      const int n = 200000;
+      double mx = 0, my = 0, xx = 0, yy = 0;
+      for (const Vec2& a : aperture_points(cam, n)) {
+        // Inside the ellipse the anamorphic squeeze makes of the disk.
+        ASSERT_LE(std::hypot(a.x * ratio, a.y), r * (1 + 1e-4));
+        mx += a.x, my += a.y, xx += double(a.x) * a.x, yy += double(a.y) * a.y;
+      }
+      // Uniform on the disk of radius r: mean 0, E[x^2] = E[y^2] = r^2 / 4 (x divided by the ratio).
+      // The bounds are five standard errors of independent samples: x's standard deviation is
+      // r / 2, and x^2's is r^2 / 4 (E[x^4] = r^4 / 8), so E[x^2]'s relative error is 1 / sqrt(n).
+      const double se = 1.0 / std::sqrt(double(n));
+      EXPECT_NEAR(mx / n, 0.0, 5 * 0.5 * r * se);
+      EXPECT_NEAR(my / n, 0.0, 5 * 0.5 * r * se);
+      EXPECT_NEAR(xx / n * ratio * ratio / (r * r / 4), 1.0, 5 * se);
+      EXPECT_NEAR(yy / n / (r * r / 4), 1.0, 5 * se);
+    }
+  }
+}
+
+TEST(ThinLens, BladesMakeAUniformRegularPolygonTurnedByTheRotation) {
+  for (int blades : {3, 5, 8}) {
+    const float rotation = 0.4f;
+    const Camera cam = Camera::make(with_dof(landscape(), 2.0f, 1.0f, blades, rotation));
+    const double r = 0.035 / 2.0, half = kPi / blades;
+    const double inradius = r * std::cos(half);
+    const int n = 200000;
+    double rr = 0, rr4 = 0;
+    int in_incircle = 0;
+    double corner_reach = 0, edge_reach = 0;
+    for (const Vec2& a : aperture_points(cam, n)) {
+      // Inside every edge: the edges' outward normals point at rotation + 2 pi k / blades.
+      for (int k = 0; k < blades; ++k) {
+        const double phi = rotation + 2.0 * half * k;
+        ASSERT_LE(a.x * std::cos(phi) + a.y * std::sin(phi), inradius * (1 + 1e-4));
+      }
+      const double a2 = double(a.x) * a.x + double(a.y) * a.y;
+      rr += a2, rr4 += a2 * a2;
+      in_incircle += std::hypot(a.x, a.y) < inradius;
+      corner_reach = std::max(corner_reach, a.x * std::cos(rotation + half) + a.y * std::sin(rotation + half));
+      edge_reach = std::max(edge_reach, a.x * std::cos(double(rotation)) + a.y * std::sin(double(rotation)));
+    }
+    // Uniform: the incircle holds its share of the polygon's area, and E[|p|^2] is the fan of
+    // isosceles triangles' (1 + 2 cos^2(pi / n)) r^2 / 6 (a triangle's E[p p^T] is
+    // (sum v v^T + (sum v)(sum v)^T) / 12).
+    const double area = 0.5 * blades * r * r * std::sin(2.0 * half);
+    EXPECT_NEAR(regular_polygon_area(blades) * r * r, area, 1e-6 * area);
+    const double share = kPi * inradius * inradius / area;
+    EXPECT_NEAR(double(in_incircle) / n, share, 5 * std::sqrt(share * (1 - share) / n));
+    // Within five standard errors, estimated from the samples' own spread of |p|^2.
+    const double mean_rr = rr / n, se = std::sqrt((rr4 / n - mean_rr * mean_rr) / n);
+    EXPECT_NEAR(mean_rr, (1 + 2 * std::cos(half) * std::cos(half)) * r * r / 6, 5 * se);
+    // The corners reach the circumradius, towards rotation + pi / n; the edges' midpoints the inradius.
+    EXPECT_NEAR(corner_reach / r, 1.0, 0.01);
+    EXPECT_NEAR(edge_reach / inradius, 1.0, 0.01);
+  }
+}
+
+TEST(ThinLens, WithoutDepthOfFieldTheRaysAreThePinholesBitForBit) {
+  for (CameraType type : {CameraType::Perspective, CameraType::Orthographic}) {
+    CameraParams p = with_dof(landscape(), 2.0f, 0.1f, 6);
+    p.use_dof = false;  // the other settings are ignored
+    p.type = type;
+    p.matrix_world = some_camera_matrix();
+    const Camera cam = Camera::make(p);
+    EXPECT_TRUE(cam.lens.pinhole());
+    for (float px : {0.0f, 17.25f, 639.9f})
+      for (float py : {0.0f, 240.5f, 479.9f}) {
+        const Ray a = cam.generate(px, py), b = cam.generate(px, py, Vec2(0.9f, 0.1f));
+        EXPECT_EQ(0, std::memcmp(&a, &b, sizeof(Ray)));
+      }
+  }
+}
+
+TEST(ThinLens, RejectsInvalidSettingsAndClampsZerosAsCycles) {
+  const auto bad = [](auto change) {
+    CameraParams p = with_dof(landscape(), 2.0f, 2.8f);
+    change(p);
+    EXPECT_THROW(Camera::make(p), std::invalid_argument);
+  };
+  bad([](CameraParams& p) { p.focus_distance = -1.0f; });
+  bad([](CameraParams& p) { p.focus_distance = NAN; });
+  bad([](CameraParams& p) { p.aperture_fstop = -2.0f; });
+  bad([](CameraParams& p) { p.aperture_fstop = INFINITY; });
+  bad([](CameraParams& p) { p.aperture_blades = -1; });
+  bad([](CameraParams& p) { p.aperture_rotation = NAN; });
+  bad([](CameraParams& p) { p.aperture_ratio = 0.0f; });
+  bad([](CameraParams& p) { p.aperture_ratio = -1.0f; });
+  // Blender allows a zero f-stop and focus distance; Cycles clamps both to 1e-5.
+  const Camera cam = Camera::make(with_dof(landscape(), 0.0f, 0.0f, 2));
+  EXPECT_FLOAT_EQ(cam.lens.focus_distance, 1e-5f);
+  EXPECT_FLOAT_EQ(cam.lens.radius, 0.035f / 2e-5f);
+  EXPECT_EQ(cam.lens.blades, 0);  // fewer than 3 blades: round
 }
