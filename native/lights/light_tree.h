@@ -10,8 +10,9 @@
 //
 // Unbiased because a cluster's importance is a bound: zero only where no light in it can reach
 // (p, n) (the whole cone faces away from p, or the whole box is below p's tangent plane). A leaf
-// holds one light and weighs it by the light's own importance(). Lights at infinity (suns) have no
-// box: they are chosen among themselves by importance(), against the tree's root.
+// holds up to kLeafSize lights and weighs them by the sum of their own importance(), exact where
+// a bound is coarsest (the nearest lights); the pick inside it is the linear selector's. Lights at infinity (suns) have
+// no box: they are chosen among themselves by importance(), against the tree's root.
 //
 // Built once per commit by the scene (Scene::light_tree). Flat arrays, no allocation per call.
 #pragma once
@@ -24,7 +25,7 @@
 
 namespace toyrt {
 
-// A cluster, 48 bytes. Its box enters importance only through the bounding sphere.
+// A cluster, 52 bytes. Its box enters importance only through the bounding sphere.
 struct LightTreeNode {
   Vec3 center{0.0f};
   float radius = 0.0f;  // of the sphere around the box
@@ -32,9 +33,10 @@ struct LightTreeNode {
   float power = 0.0f;              // the lights' summed LightBounds::power
   float cos_o = -1.0f, sin_o = 0;  // theta_o: every emitting normal within it of axis
   float cos_e = 0.0f;              // theta_e: each normal emits within it
-  int32_t child = 0;               // internal: the first child (the second follows); leaf: -1 - light
+  int32_t child = 0;               // internal: the first child (the second follows); leaf: -1 - first
+  uint32_t count = 0;              // a leaf's lights: LightTree::order_[first, first + count)
   bool leaf() const { return child < 0; }
-  uint32_t light() const { return uint32_t(-1 - child); }
+  uint32_t first() const { return uint32_t(-1 - child); }
 };
 
 class LightTree {
@@ -42,9 +44,12 @@ class LightTree {
   // Trees deeper than this are never built (the median split takes over well before), so
   // probability() walks a path in a fixed array.
   static constexpr int kMaxDepth = 64;
+  // Lights per leaf, at most: measured in docs/lights.md ("Light selection"), variance against
+  // time per pick (1 is Conty Estevez and Kulla's, a bound at every level).
+  static constexpr uint32_t kLeafSize = 8;
 
   LightTree() = default;
-  explicit LightTree(const std::vector<Light>& lights);
+  explicit LightTree(const std::vector<Light>& lights, uint32_t leaf_size = kLeafSize);
 
   // `lights` must be the ones the tree was built from.
   LightSelection select(const Light* lights, const Vec3& p, const Vec3& n, float u) const;
@@ -61,9 +66,11 @@ class LightTree {
   };
   Weights top_weights(const Light* lights, const Vec3& p, const Vec3& n) const;
   Weights child_weights(const Light* lights, int32_t node, const Vec3& p, const Vec3& n) const;
+  float weight(const Light* lights, const LightTreeNode& node, const Vec3& p, const Vec3& n) const;
 
   std::vector<LightTreeNode> nodes_;  // nodes_[0]: the root over the local lights, if any
   std::vector<int32_t> parent_;       // per node; -1 for the root
+  std::vector<uint32_t> order_;       // the local lights, leaf by leaf
   std::vector<int32_t> leaf_of_;      // per light, its leaf; -1 for a light at infinity
   std::vector<uint32_t> distant_;     // the lights at infinity
   int depth_ = 0;

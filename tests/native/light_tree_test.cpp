@@ -84,9 +84,12 @@ double binomial_slack(double n, double probability) {
 
 }  // namespace
 
-TEST(LightTree, SelectMatchesProbabilityAndTheProbabilitiesSumToOne) {
+class LightTreeLeaves : public ::testing::TestWithParam<uint32_t> {};  // lights per leaf
+INSTANTIATE_TEST_SUITE_P(LightTree, LightTreeLeaves, ::testing::Values(1u, LightTree::kLeafSize));
+
+TEST_P(LightTreeLeaves, SelectMatchesProbabilityAndTheProbabilitiesSumToOne) {
   const std::vector<Light> lights = mixed_lights(300, 1);
-  const LightTree tree(lights);
+  const LightTree tree(lights, GetParam());
   ASSERT_EQ(tree.light_count(), lights.size());
   constexpr int kN = 40000;
   for (uint32_t j = 0; j < 12; ++j) {
@@ -132,9 +135,9 @@ TEST(LightTree, WithoutAReceiverCosineEveryBranchCanBeTakenAndTheProbabilitiesSu
   }
 }
 
-TEST(LightTree, EveryLightThatCanContributeHasAPositiveProbability) {
+TEST_P(LightTreeLeaves, EveryLightThatCanContributeHasAPositiveProbability) {
   const std::vector<Light> lights = mixed_lights(400, 6);
-  const LightTree tree(lights);
+  const LightTree tree(lights, GetParam());
   int contributing = 0, behind = 0;
   for (uint32_t j = 0; j < 60; ++j) {
     const Receiver at = receiver(j, 7);
@@ -157,7 +160,7 @@ TEST(LightTree, EveryLightThatCanContributeHasAPositiveProbability) {
   EXPECT_GT(behind, 2000);
 }
 
-TEST(LightTree, AClusterWhollyBelowTheReceiversPlaneIsNeverEntered) {
+TEST_P(LightTreeLeaves, AClusterWhollyBelowTheReceiversPlaneIsNeverEntered) {
   // 100 lights in a ball 5 m below a floor facing up, 100 above: the bound of the lower cluster
   // fails at the root's children, so none of it is chosen or even weighed.
   std::vector<Light> lights;
@@ -166,7 +169,7 @@ TEST(LightTree, AClusterWhollyBelowTheReceiversPlaneIsNeverEntered) {
     const float z = i < 100 ? -5.0f : 5.0f;
     lights.emplace_back(PointLight::make(Vec3(0.0f, 0.0f, z) + offset - Vec3(0.5f), 10.0f, Vec3(1.0f)));
   }
-  const LightTree tree(lights);
+  const LightTree tree(lights, GetParam());
   const Vec3 p(0.3f, -0.2f, 0.0f), n(0, 0, 1);
   for (size_t i = 0; i < 100; ++i) EXPECT_EQ(tree.probability(lights.data(), p, n, i), 0.0f);
   double sum = 0.0;
@@ -179,7 +182,7 @@ TEST(LightTree, AClusterWhollyBelowTheReceiversPlaneIsNeverEntered) {
   }
 }
 
-TEST(LightTree, OneSampleEstimateConvergesToTheSumOfTwoHundredLightsIrradiance) {
+TEST_P(LightTreeLeaves, OneSampleEstimateConvergesToTheSumOfTwoHundredLightsIrradiance) {
   // 200 point lights of radius 0 and a sun over a floor facing up: E = sum of I cos / r^2 over
   // those above it, plus S cos for the sun.
   std::vector<Light> lights;
@@ -200,7 +203,7 @@ TEST(LightTree, OneSampleEstimateConvergesToTheSumOfTwoHundredLightsIrradiance) 
   sun.angle = 0.0f;
   lights.emplace_back(SunLight::make(sun));
   exact += 2.0 * std::cos(0.5);
-  const LightTree tree(lights);
+  const LightTree tree(lights, GetParam());
   const Estimate e = monte_carlo(400000, [&](uint32_t i) {
     const LightSelection s = tree.select(lights.data(), p, n, random_float(i, 0, 2, 12));
     if (!s.found()) return 0.0;
@@ -258,19 +261,22 @@ TEST(LightTree, BuildsOnNoneOneTwoAndCoincidentLights) {
 
   const std::vector<Light> two = {PointLight::make(Vec3(0, 0, 1), 10.0f, Vec3(1.0f)),
                                   PointLight::make(Vec3(0, 0, 2), 10.0f, Vec3(1.0f))};
-  const LightTree tree_two(two);
-  EXPECT_EQ(tree_two.node_count(), 3u);
-  // Two leaves weigh by their own importance: 1 / 1 against 1 / 4.
-  EXPECT_NEAR(tree_two.probability(two.data(), p, n, 0), 0.8f, 1e-6f);
-  EXPECT_NEAR(tree_two.probability(two.data(), p, n, 1), 0.2f, 1e-6f);
+  // Two lights in one leaf, and in two (leaf size 1): each weighs by its own importance, 1 / 1
+  // against 1 / 4.
+  for (uint32_t leaf_size : {LightTree::kLeafSize, 1u}) {
+    const LightTree tree_two(two, leaf_size);
+    EXPECT_EQ(tree_two.node_count(), leaf_size == 1 ? 3u : 1u);
+    EXPECT_NEAR(tree_two.probability(two.data(), p, n, 0), 0.8f, 1e-6f);
+    EXPECT_NEAR(tree_two.probability(two.data(), p, n, 1), 0.2f, 1e-6f);
+  }
 
   // 1000 lights at one position (and 1000 of power 0 there): no plane separates them, so the
   // build halves them by count: a balanced tree, every light equally likely, no NaN.
   std::vector<Light> same(1000, Light(PointLight::make(Vec3(1, 2, 3), 5.0f, Vec3(1.0f))));
   for (int i = 0; i < 1000; ++i) same.emplace_back(PointLight::make(Vec3(1, 2, 3), 0.0f, Vec3(1.0f)));
-  const LightTree tree_same(same);
+  const LightTree tree_same(same, 1);
   EXPECT_EQ(tree_same.node_count(), 2 * same.size() - 1);
-  EXPECT_LE(tree_same.depth(), 12);
+  EXPECT_LE(tree_same.depth(), 11);  // ceil(log2(2000))
   for (size_t i = 0; i < same.size(); ++i) {
     const float probability = tree_same.probability(same.data(), p, n, i);
     ASSERT_TRUE(std::isfinite(probability));
