@@ -51,8 +51,9 @@ std::vector<Light> plane_lights(size_t count) {
 int main(int argc, char** argv) {
   const auto args = bench::parse_args(argc, argv, "bench_lights [--quick] [--runs N]", 5);
   if (!args) return 2;
-  const std::vector<size_t> counts =
-      args->quick ? std::vector<size_t>{4, 16, 100, 1000} : std::vector<size_t>{2, 4, 8, 16, 32, 64, 100, 1000, 10000};
+  const std::vector<size_t> counts = args->quick
+                                         ? std::vector<size_t>{4, 16, 100, 1000}
+                                         : std::vector<size_t>{2, 4, 8, 16, 32, 64, 100, 300, 1000, 3000, 10000};
   std::printf("# %s\n", bench::cpu_model().c_str());
   std::printf("%6s %10s %10s %9s %9s %10s %10s %9s %9s %9s %10s %10s %10s\n", "lights", "linear_ns", "tree_ns",
               "lin_var", "tree_var", "err_render", "build_ms", "tree_KB", "nodes", "depth", "err_select", "render_lin",

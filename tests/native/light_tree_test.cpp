@@ -310,10 +310,10 @@ TEST(LightTree, TheSceneBuildsItAtCommitForMoreThanTheThresholdOfLights) {
 }
 
 TEST(LightTree, ARenderThroughTheTreeHasTheMeanOfARenderOfEveryLight) {
-  // 60 point lights over the Lambert floor: one light per hit through the tree, and every light
-  // at every hit, render one pixel to the same mean within the noise.
+  // More point lights than the threshold over the Lambert floor: one light per hit through the
+  // tree, and every light at every hit, render one pixel to the same mean within the noise.
   Scene scene = floor_of(Lambert{Vec3(0.8f), -1});
-  for (uint32_t i = 0; i < 60; ++i)
+  for (uint32_t i = 0; i < kLightTreeFrom + 50; ++i)
     scene.add_light(
         PointLight::make(Vec3(8.0f * random_float(i, 0, 0, 15) - 4.0f, 8.0f * random_float(i, 0, 1, 15) - 4.0f,
                               0.3f + 3.0f * random_float(i, 0, 2, 15)),
