@@ -294,6 +294,25 @@ size_t LightTree::memory_bytes() const {
 namespace {
 // u rescaled into the branch it chose, kept below 1 (rounding could reach it).
 float rescale(float u, float lo, float width) { return std::min((u - lo) / width, 0x1.fffffep-1f); }
+
+// The linear selector's pick among lights ids[0, count), whose importances sum to `total` in this
+// order (so the running sum ends at exactly `total`; u * total rounding up to it keeps the last
+// candidate), the probability scaled by that of reaching them.
+LightSelection pick_among(const Light* lights, const uint32_t* ids, size_t count, float total, float u, float scale,
+                          const Vec3& p, const Vec3& n) {
+  LightSelection chosen;
+  const float target = u * total;
+  float running = 0.0f;
+  for (size_t i = 0; i < count; ++i) {
+    const float w = importance_of(lights[ids[i]], p, n);
+    if (w <= 0.0f) continue;
+    running += w;
+    chosen.index = int32_t(ids[i]);
+    chosen.probability = scale * (w / total);
+    if (target < running) break;
+  }
+  return chosen;
+}
 }  // namespace
 
 LightSelection LightTree::select(const Light* lights, const Vec3& p, const Vec3& n, float u) const {
@@ -303,19 +322,9 @@ LightSelection LightTree::select(const Light* lights, const Vec3& p, const Vec3&
   if (!(total > 0.0f)) return chosen;
   const float p_tree = top.first / total;
   if (!(u < p_tree)) {
-    // A light at infinity, by importance among them: the linear selector's two passes.
-    u = rescale(u, p_tree, top.second / total);
-    const float target = u * top.second;
-    float running = 0.0f;
-    for (uint32_t i : distant_) {
-      const float w = importance_of(lights[i], p, n);
-      if (w <= 0.0f) continue;
-      running += w;
-      chosen.index = int32_t(i);
-      chosen.probability = top.second / total * (w / top.second);
-      if (target < running) break;
-    }
-    return chosen;
+    // A light at infinity, by importance among them.
+    return pick_among(lights, distant_.data(), distant_.size(), top.second, rescale(u, p_tree, top.second / total),
+                      top.second / total, p, n);
   }
   u = rescale(u, 0.0f, p_tree);
   float probability = top.first / total;
@@ -335,21 +344,8 @@ LightSelection LightTree::select(const Light* lights, const Vec3& p, const Vec3&
       node = nodes_[size_t(node)].child + 1;
     }
   }
-  // Inside the leaf, the linear selector's pick; the running sum ends at exactly the leaf's weight.
   const LightTreeNode& leaf = nodes_[size_t(node)];
-  const float leaf_weight = weight(lights, leaf, p, n);
-  const float target = u * leaf_weight;
-  float running = 0.0f;
-  for (uint32_t i = 0; i < leaf.count; ++i) {
-    const uint32_t light = order_[leaf.first() + i];
-    const float w = importance_of(lights[light], p, n);
-    if (w <= 0.0f) continue;
-    running += w;
-    chosen.index = int32_t(light);
-    chosen.probability = probability * (w / leaf_weight);
-    if (target < running) break;
-  }
-  return chosen;
+  return pick_among(lights, order_.data() + leaf.first(), leaf.count, weight(lights, leaf, p, n), u, probability, p, n);
 }
 
 float LightTree::probability(const Light* lights, const Vec3& p, const Vec3& n, size_t index) const {
