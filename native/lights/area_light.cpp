@@ -146,6 +146,16 @@ float importance(const AreaLight& light, const Vec3& p, const Vec3& n) {
   return mean_intensity * cos_emit * cos_receive / std::max(d2, r2);
 }
 
+LightBounds bounds(const AreaLight& light) {
+  LightBounds b;
+  const Vec3 c = light.corner();
+  for (const Vec3& q : {c, c + light.edge_x, c + light.edge_y, c + light.edge_x + light.edge_y}) b.box.extend(q);
+  b.axis = light.normal;
+  b.theta_o = 0.0f;
+  b.power = (light.radiance.x + light.radiance.y + light.radiance.z) / 3.0f * light.area;
+  return b;
+}
+
 AreaShape parse_area_shape(const std::string& name) {
   if (name == "RECTANGLE") return AreaShape::Rectangle;
   if (name == "SQUARE") return AreaShape::Square;

@@ -17,6 +17,7 @@
 #pragma once
 
 #include "core/params.h"
+#include "lights/light_bounds.h"
 #include "lights/light_context.h"
 #include "lights/light_sample.h"
 #include "sampling/warp.h"
@@ -82,5 +83,8 @@ const char* area_sampling_name(AreaSampling sampling);
 // cosines over the light's bounding sphere. Zero exactly when p is not in front of the light or
 // the whole bounding sphere is below p's tangent plane.
 float importance(const AreaLight& light, const Vec3& p, const Vec3& n);
+// The rectangle's box (a disk's or ellipse's enclosing one), normals along `normal` only
+// (theta_o = 0) emitting over the hemisphere, with L area as power (the intensity along the normal).
+LightBounds bounds(const AreaLight& light);
 
 }  // namespace toyrt

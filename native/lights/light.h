@@ -4,7 +4,7 @@
 //     static constexpr const char* kType, kParams;  static X from_params(const Params&);  (make_light)
 //     LightSample sample(const X&, const Vec3& p, const Vec2& u, const LightContext&);
 //     LightEval evaluate(const X&, const Vec3& p, const Vec3& wi, const LightContext&);
-//     float importance(const X&, const Vec3& p, const Vec3& n);
+//     float importance(const X&, const Vec3& p, const Vec3& n);  LightBounds bounds(const X&);  (light trees)
 // and a type without them fails to compile here. The render's choices (how area lights are
 // sampled) come in the LightContext.
 #pragma once
@@ -31,6 +31,9 @@ inline LightEval evaluate_light(const Light& light, const Vec3& p, const Vec3& w
 }
 inline float light_importance(const Light& light, const Vec3& p, const Vec3& n) {
   return std::visit([&](const auto& l) { return importance(l, p, n); }, light);
+}
+inline LightBounds light_bounds(const Light& light) {
+  return std::visit([](const auto& l) { return bounds(l); }, light);
 }
 
 // The light of Blender type `type` ("POINT", "AREA", "SPOT", "SUN": the kTypes) from its parameters. Throws

@@ -2,7 +2,7 @@
 
 namespace toyrt {
 
-LightSelection LightSelector::select(const Vec3& p, const Vec3& n, float u) const {
+LightSelection LightSelector::select_linear(const Vec3& p, const Vec3& n, float u) const {
   float total = 0.0f;
   for (size_t i = 0; i < count; ++i) total += light_importance(lights[i], p, n);
   LightSelection chosen;
@@ -22,7 +22,7 @@ LightSelection LightSelector::select(const Vec3& p, const Vec3& n, float u) cons
   return chosen;
 }
 
-float LightSelector::probability(const Vec3& p, const Vec3& n, size_t index) const {
+float LightSelector::probability_linear(const Vec3& p, const Vec3& n, size_t index) const {
   if (index >= count) return 0.0f;
   float total = 0.0f;
   for (size_t i = 0; i < count; ++i) total += light_importance(lights[i], p, n);

@@ -163,4 +163,12 @@ float importance(const PointLight& light, const Vec3& p, const Vec3& n) {
   return mean_intensity * cos_bound / std::max({d2, r2, 1e-12f});
 }
 
+LightBounds bounds(const PointLight& light) {
+  LightBounds b;
+  b.box.extend(light.position - Vec3(light.radius));
+  b.box.extend(light.position + Vec3(light.radius));
+  b.power = (light.intensity.x + light.intensity.y + light.intensity.z) / 3.0f;
+  return b;
+}
+
 }  // namespace toyrt

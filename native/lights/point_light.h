@@ -24,6 +24,7 @@
 #pragma once
 
 #include "core/params.h"
+#include "lights/light_bounds.h"
 #include "lights/light_context.h"
 #include "lights/light_sample.h"
 #include "sampling/warp.h"
@@ -68,5 +69,7 @@ LightEval evaluate(const PointLight& light, const Vec3& p, const Vec3& wi, const
 // mean intensity over distance^2, times a bound of the receiver's cosine over the sphere. Zero
 // exactly when no point of the light is above p's tangent plane.
 float importance(const PointLight& light, const Vec3& p, const Vec3& n);
+// The sphere's box, emitting every way (theta_o = pi), with the mean intensity as power.
+LightBounds bounds(const PointLight& light);
 
 }  // namespace toyrt

@@ -106,6 +106,8 @@ float importance(const SpotLight& light, const Vec3& p, const Vec3& n) {
   return len > 0.0f ? base * light.attenuation(v / len) : 0.0f;
 }
 
+LightBounds bounds(const SpotLight& light) { return bounds(light.emitter); }
+
 SpotFalloff parse_spot_falloff(const std::string& name) {
   if (name == "SMOOTHSTEP") return SpotFalloff::Smoothstep;
   if (name == "COSINE_SMOOTHSTEP") return SpotFalloff::CosineSmoothstep;

@@ -103,6 +103,14 @@ float importance(const SunLight& light, const Vec3&, const Vec3& n) {
   return bound > 0.0f ? mean * bound : 0.0f;
 }
 
+LightBounds bounds(const SunLight& light) {
+  LightBounds b;
+  b.axis = -light.to_sun;
+  b.power = (light.irradiance.x + light.irradiance.y + light.irradiance.z) / 3.0f;
+  b.distant = true;
+  return b;
+}
+
 SunDisc parse_sun_disc(const std::string& name) {
   if (name == "CONE") return SunDisc::Cone;
   if (name == "TANGENT_DISK") return SunDisc::TangentDisk;

@@ -18,6 +18,7 @@
 #pragma once
 
 #include "core/params.h"
+#include "lights/light_bounds.h"
 #include "lights/light_context.h"
 #include "lights/light_sample.h"
 #include "sampling/warp.h"
@@ -64,6 +65,8 @@ LightSample sample(const SunLight& light, const Vec3& p, const Vec2& u, const Li
 LightEval evaluate(const SunLight& light, const Vec3& p, const Vec3& wi, const LightContext& ctx);
 // S times a bound of the receiver's cosine over the disc (no distance: the sun is as bright everywhere).
 float importance(const SunLight& light, const Vec3& p, const Vec3& n);
+// A light at infinity (distant), its mean irradiance as power.
+LightBounds bounds(const SunLight& light);
 
 SunDisc parse_sun_disc(const std::string& name);  // throws std::invalid_argument
 const char* sun_disc_name(SunDisc disc);

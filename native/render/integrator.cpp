@@ -203,7 +203,7 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
   if (settings.light_sampling != LightSampling::One || lights.size() == 1) {
     for (size_t j = 0; j < lights.size(); ++j) add(j, 1.0f, 1 + uint32_t(j));
   } else {
-    const LightSelector selector(lights);
+    const LightSelector selector(lights, scene.light_tree());
     const LightSelection pick =
         selector.select(s.p, ns, sobol_owen_1d(pixel, sample, vertex_dimension(depth, 0), settings.seed));
     if (pick.found()) add(size_t(pick.index), pick.probability, 1);

@@ -143,12 +143,14 @@ void Scene::set_texture(int64_t texture, Texture replacement) {
 uint32_t Scene::add_light(const Light& light, LightVisibility visibility) {
   world_.lights.push_back(light);
   world_.light_visibility.push_back(visibility);
+  light_tree_current_ = false;
   return uint32_t(world_.lights.size() - 1);
 }
 
 void Scene::clear_lights() {
   world_.lights.clear();
   world_.light_visibility.clear();
+  light_tree_current_ = false;
 }
 
 void Scene::set_background(const Vec3& radiance) {
@@ -280,6 +282,16 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
   stats_.emissive_triangles = emitters_.triangles.size();
   stats_.emitters_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - gather_start).count();
+  if (!light_tree_current_) {
+    // Only when the lights changed: a viewport edit of a mesh does not rebuild it. A scene of
+    // few lights keeps no tree (the linear walk is cheaper there: kLightTreeFrom).
+    const auto tree_start = std::chrono::steady_clock::now();
+    light_tree_ = world_.lights.size() > kLightTreeFrom ? LightTree(world_.lights) : LightTree{};
+    light_tree_current_ = true;
+    stats_.light_tree_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tree_start).count();
+  }
+  stats_.light_tree_nodes = light_tree_.node_count();
   committed_ = true;
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -399,7 +411,7 @@ size_t Scene::memory_bytes() const {
     bytes += sh.corner_normals.capacity() * sizeof(Vec3) + sh.corner_uvs.capacity() * sizeof(Vec2) +
              sh.material_ids.capacity() * sizeof(int32_t);
   for (const auto& m : meshes_) bytes += m->memory_bytes();
-  return bytes;
+  return bytes + light_tree_.memory_bytes();
 }
 
 }  // namespace toyrt

@@ -14,6 +14,7 @@
 #include "core/cancel_poll.h"
 #include "core/ray.h"
 #include "geometry/mesh.h"
+#include "lights/light_selector.h"
 #include "lights/mesh_emitters.h"
 #include "materials/emission.h"
 #include "materials/material.h"
@@ -45,6 +46,8 @@ struct CommitStats {
   size_t sah_meshes = 0, lbvh_meshes = 0;
   size_t emissive_triangles = 0;  // sampled as lights (world space, each instance's counted)
   double emitters_ms = 0.0;       // gathering them, part of build_ms
+  size_t light_tree_nodes = 0;    // 0: no tree (kLightTreeFrom lights or fewer)
+  double light_tree_ms = 0.0;     // building it (only when the lights changed), part of build_ms
   // Set when an LBVH build could not run (no OpenCL device, kernel build failure) and the SAH
   // builder stood in: one message per commit.
   std::string warning;
@@ -165,6 +168,14 @@ class Scene {
   bool any_emission() const { return any_emission_; }
   const MeshEmitters& emitters() const { return emitters_; }  // the sampled emissive triangles, by commit()
   const World& world() const { return world_; }
+  // The tree the render selects lights with: built by commit() over more than kLightTreeFrom
+  // lights; null for fewer, and for lights edited since the last commit (they are selected
+  // linearly until the next one: the same answers in distribution, only slower).
+  const LightTree* light_tree() const {
+    return light_tree_current_ && light_tree_.light_count() == world_.lights.size() && light_tree_.node_count() > 0
+               ? &light_tree_
+               : nullptr;
+  }
   // Triangles stored (each mesh counted once) and placed (each instance counting its mesh).
   size_t stored_triangle_count() const;
   size_t instanced_triangle_count() const;
@@ -188,6 +199,8 @@ class Scene {
   MeshEmitters emitters_;
   std::vector<Texture> textures_;
   World world_;
+  LightTree light_tree_;             // over world_.lights when light_tree_current_
+  bool light_tree_current_ = false;  // add_light and clear_lights reset it, commit() rebuilds
   std::vector<Instance> instances_;
   Bvh top_;                       // over instances with a non-empty world box
   bool single_identity_ = false;  // one untransformed instance: skip the top level

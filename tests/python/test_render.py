@@ -65,6 +65,26 @@ def test_point_light_over_a_plane_gives_I_cos_over_r2_in_blender_units():
     assert (img[..., 3] == 1).all()
 
 
+def test_many_point_lights_are_selected_through_a_light_tree_to_the_closed_form():
+    # 1,200 point lights (above the tree's threshold of 1,000) over the floor: commit builds the
+    # tree, and one light per hit through it converges to the sum of the lights' I cos / r^2.
+    rng = np.random.default_rng(3)
+    n, albedo = 1200, 0.8
+    pos = np.column_stack([rng.uniform(-6, 6, n), rng.uniform(-6, 6, n), rng.uniform(0.5, 3.0, n)])
+    power = rng.uniform(1.0, 50.0, n)
+    s = floor_scene(albedo)
+    s.commit()
+    assert s.last_commit["light_tree_nodes"] == 0
+    for p, w in zip(pos, power):
+        s.add_point_light(tuple(p), float(w))
+    s.commit()
+    assert s.last_commit["light_tree_nodes"] > 0
+    img = s.render(camera_above(size=1e-3, resolution=1), samples=8192, light_sampling="one")
+    r2 = (pos**2).sum(axis=1)
+    exact = albedo / np.pi * (power / (4 * np.pi) * (pos[:, 2] / np.sqrt(r2)) / r2).sum()
+    assert img[0, 0, 0] == pytest.approx(exact, rel=0.03)
+
+
 def test_square_area_light_above_a_point_matches_the_closed_form_with_both_estimators():
     power, h, a = 40.0, 0.5, 1.0
     s = floor_scene(1.0)

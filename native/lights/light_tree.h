@@ -1,0 +1,79 @@
+// A bounding hierarchy over the scene's lights that picks one light per shading point with a
+// probability that follows its expected contribution there, in O(log lights) instead of the
+// linear selector's two passes over all of them (Conty Estevez and Kulla 2018, "Importance
+// Sampling of Many Lights with Adaptive Tree Splitting", without the splitting: one light per
+// call). Each node bounds a cluster: a box, an orientation cone (axis, theta_o, theta_e) and the
+// cluster's power. Traversal goes down one child at a time, choosing between the two children by
+// their importance at (p, n); the probability of a light is the product of the branch
+// probabilities along its root-to-leaf path, and probability() recomputes that product along the
+// stored path, so it equals what select() returned bit for bit.
+//
+// Unbiased because a cluster's importance is a bound: zero only where no light in it can reach
+// (p, n) (the whole cone faces away from p, or the whole box is below p's tangent plane). A leaf
+// holds up to kLeafSize lights and weighs them by the sum of their own importance(), exact where
+// a bound is coarsest (the nearest lights); the pick inside it is the linear selector's. Lights at infinity (suns) have
+// no box: they are chosen among themselves by importance(), against the tree's root.
+//
+// Built once per commit by the scene (Scene::light_tree). Flat arrays, no allocation per call.
+#pragma once
+
+#include "lights/light.h"
+#include "lights/light_selection.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace toyrt {
+
+// A cluster, 52 bytes. Its box enters importance only through the bounding sphere.
+struct LightTreeNode {
+  Vec3 center{0.0f};
+  float radius = 0.0f;  // of the sphere around the box
+  Vec3 axis{0.0f, 0.0f, 1.0f};
+  float power = 0.0f;              // the lights' summed LightBounds::power
+  float cos_o = -1.0f, sin_o = 0;  // theta_o: every emitting normal within it of axis
+  float cos_e = 0.0f;              // theta_e: each normal emits within it
+  int32_t child = 0;               // internal: the first child (the second follows); leaf: -1 - first
+  uint32_t count = 0;              // a leaf's lights: LightTree::order_[first, first + count)
+  bool leaf() const { return child < 0; }
+  uint32_t first() const { return uint32_t(-1 - child); }
+};
+
+class LightTree {
+ public:
+  // Trees deeper than this are never built (the median split takes over well before), so
+  // probability() walks a path in a fixed array.
+  static constexpr int kMaxDepth = 64;
+  // Lights per leaf, at most: measured in docs/lights.md ("Light selection"), variance against
+  // time per pick (1 is Conty Estevez and Kulla's, a bound at every level).
+  static constexpr uint32_t kLeafSize = 8;
+
+  LightTree() = default;
+  explicit LightTree(const std::vector<Light>& lights, uint32_t leaf_size = kLeafSize);
+
+  // `lights` must be the ones the tree was built from.
+  LightSelection select(const Light* lights, const Vec3& p, const Vec3& n, float u) const;
+  float probability(const Light* lights, const Vec3& p, const Vec3& n, size_t index) const;
+
+  size_t light_count() const { return leaf_of_.size(); }
+  size_t node_count() const { return nodes_.size(); }
+  int depth() const { return depth_; }
+  size_t memory_bytes() const;
+
+ private:
+  struct Weights {
+    float first, second;
+  };
+  Weights top_weights(const Light* lights, const Vec3& p, const Vec3& n) const;
+  Weights child_weights(const Light* lights, int32_t node, const Vec3& p, const Vec3& n) const;
+  float weight(const Light* lights, const LightTreeNode& node, const Vec3& p, const Vec3& n) const;
+
+  std::vector<LightTreeNode> nodes_;  // nodes_[0]: the root over the local lights, if any
+  std::vector<int32_t> parent_;       // per node; -1 for the root
+  std::vector<uint32_t> order_;       // the local lights, leaf by leaf
+  std::vector<int32_t> leaf_of_;      // per light, its leaf; -1 for a light at infinity
+  std::vector<uint32_t> distant_;     // the lights at infinity
+  int depth_ = 0;
+};
+
+}  // namespace toyrt
