@@ -268,8 +268,10 @@ def test_time_limit():
     samples = [(int(m.group(1)), int(m.group(2))) for m in samples if m]
     done = [re.search(r"\((\d+)x(\d+), (\d+) of (\d+) samples: time limit", line) for line in lines]
     done = [int(m.group(3)) for m in done if m]
-    check(samples and done and samples[-1] == (done[0], 1 << 20) and 1 <= done[0] < 1 << 20,
-          f"the last Sample line {samples[-1] if samples else None} says the samples taken ({done})")
+    check(done and 1 <= done[0] < 1 << 20, f"the limit stopped the frame after {done} of {1 << 20} samples")
+    if samples or not NO_BINARY:  # the bpy module prints no stats lines
+        check(samples and samples[-1] == (done[0], 1 << 20),
+              f"the last Sample line {samples[-1] if samples else None} says the samples taken ({done})")
     strict = [line for line in lines if re.search(r"Warning|Error|Exception", line)]
     check(not strict, f"no line a strict farm fails on: {strict[:3]}")
     # Adaptive sampling: this flat scene's pixels all stop at the first test (the automatic minimum
