@@ -160,9 +160,9 @@ test-python:
 test-blender:
 	@[ -n "$(BLENDER_TESTS)" ] || { echo "no tests/blender/test_*.py found" >&2; exit 1; }
 	@passed=0; for t in $(BLENDER_TESTS); do \
-		echo "blender: $$t"; \
+		echo "blender: $$t"; start=$$(date +%s); \
 		TOYRT_BUILD_DIR=$(abspath $(BUILD)) $(BLENDER) -b --python-exit-code 1 --python $$t || { echo "FAILED: $$t" >&2; echo "blender: $$passed passed, 1 failed"; exit 1; }; \
-		passed=$$((passed + 1)); \
+		echo "blender: $$t took $$(( $$(date +%s) - start )) s"; passed=$$((passed + 1)); \
 	done; echo "blender: $$passed passed, 0 failed"
 
 # The same tests under a current Blender: the bpy module from PyPI (requirements-test.txt), one
@@ -172,9 +172,9 @@ test-blender:
 BPY_TESTS := $(filter-out tests/blender/test_viewport.py,$(BLENDER_TESTS))
 test-bpy:
 	@passed=0; for t in $(BPY_TESTS); do \
-		echo "bpy: $$t"; \
+		echo "bpy: $$t"; start=$$(date +%s); \
 		$(VENV)/bin/python tests/blender/run_with_bpy.py $$t --build $(BUILD) || { echo "FAILED (bpy): $$t" >&2; echo "bpy: $$passed passed, 1 failed"; exit 1; }; \
-		passed=$$((passed + 1)); \
+		echo "bpy: $$t took $$(( $$(date +%s) - start )) s"; passed=$$((passed + 1)); \
 	done; echo "bpy: $$passed passed, 0 failed"
 
 # The release files installed where users are: each wheel in a fresh venv (numpy 1.x and 2.x on 3.11,
