@@ -12,15 +12,16 @@ namespace {
 struct AovInfo {
   const char* name;
   int channels;
+  bool from_first_sample;  // Cycles writes it at sample 0 only; the others are averaged
 };
-constexpr std::array<AovInfo, kAovCount> kAovs{{{"depth", 1},
-                                                {"mist", 1},
-                                                {"position", 3},
-                                                {"normal", 3},
-                                                {"diffuse_color", 3},
-                                                {"emission", 3},
-                                                {"object_index", 1},
-                                                {"material_index", 1}}};
+constexpr std::array<AovInfo, kAovCount> kAovs{{{"depth", 1, true},
+                                                {"mist", 1, false},
+                                                {"position", 3, true},
+                                                {"normal", 3, false},
+                                                {"diffuse_color", 3, false},
+                                                {"emission", 3, false},
+                                                {"object_index", 1, true},
+                                                {"material_index", 1, true}}};
 
 // Cycles' mist (kernel/film/data_passes.h): the distance from the camera (perspective) or along
 // its axis (orthographic) mapped to [0, 1] over [start, start + depth], then the falloff power.
@@ -42,6 +43,7 @@ float index_at(const std::vector<float>& table, int32_t id) {
 
 const char* aov_name(Aov aov) { return kAovs[size_t(aov)].name; }
 int aov_channels(Aov aov) { return kAovs[size_t(aov)].channels; }
+bool aov_from_first_sample(Aov aov) { return kAovs[size_t(aov)].from_first_sample; }
 
 Aov parse_aov(const std::string& name) {
   for (size_t k = 0; k < kAovCount; ++k)

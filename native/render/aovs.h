@@ -29,6 +29,8 @@ inline constexpr size_t kAovCount = size_t(Aov::Count);
 // The name render(passes=...) takes ("depth", "diffuse_color", ...) and the float channels per pixel.
 const char* aov_name(Aov aov);
 int aov_channels(Aov aov);
+// Whether the pass holds its first sample's value (depth, position, indices) rather than a mean.
+bool aov_from_first_sample(Aov aov);
 // Throws std::invalid_argument for a name that is none of aov_name's.
 Aov parse_aov(const std::string& name);
 

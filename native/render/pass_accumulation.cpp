@@ -36,10 +36,6 @@ void merge_cryptomatte(float* into, const float* pass, int depth, float wa, floa
   }
 }
 
-bool from_first_sample(Aov aov) {
-  return aov == Aov::Depth || aov == Aov::Position || aov == Aov::ObjectIndex || aov == Aov::MaterialIndex;
-}
-
 }  // namespace
 
 void accumulate_tile(RenderResult& into, std::vector<uint32_t>& counts_into, const RenderResult& pass,
@@ -60,7 +56,7 @@ void accumulate_tile(RenderResult& into, std::vector<uint32_t>& counts_into, con
         const size_t ch = size_t(aov_channels(Aov(k)));
         const float* src = &pass.passes.data[k][index * ch];
         float* dst = &d[index * ch];
-        if (from_first_sample(Aov(k))) {
+        if (aov_from_first_sample(Aov(k))) {
           if (na == 0) std::copy(src, src + ch, dst);
         } else {
           for (size_t c = 0; c < ch; ++c) dst[c] = wa * dst[c] + wp * src[c];

@@ -28,6 +28,14 @@ namespace {
 // depth of 2^26.
 constexpr uint32_t kLensDimension = 0xFFFFFFFFu;
 
+// A pixel's sums over every sample it has taken, kept between the passes of a time-limited
+// render when adaptive sampling is on (its test needs them all).
+struct PixelProgress {
+  Vec3 sum{0.0f}, half{0.0f};
+  uint32_t n = 0;
+  bool converged = false;
+};
+
 std::string format_bytes(size_t bytes) {
   char buf[32];
   const double b = double(bytes);
@@ -56,10 +64,10 @@ size_t render_memory_estimate(const Camera& camera, const RenderSettings& settin
   for (size_t k = 0; k < kCryptoKindCount; ++k)
     if (passes.cryptomatte.has(CryptoKind(k))) channels += passes.cryptomatte.channels();
   // A time limit renders into a pass buffer beside the image, with each pixel's sample count (and,
-  // adaptive, its sums: PixelProgress, 32 bytes) for adding passes up.
+  // adaptive, its sums: PixelProgress) for adding passes up.
   const bool in_passes = settings.time_limit > 0.0;
   const double copies = in_passes ? 3 : 2;
-  const double per_pixel = in_passes ? 2 * sizeof(uint32_t) + (settings.adaptive.use ? 32 : 0)
+  const double per_pixel = in_passes ? 2 * sizeof(uint32_t) + (settings.adaptive.use ? sizeof(PixelProgress) : 0)
                                      : (settings.adaptive.use ? sizeof(uint32_t) : 0);
   const double bytes = pixels * (channels * sizeof(float) * copies + per_pixel) +
                        tiles * (sizeof(Tile) + sizeof(size_t)) + threads * 1e6;
@@ -80,14 +88,6 @@ size_t available_memory_bytes() {
 }
 
 namespace {
-
-// A pixel's sums over every sample it has taken, kept between the passes of a time-limited
-// render when adaptive sampling is on (its test needs them all).
-struct PixelProgress {
-  Vec3 sum{0.0f}, half{0.0f};
-  uint32_t n = 0;
-  bool converged = false;
-};
 
 // What one pass needs beside the render's own arguments.
 struct PassPlan {
@@ -127,10 +127,12 @@ void render_pass(const Scene& scene, const Camera& camera, const RenderSettings&
   // taken, or -1 when cancelled. Without adaptive sampling the loop is the plain one.
   auto sample_pixel = [&](auto adaptive, size_t index, Vec3& sum, auto&& trace_one) -> int {
     const int first = settings.first_sample, last = settings.first_sample + settings.samples;
+    // Adaptive: the pixel's sums so far (kept between passes under a time limit, else its own).
     PixelProgress local;
-    PixelProgress& state = plan.progress ? (*plan.progress)[index] : local;
+    PixelProgress* state = &local;
     if constexpr (adaptive) {
-      if (state.converged) return 0;
+      if (plan.progress) state = &(*plan.progress)[index];
+      if (state->converged) return 0;
     }
     for (int s = first; s < last; ++s) {
       // A relaxed load every few samples costs nothing next to a path, and bounds the cancel
@@ -140,11 +142,11 @@ void render_pass(const Scene& scene, const Camera& camera, const RenderSettings&
       const Vec3 L = trace_one(s);
       sum += L;
       if constexpr (adaptive) {
-        state.sum += L;
-        if (AdaptiveRule::in_half(uint32_t(s))) state.half += L;
-        ++state.n;
-        if (plan.rule.tests_after(s) && plan.rule.converged(state.sum, state.half, int(state.n))) {
-          state.converged = true;
+        state->sum += L;
+        if (AdaptiveRule::in_half(uint32_t(s))) state->half += L;
+        ++state->n;
+        if (plan.rule.tests_after(s) && plan.rule.converged(state->sum, state->half, int(state->n))) {
+          state->converged = true;
           return s - first + 1;
         }
       }
@@ -350,7 +352,6 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
     pass.tiles_done = 0;
     plan.on_finished = [&](size_t k) {
       accumulate_tile(result, counts, pass, pass_counts, tiles[k], passes.cryptomatte.depth);
-      ++result.tiles_done;
       result.progress_samples = double(taken) + double(next) * double(pass.tiles_done) / double(tiles.size());
       if (on_tile) on_tile(tiles[k], result);
     };
@@ -371,7 +372,8 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
       break;
     }
   }
-  result.tiles_done = std::min(result.tiles_done, result.tiles_total);
+  // Every tile holds the passes before the last one; a cancelled last pass finished only some.
+  result.tiles_done = taken > 0 ? result.tiles_total : pass.tiles_done;
   result.samples_done = taken;
   result.mean_samples = mean_samples();
   result.progress_samples = taken;
