@@ -52,7 +52,7 @@ VERSION     := $(shell sed -n 's/^project(toyrt LANGUAGES CXX VERSION \([0-9.]*\
 
 BLENDER_TESTS := $(sort $(wildcard tests/blender/test_*.py))
 
-.PHONY: bench help setup apt venv configure native addon test test-native test-python test-blender test-bpy bench-blender \
+.PHONY: bench help setup apt venv configure native addon tables test test-native test-python test-blender test-bpy bench-blender \
 	demo bench-trace bench-lbvh clean distclean fuzz sanitize test-levels lint format test-quick venv-package package test-package
 
 help:
@@ -101,6 +101,12 @@ $(BUILD)/CMakeCache.txt: | $(APT_STAMP)
 # Always asks CMake: it knows what changed, and does nothing in well under a second when nothing did.
 native: $(BUILD)/CMakeCache.txt
 	@# (run as a top-level make: no "Entering directory" noise, its own -j)
+	@env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL cmake --build $(BUILD) -j$(JOBS)
+
+# Regenerates the GGX albedo tables (native/sampling/ggx_albedo_tables.inc) from their estimators,
+# after a change to the GGX lobe; ggx_albedo_test fails until the committed file matches.
+tables: native
+	$(BUILD)/tests/native/ggx_albedo_tables native/sampling/ggx_albedo_tables.inc
 	@env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL cmake --build $(BUILD) -j$(JOBS)
 
 # Copies addon/render_toyrt + the module into Blender's user add-ons folder when they changed, and

@@ -22,4 +22,30 @@ inline float fresnel_dielectric(float cos_i, float eta) {
   return 0.5f * (rs * rs + rp * rp);
 }
 
+// Reflectance at normal incidence, ((eta - 1) / (eta + 1))^2, and its inverse for eta >= 1 (f0
+// kept below 0.99, as Blender does, so the answer stays finite).
+inline float f0_from_ior(float eta) {
+  const float r = (eta - 1.0f) / (eta + 1.0f);
+  return r * r;
+}
+inline float ior_from_f0(float f0) {
+  const float r = std::sqrt(std::clamp(f0, 0.0f, 0.99f));
+  return (1.0f + r) / (1.0f - r);
+}
+
+// The cosine-weighted hemispherical average 2 int_0^1 F(mu) mu dmu: the share of uniformly
+// incident light a smooth interface reflects. Below the critical cosine (eta < 1) F is 1 and the
+// integral is exact; above it, where F is smooth, a 256-point midpoint rule (within 1e-4 of a fine
+// integral: ggx_albedo_test).
+inline float fresnel_dielectric_average(float eta) {
+  constexpr int kN = 256;
+  const float mu_c = eta < 1.0f ? std::sqrt(1.0f - eta * eta) : 0.0f;
+  double sum = 0.0;
+  for (int i = 0; i < kN; ++i) {
+    const float mu = mu_c + (1.0f - mu_c) * (float(i) + 0.5f) / float(kN);
+    sum += double(fresnel_dielectric(mu, eta)) * mu;
+  }
+  return float(double(mu_c) * mu_c + 2.0 * sum * (1.0 - mu_c) / kN);
+}
+
 }  // namespace toyrt

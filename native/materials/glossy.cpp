@@ -1,16 +1,18 @@
 #include "materials/glossy.h"
 
+#include "materials/multiscatter.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 namespace toyrt {
 
-Glossy Glossy::make(const Vec3& color, float roughness, GgxShadowing shadowing) {
+Glossy Glossy::make(const Vec3& color, float roughness, GgxShadowing shadowing, bool multiscatter) {
   if (!std::isfinite(roughness)) throw std::invalid_argument("glossy: roughness must be finite");
   if (!is_finite(color) || glm::any(glm::lessThan(color, Vec3(0.0f))))
     throw std::invalid_argument("glossy: color must be finite and >= 0");
-  return Glossy{color, std::clamp(roughness, 0.0f, 1.0f), shadowing};
+  return Glossy{color, std::clamp(roughness, 0.0f, 1.0f), shadowing, multiscatter};
 }
 
 GgxShadowing shadowing_from_params(const Params& params) {
@@ -23,12 +25,10 @@ GgxShadowing shadowing_from_params(const Params& params) {
 Glossy Glossy::from_params(const Params& params) {
   const Glossy d;
   return make(params.color("color", d.color), float(params.number("roughness", d.roughness)),
-              shadowing_from_params(params));
+              shadowing_from_params(params), params.flag("multiscatter", d.multiscatter));
 }
 
-Scatter scatter(const Glossy& m, const ShadingPoint& s, const MaterialContext&) {
-  // Normals to wo's side, as the integrator orients them for its light samples; where wo is below
-  // the shading normal's tangent plane (silhouettes of smooth meshes) the lobe sits on ng.
+GlossyLobe oriented_lobe(const ShadingPoint& s, float roughness, GgxShadowing shadowing) {
   const Vec3 ng = glm::dot(s.ng, s.wo) > 0.0f ? s.ng : -s.ng;
   Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;
   if (glm::dot(s.wo, ns) <= 1e-6f) ns = ng;
@@ -36,9 +36,16 @@ Scatter scatter(const Glossy& m, const ShadingPoint& s, const MaterialContext&) 
   lobe.frame = Frame::from_normal(ns);
   lobe.wo = lobe.frame.to_local(s.wo);
   lobe.wo.z = std::max(lobe.wo.z, 1e-6f);
-  lobe.tint = m.color;
-  lobe.alpha = ggx_alpha(m.roughness);
-  lobe.shadowing = m.shadowing;
+  lobe.alpha = ggx_alpha(roughness);
+  lobe.shadowing = shadowing;
+  return lobe;
+}
+
+Scatter scatter(const Glossy& m, const ShadingPoint& s, const MaterialContext&) {
+  GlossyLobe lobe = oriented_lobe(s, m.roughness, m.shadowing);
+  // Cycles' Glossy BSDF has its colour in the closure's weight and takes it as the lobe's average
+  // Fresnel for the energy compensation.
+  lobe.tint = m.multiscatter ? m.color * multiscatter_scale(m.roughness, lobe.wo.z, m.color) : m.color;
   return Scatter::glossy_lobe(lobe);
 }
 

@@ -5,7 +5,8 @@
 //
 // Parameters (add_material('glossy', ...)): color ((0.8, 0.8, 0.8), linear RGB >= 0), roughness
 // (0.5, Blender's default; finite, clamped to [0, 1] as Cycles does), shadowing ('separable',
-// Blender 3.x's masking-shadowing, or 'correlated', 4.0+'s).
+// Blender 3.x's masking-shadowing, or 'correlated', 4.0+'s), multiscatter (False; True:
+// Multiscatter GGX, Blender 4.0+'s energy compensation, materials/multiscatter.h).
 #pragma once
 
 #include "core/params.h"
@@ -19,15 +20,22 @@ struct Glossy {
   static constexpr const char* kType = "glossy";
   static constexpr const char* kParams =
       "color (linear RGB, (0.8, 0.8, 0.8)), roughness (0.5, clamped to [0, 1]; alpha = roughness^2),\n"
-      "shadowing ('separable': Blender 3.x, 'correlated': 4.0+): GGX reflection, Blender's Glossy BSDF";
+      "shadowing ('separable': Blender 3.x, 'correlated': 4.0+), multiscatter (False; 4.0+'s Multiscatter GGX):\n"
+      "GGX reflection, Blender's Glossy BSDF";
   Vec3 color{0.8f};
   float roughness = 0.5f;  // in [0, 1]
   GgxShadowing shadowing = GgxShadowing::Separable;
+  bool multiscatter = false;
 
   // Throws std::invalid_argument for a non-finite roughness or an unknown shadowing name.
-  static Glossy make(const Vec3& color, float roughness, GgxShadowing shadowing);
+  static Glossy make(const Vec3& color, float roughness, GgxShadowing shadowing, bool multiscatter = false);
   static Glossy from_params(const Params& params);
 };
+
+// A lobe at the hit with its frame on wo's side, as the integrator orients its light samples;
+// where wo is below the shading normal's tangent plane (silhouettes of smooth meshes) the lobe sits
+// on the geometric normal. Tint 0 and no Fresnel: the material fills them in.
+GlossyLobe oriented_lobe(const ShadingPoint& s, float roughness, GgxShadowing shadowing);
 
 // The `shadowing` parameter ('separable' by default); throws std::invalid_argument for another name.
 GgxShadowing shadowing_from_params(const Params& params);

@@ -1,11 +1,12 @@
 // A glossy (microfacet GGX) reflection lobe as a material hands it to the integrator, which then
 // needs three things of it without knowing the material: its value and pdf for a light's
 // direction (next-event estimation, MIS), and a sampled direction to continue the path along.
-// Plain data: the shading frame, wo in it, the tint and alpha; one lobe per Scatter, so a
-// future Principled specular layer returns the same struct.
+// Plain data: the shading frame, wo in it, the tint and alpha, and the Fresnel term: none (the
+// tint alone, Blender's Glossy BSDF), or Principled's dielectric blend (materials/principled.h).
 #pragma once
 
 #include "core/math.h"
+#include "materials/fresnel.h"
 #include "sampling/frame.h"
 #include "sampling/ggx.h"
 
@@ -17,7 +18,22 @@ struct GlossyLobe {
   Vec3 tint{0.0f};  // the Fresnel term as Blender's Glossy BSDF has it: the colour, at every angle
   float alpha = kGgxMinAlpha;
   GgxShadowing shadowing = GgxShadowing::Separable;
+  // Principled's dielectric Fresnel (Blender 4.0+): F = mix(f0, 1, s) times the tint, where s is
+  // the interface's own curve remapped to [0, 1], (F_ior(wo.h) - F0(ior)) / (1 - F0(ior)), so
+  // f0 sets the strength at normal incidence and ior the shape. ior 0: no Fresnel term.
+  Vec3 f0{1.0f};
+  float ior = 0.0f;
+  float ior_f0 = 0.0f;  // F0(ior)
 };
+
+// The Fresnel factor for the microfacet normal between wo and wi (local, unit, both above).
+inline Vec3 lobe_fresnel(const GlossyLobe& lobe, const Vec3& wi) {
+  if (lobe.ior == 0.0f) return Vec3(1.0f);
+  const Vec3 h = glm::normalize(lobe.wo + wi);
+  const float s = std::clamp((fresnel_dielectric(glm::dot(lobe.wo, h), lobe.ior) - lobe.ior_f0) / (1.0f - lobe.ior_f0),
+                             0.0f, 1.0f);
+  return glm::mix(lobe.f0, Vec3(1.0f), s);
+}
 
 struct BsdfEval {
   Vec3 f{0.0f};      // BSDF value (1 / sr)
@@ -32,13 +48,16 @@ struct BsdfSample {
 
 // wi: world, unit. The caller checks that wi leaves on the geometric normal's side.
 inline BsdfEval evaluate_lobe(const GlossyLobe& lobe, const Vec3& wi) {
-  const GgxEval e = ggx_reflection_eval(lobe.alpha, lobe.shadowing, lobe.wo, lobe.frame.to_local(wi));
-  return {lobe.tint * e.f, e.pdf};
+  const Vec3 wi_local = lobe.frame.to_local(wi);
+  const GgxEval e = ggx_reflection_eval(lobe.alpha, lobe.shadowing, lobe.wo, wi_local);
+  if (!(e.f > 0.0f)) return {Vec3(0.0f), e.pdf};
+  return {lobe.tint * lobe_fresnel(lobe, wi_local) * e.f, e.pdf};
 }
 
 inline BsdfSample sample_lobe(const GlossyLobe& lobe, const Vec2& u) {
   const GgxSample s = ggx_reflection_sample(lobe.alpha, lobe.shadowing, lobe.wo, u);
-  return {lobe.frame.to_world(s.wi), lobe.tint * s.weight, s.pdf};
+  if (!(s.weight > 0.0f)) return {lobe.frame.to_world(s.wi), Vec3(0.0f), s.pdf};
+  return {lobe.frame.to_world(s.wi), lobe.tint * lobe_fresnel(lobe, s.wi) * s.weight, s.pdf};
 }
 
 }  // namespace toyrt

@@ -12,6 +12,7 @@
 #include "materials/diffuse_glossy.h"
 #include "materials/glossy.h"
 #include "materials/lambert.h"
+#include "materials/principled.h"
 #include "materials/refraction.h"
 
 #include <cstdint>
@@ -21,14 +22,14 @@
 
 namespace toyrt {
 
-using Material = std::variant<Lambert, PerfectRefraction, FresnelDielectric, Glossy, DiffuseGlossy>;
+using Material = std::variant<Lambert, PerfectRefraction, FresnelDielectric, Glossy, DiffuseGlossy, Principled>;
 
 // The texture a material reads (-1: none).
 inline int32_t texture_of(const Material& material) {
   return std::visit([](const auto& m) { return texture_index(m); }, material);
 }
 
-// A material of kind `kind` ("diffuse", "refraction", "glass", "glossy", "diffuse_glossy": the kTypes) from its
+// A material of kind `kind` ("diffuse", "refraction", "glass", "glossy", "diffuse_glossy", "principled": the kTypes) from its
 // parameters. Throws std::invalid_argument for another kind (listing the known ones), a bad value or an argument the
 // kind does not read. Texture ids are checked against the scene's textures by Scene::add_material.
 inline constexpr const char* kDefaultMaterialKind = Lambert::kType;  // Blender's default surface

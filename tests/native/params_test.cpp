@@ -77,7 +77,7 @@ TEST(Params, UnknownTypeListsTheKnownOnes) {
   EXPECT_EQ(refusal([] { make_light("HEMI", {}); }),
             "unknown light type 'HEMI': expected 'POINT', 'AREA', 'SPOT' or 'SUN'");
   EXPECT_EQ(refusal([] { make_material("metal", {}); }),
-            "unknown material kind 'metal': expected 'diffuse', 'refraction', 'glass', 'glossy' or 'diffuse_glossy'");
+            "unknown material kind 'metal': expected 'diffuse', 'refraction', 'glass', 'glossy', 'diffuse_glossy' or 'principled'");
 }
 
 TEST(Params, AllowedUnreadArgumentsPass) {

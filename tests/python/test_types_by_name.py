@@ -49,7 +49,7 @@ def test_unknown_keyword_is_named():
 
 
 def test_unknown_material_kind_lists_the_known_ones():
-    with pytest.raises(ValueError, match="expected 'diffuse', 'refraction', 'glass', 'glossy' or 'diffuse_glossy'"):
+    with pytest.raises(ValueError, match="expected 'diffuse', 'refraction', 'glass', 'glossy', 'diffuse_glossy' or 'principled'"):
         toyrt.Scene().add_material("metal")
 
 

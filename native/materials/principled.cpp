@@ -1,0 +1,69 @@
+#include "materials/principled.h"
+
+#include "materials/fresnel.h"
+#include "materials/glossy.h"
+#include "materials/multiscatter.h"
+#include "sampling/ggx_albedo.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace toyrt {
+
+Principled Principled::from_params(const Params& params) {
+  Principled m;
+  m.base = Lambert::from_params(params);
+  const float roughness = float(params.number("roughness", m.roughness));
+  if (!std::isfinite(roughness)) throw std::invalid_argument("principled: roughness must be finite");
+  m.roughness = std::clamp(roughness, 0.0f, 1.0f);
+  m.multiscatter = params.flag("multiscatter", m.multiscatter);
+  const float ior = float(params.number("ior", 1.5));
+  if (!(ior > 0.0f) || !std::isfinite(ior)) throw std::invalid_argument("principled: ior must be finite and > 0");
+  const float level = float(params.non_negative("specular_ior_level", 0.5));
+  const Vec3 tint = params.color("specular_tint", Vec3(1.0f));
+  // Specular IOR Level scales F0 (0.5: as the IOR gives it); the IOR with that F0 then shapes the
+  // curve, on the same side of 1 as the given one.
+  float f0 = f0_from_ior(ior);
+  m.eta = ior;
+  if (level != 0.5f) {
+    f0 *= 2.0f * level;
+    m.eta = ior_from_f0(f0);
+    if (ior < 1.0f) m.eta = 1.0f / m.eta;
+  }
+  m.eta_f0 = f0_from_ior(m.eta);
+  m.f0 = glm::clamp(f0 * tint, Vec3(0.0f), Vec3(1.0f));
+  // Fss: the same blend at the curve's average, F_avg(eta) remapped as the curve is.
+  const float s = m.eta_f0 < 1.0f ? std::clamp((fresnel_dielectric_average(m.eta) - m.eta_f0) / (1.0f - m.eta_f0), 0.0f, 1.0f)
+                                  : 1.0f;
+  m.fss = glm::mix(m.f0, Vec3(1.0f), s);
+  return m;
+}
+
+Scatter scatter(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx) {
+  const Vec3 albedo = lambert_albedo(m.base, *ctx.textures, s.uv);
+  if (m.eta == 1.0f) return Scatter::diffuse(lambert_f(albedo));
+  GlossyLobe lobe = oriented_lobe(s, m.roughness, GgxShadowing::HeightCorrelated);
+  const float mu = lobe.wo.z;
+  lobe.f0 = m.f0;
+  lobe.ior = m.eta;
+  lobe.ior_f0 = m.eta_f0;
+  // The layer's albedo at wo: mix(F0, 1, s) with s the table's mean blend (Cycles' estimate),
+  // darkened with the multiscatter terms as its closure weight is; the base gets the rest.
+  const Vec3 layer_albedo = glm::mix(m.f0, Vec3(1.0f), ggx_fresnel_blend(m.roughness, mu, m.eta));
+  Vec3 darkening(1.0f);
+  if (m.multiscatter) {
+    lobe.tint = multiscatter_scale(m.roughness, mu, m.fss);
+    const float e = ggx_albedo(m.roughness, mu);
+    darkening = lobe.tint * e;  // the scale over 1 / E, Cycles' energy_scale
+  } else {
+    lobe.tint = Vec3(1.0f);
+  }
+  const Vec3 covered = darkening * layer_albedo;
+  const float base = std::clamp(1.0f - std::max({covered.x, covered.y, covered.z}), 0.0f, 1.0f);
+  Scatter sc = Scatter::glossy_lobe(lobe);
+  sc.f = base * lambert_f(albedo);
+  return sc;
+}
+
+}  // namespace toyrt

@@ -1,0 +1,47 @@
+// Blender 4.0+'s Principled BSDF, dielectric (Metallic 0, Transmission 0): a Lambert base under a
+// GGX specular layer, as Cycles 4.0+ builds it.
+//   - The layer's Fresnel is the interface's own curve blended from F0 = F0(IOR) x 2 Specular IOR
+//     Level (the IOR that gives that F0 shapes the curve) times Specular Tint, to 1 at grazing
+//     (materials/glossy_lobe.h). IOR 1 (or Level 0) leaves no layer: plain Lambert.
+//   - The base is scaled by what the layer leaves, 1 - max over channels of the layer's
+//     directional albedo at wo, estimated as Cycles does from a table (sampling/ggx_albedo.h):
+//     energy layering without a random walk, so the sum reflects at most what came in.
+//   - Multiscatter GGX (Principled's default distribution in 4.0+) adds the microfacets' inter-
+//     reflections back to the layer (materials/multiscatter.h); plain GGX does not.
+// The integrator sees what a Mix of Diffuse and Glossy gives it (scatter.h's Glossy answer with a
+// diffuse part), so the base's direct light is a Lambert hit's and the layer's is MIS'd.
+//
+// Parameters (add_material('principled', ...)): color ((0.8, 0.8, 0.8)), texture (the base
+// colour), roughness (0.5, clamped to [0, 1]), ior (1.5, > 0), specular_ior_level (0.5, >= 0),
+// specular_tint ((1, 1, 1), >= 0), multiscatter (True).
+#pragma once
+
+#include "core/params.h"
+#include "materials/lambert.h"
+#include "materials/scatter.h"
+
+#include <cstdint>
+
+namespace toyrt {
+
+struct Principled {
+  static constexpr const char* kType = "principled";
+  static constexpr const char* kParams =
+      "color, texture (the base colour), roughness (0.5), ior (1.5), specular_ior_level (0.5),\n"
+      "specular_tint ((1, 1, 1)), multiscatter (True): Blender 4.0+'s Principled BSDF, dielectric";
+  Lambert base;
+  float roughness = 0.5f;  // in [0, 1]
+  bool multiscatter = true;
+  // Derived once from ior, specular_ior_level and specular_tint:
+  float eta = 1.5f;           // the IOR whose curve shapes the Fresnel term; 1: no layer
+  Vec3 f0{0.04f};             // the layer's reflectance at normal incidence, tint included, <= 1
+  float eta_f0 = 0.04f;       // F0(eta)
+  Vec3 fss{0.0f};             // the layer's average single-bounce Fresnel (multiscatter)
+
+  static Principled from_params(const Params& params);
+};
+
+Scatter scatter(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx);
+inline int32_t texture_index(const Principled& m) { return m.base.texture; }
+
+}  // namespace toyrt
