@@ -156,6 +156,28 @@ def principled(name, color):
     return mat
 
 
+def principled_dielectric(name, color, roughness, specular=0.5, tint=None, distribution=None):
+    """A Principled BSDF (Metallic 0) with a specular layer of reflectance 0.08 x `specular` at
+    normal incidence on every Blender: 3.x's Specular socket, 4.0+'s Specular IOR Level at IOR 1.5
+    (F0 = 0.04 x 2 x level). `tint`: 3.x's scalar Specular Tint, or 4.0+'s colour. `distribution`
+    None keeps the version's default (3.x GGX, 4.0+ Multiscatter GGX)."""
+    mat = principled(name, color)
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    bsdf.inputs["Roughness"].default_value = roughness
+    if "Specular IOR Level" in bsdf.inputs:
+        bsdf.inputs["Specular IOR Level"].default_value = specular
+        bsdf.inputs["IOR"].default_value = 1.5
+        if tint is not None:
+            bsdf.inputs["Specular Tint"].default_value = (*tint, 1.0)
+    else:
+        bsdf.inputs["Specular"].default_value = specular
+        if tint is not None:
+            bsdf.inputs["Specular Tint"].default_value = tint
+    if distribution is not None:
+        bsdf.distribution = distribution
+    return mat
+
+
 def image(name, rgba, float_buffer=False, colorspace=None):
     """A packed image of an (h, w, 4) array, rows from the bottom (Blender's order): 8-bit, or float
     with float_buffer. `colorspace` names how Blender decodes the values (default: sRGB for 8-bit,

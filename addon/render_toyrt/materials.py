@@ -41,7 +41,8 @@ PLACEHOLDER = ImageKey("", False)
 class MaterialSpec:
     """What the core's material is made of: kind 'diffuse' (a colour or a texture), 'refraction'
     or 'glass' (an index of refraction), 'glossy' (a colour, a roughness and the masking-shadowing
-    of the Blender version: 'separable' in 3.x, 'correlated' since 4.0)."""
+    of the Blender version: 'separable' in 3.x, 'correlated' since 4.0), 'principled' (a base
+    colour or texture under a specular layer: roughness, IOR, Specular IOR Level and Tint)."""
     kind: str
     color: tuple[float, float, float] = DEFAULT_GREY
     texture: ImageKey | None = None
@@ -50,6 +51,10 @@ class MaterialSpec:
     shadowing: str = "separable"
     diffuse_weight: float = 1.0                              # 'diffuse_glossy': the diffuse part's weight
     glossy_color: tuple[float, float, float] = DEFAULT_GREY  # 'diffuse_glossy': the glossy part's colour
+    multiscatter: bool = False                               # 'glossy', 'principled': 4.0+'s Multiscatter GGX
+    specular_ior_level: float = 0.5                          # 'principled' (4.0+'s socket)
+    specular_tint: tuple[float, float, float] = (1.0, 1.0, 1.0)  # 'principled': the layer's F0 tint
+    layered: bool = True                                     # 'principled': 4.0+ (False: 3.x's sum)
     emission: tuple[float, float, float] = (0.0, 0.0, 0.0)   # colour x strength, linear radiance
     emission_sampling: str = "AUTO"                           # Blender 4.x's names (3.x: AUTO or NONE)
 
@@ -57,8 +62,13 @@ class MaterialSpec:
         """Keyword arguments of toyrt.Scene.add_material / set_material, with the texture's id."""
         args = dict(kind=self.kind, color=self.color, texture=texture_id, ior=self.ior, emission=self.emission,
                     emission_sampling=self.emission_sampling)
-        if self.kind in ("glossy", "diffuse_glossy"):   # the core refuses keywords a kind does not read
+        if self.kind in ("glossy", "diffuse_glossy", "principled"):   # the core refuses keywords a kind does not read
             args.update(roughness=self.roughness, shadowing=self.shadowing)
+        if self.kind in ("glossy", "principled"):
+            args.update(multiscatter=self.multiscatter)
+        if self.kind == "principled":
+            args.update(specular_ior_level=self.specular_ior_level, specular_tint=self.specular_tint,
+                        layered=self.layered)
         if self.kind == "diffuse_glossy":
             args.update(diffuse_weight=self.diffuse_weight, glossy_color=self.glossy_color)
         return args
@@ -291,14 +301,17 @@ def _check_sharp(name, node, label, notes):
         notes.append(f"material '{name}': {label} tint (white)")
 
 
-def _shadowing() -> str:
-    """Cycles' GGX masking-shadowing: separable G1 G1 in 3.x, height-correlated since 4.0."""
+def _blender_version() -> tuple:
     try:
         import bpy
-        version = tuple(bpy.app.version)
+        return tuple(bpy.app.version)
     except ImportError:      # outside Blender
-        version = (3, 4, 0)
-    return "separable" if version < (4, 0, 0) else "correlated"
+        return (3, 4, 0)
+
+
+def _shadowing() -> str:
+    """Cycles' GGX masking-shadowing: separable G1 G1 in 3.x, height-correlated since 4.0."""
+    return "separable" if _blender_version() < (4, 0, 0) else "correlated"
 
 
 def _constant(name, sock, label, fallback, notes, lo=None, hi=None) -> float:
@@ -342,7 +355,7 @@ def _glossy(name, node, notes):
         rough = None
     else:
         rough = input_socket(node, "Roughness")
-        if distribution == "MULTI_GGX":
+        if distribution == "MULTI_GGX" and _blender_version() < (4, 0, 0):   # 3.x's is a random walk
             notes.append(f"material '{name}': Multiscatter GGX (single-scatter GGX: darker at high roughness)")
         elif distribution != "GGX":
             notes.append(f"material '{name}': {distribution.title()} glossy distribution (GGX)")
@@ -353,6 +366,8 @@ def _glossy(name, node, notes):
     if normal is not None and normal.is_linked:
         notes.append(f"material '{name}': glossy normal input (the surface normal)")
     spec = _glossy_spec(name, input_socket(node, "Color"), rough, notes)
+    if distribution == "MULTI_GGX" and _blender_version() >= (4, 0, 0):
+        spec = replace(spec, multiscatter=True)
     return (replace(spec, roughness=0.0) if rough is None else spec), None
 
 
@@ -371,15 +386,73 @@ def _principled(name, node, notes):
         extras.append("metallic")
     if trans is not None and (trans.is_linked or trans.default_value > 0.0):
         extras.append("partial transmission")
-    spec = input_socket(node, "Specular IOR Level", "Specular")
-    if spec is not None and (spec.is_linked or spec.default_value > 0.0):
-        extras.append("specular")
+    for label, names in (("coat", ("Coat Weight", "Clearcoat")), ("sheen", ("Sheen Weight", "Sheen")),
+                         ("subsurface", ("Subsurface Weight", "Subsurface")), ("anisotropy", ("Anisotropic",)),
+                         ("diffuse roughness", ("Diffuse Roughness",)), ("thin film", ("Thin Film Thickness",))):
+        sock = input_socket(node, *names)
+        if sock is not None and (sock.is_linked or sock.default_value > 0.0):
+            extras.append(label)
+    normal = input_socket(node, "Normal")
+    if normal is not None and normal.is_linked:
+        extras.append("normal input")
     emission = _emission(name, input_socket(node, "Emission Color", "Emission"),  # 4.0+ / 3.x
                          input_socket(node, "Emission Strength"), notes)
+    base, image = _color_material(name, input_socket(node, "Base Color"), notes)
+    layer = _specular_layer(name, node, base, extras, notes)
     if extras:
-        notes.append(f"material '{name}': Principled {', '.join(extras)} (Lambert base colour)")
-    spec, image = _color_material(name, input_socket(node, "Base Color"), notes)
+        notes.append(f"material '{name}': Principled {', '.join(extras)} (not modelled)")
+    spec = base if layer is None else replace(base, kind="principled", **layer)
     return replace(spec, emission=emission), image
+
+
+# Blender's luminance weights for linear Rec.709 RGB (3.x's Specular Tint divides the base colour
+# by its luminance).
+_LUMINANCE = (0.2126, 0.7152, 0.0722)
+
+
+def _specular_layer(name, node, base, extras, notes):
+    """The Principled BSDF's dielectric specular layer as the 'principled' kind's arguments, per
+    Blender version; None where there is none (Specular 0, IOR 1)."""
+    rough = _constant(name, input_socket(node, "Roughness"), "roughness", 0.5, notes, 0.0, 1.0)
+    distribution = getattr(node, "distribution", "GGX")
+    if _blender_version() >= (4, 0, 0):
+        # A Lambert base energy-layered under the layer; F0 from the IOR times 2 x Specular IOR
+        # Level, tinted by the Specular Tint colour; Multiscatter GGX by default.
+        ior = _constant(name, input_socket(node, "IOR"), "IOR", 1.5, notes, 1e-5, 1e30)
+        level = _constant(name, input_socket(node, "Specular IOR Level"), "Specular IOR Level", 0.5, notes, 0.0, 1e30)
+        tint_sock = input_socket(node, "Specular Tint")
+        tint = (1.0, 1.0, 1.0)
+        if tint_sock is not None:
+            if tint_sock.is_linked:
+                notes.append(f"material '{name}': linked Specular Tint (its constant colour)")
+            tint = _finite_color(name, tint_sock.default_value, "Specular Tint", notes)
+        if ior == 1.0 or level == 0.0:
+            return None
+        if distribution not in ("GGX", "MULTI_GGX"):
+            notes.append(f"material '{name}': Principled {distribution.title()} distribution (GGX)")
+        return dict(roughness=rough, ior=ior, specular_ior_level=level, specular_tint=tint,
+                    multiscatter=distribution == "MULTI_GGX", shadowing="correlated", layered=True)
+    # 3.x: the layer added to a whole base (no layering); F0 = 0.08 x Specular, tinted towards the
+    # base colour's hue by Specular Tint; the IOR socket is for transmission only.
+    specular = _constant(name, input_socket(node, "Specular"), "Specular", 0.5, notes, 0.0, 1e30)
+    if specular == 0.0:
+        return None
+    notes.append(f"material '{name}': Principled Burley diffuse of Blender 3.x (Lambert)")
+    if distribution == "MULTI_GGX":
+        notes.append(f"material '{name}': Multiscatter GGX of Blender 3.x (single-scatter GGX)")
+    amount = _constant(name, input_socket(node, "Specular Tint"), "Specular Tint", 0.0, notes, 0.0, 1.0)
+    tint = (1.0, 1.0, 1.0)
+    if amount > 0.0:
+        if base.texture is not None:
+            notes.append(f"material '{name}': Specular Tint of a textured base colour (untinted)")
+        else:
+            lum = sum(w * c for w, c in zip(_LUMINANCE, base.color))
+            hue = tuple(c / lum for c in base.color) if lum > 0.0 else (1.0, 1.0, 1.0)
+            tint = tuple(1.0 + amount * (h - 1.0) for h in hue)
+    f0 = min(0.08 * specular, 0.99)
+    root = f0 ** 0.5
+    return dict(roughness=rough, ior=(1.0 + root) / (1.0 - root), specular_ior_level=0.5, specular_tint=tint,
+                multiscatter=False, shadowing="separable", layered=False)
 
 
 def _metal(name, node, notes):

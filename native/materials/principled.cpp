@@ -1,7 +1,6 @@
 #include "materials/principled.h"
 
 #include "materials/fresnel.h"
-#include "materials/glossy.h"
 #include "materials/multiscatter.h"
 #include "sampling/ggx_albedo.h"
 
@@ -18,7 +17,9 @@ Principled Principled::from_params(const Params& params) {
   if (!std::isfinite(roughness)) throw std::invalid_argument("principled: roughness must be finite");
   m.roughness = std::clamp(roughness, 0.0f, 1.0f);
   m.multiscatter = params.flag("multiscatter", m.multiscatter);
-  const float ior = float(params.number("ior", 1.5));
+  m.layered = params.flag("layered", m.layered);
+  m.shadowing = params.has("shadowing") ? shadowing_from_params(params) : m.shadowing;
+  const float ior = float(params.number("ior", 1.45));  // every kind's default (the binding's)
   if (!(ior > 0.0f) || !std::isfinite(ior)) throw std::invalid_argument("principled: ior must be finite and > 0");
   const float level = float(params.non_negative("specular_ior_level", 0.5));
   const Vec3 tint = params.color("specular_tint", Vec3(1.0f));
@@ -43,24 +44,21 @@ Principled Principled::from_params(const Params& params) {
 Scatter scatter(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx) {
   const Vec3 albedo = lambert_albedo(m.base, *ctx.textures, s.uv);
   if (m.eta == 1.0f) return Scatter::diffuse(lambert_f(albedo));
-  GlossyLobe lobe = oriented_lobe(s, m.roughness, GgxShadowing::HeightCorrelated);
+  GlossyLobe lobe = oriented_lobe(s, m.roughness, m.shadowing);
   const float mu = lobe.wo.z;
   lobe.f0 = m.f0;
   lobe.ior = m.eta;
   lobe.ior_f0 = m.eta_f0;
-  // The layer's albedo at wo: mix(F0, 1, s) with s the table's mean blend (Cycles' estimate),
-  // darkened with the multiscatter terms as its closure weight is; the base gets the rest.
-  const Vec3 layer_albedo = glm::mix(m.f0, Vec3(1.0f), ggx_fresnel_blend(m.roughness, mu, m.eta));
-  Vec3 darkening(1.0f);
-  if (m.multiscatter) {
-    lobe.tint = multiscatter_scale(m.roughness, mu, m.fss);
-    const float e = ggx_albedo(m.roughness, mu);
-    darkening = lobe.tint * e;  // the scale over 1 / E, Cycles' energy_scale
-  } else {
-    lobe.tint = Vec3(1.0f);
+  lobe.tint = m.multiscatter ? multiscatter_scale(m.roughness, mu, m.fss) : Vec3(1.0f);
+  float base = 1.0f;
+  if (m.layered) {
+    // The layer's albedo at wo: mix(F0, 1, s) with s the table's mean blend (Cycles' estimate),
+    // times the multiscatter darkening its closure weight carries (the scale over 1 / E, Cycles'
+    // energy_scale); the base gets the rest.
+    const Vec3 layer_albedo = glm::mix(m.f0, Vec3(1.0f), ggx_fresnel_blend(m.roughness, mu, m.eta));
+    const Vec3 covered = m.multiscatter ? lobe.tint * ggx_albedo(m.roughness, mu) * layer_albedo : layer_albedo;
+    base = std::clamp(1.0f - std::max({covered.x, covered.y, covered.z}), 0.0f, 1.0f);
   }
-  const Vec3 covered = darkening * layer_albedo;
-  const float base = std::clamp(1.0f - std::max({covered.x, covered.y, covered.z}), 0.0f, 1.0f);
   Scatter sc = Scatter::glossy_lobe(lobe);
   sc.f = base * lambert_f(albedo);
   return sc;

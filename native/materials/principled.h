@@ -8,15 +8,20 @@
 //     energy layering without a random walk, so the sum reflects at most what came in.
 //   - Multiscatter GGX (Principled's default distribution in 4.0+) adds the microfacets' inter-
 //     reflections back to the layer (materials/multiscatter.h); plain GGX does not.
+// Blender 3.x's Principled (layered False, shadowing 'separable') adds the same kind of layer to
+// a base it leaves whole: F0 = 0.08 Specular times its tint colour, the curve of the IOR with
+// that F0 (the add-on converts); its Burley diffuse is taken as Lambert (the add-on's note).
 // The integrator sees what a Mix of Diffuse and Glossy gives it (scatter.h's Glossy answer with a
 // diffuse part), so the base's direct light is a Lambert hit's and the layer's is MIS'd.
 //
 // Parameters (add_material('principled', ...)): color ((0.8, 0.8, 0.8)), texture (the base
-// colour), roughness (0.5, clamped to [0, 1]), ior (1.5, > 0), specular_ior_level (0.5, >= 0),
-// specular_tint ((1, 1, 1), >= 0), multiscatter (True).
+// colour), roughness (0.5, clamped to [0, 1]), ior (1.45, every kind's; > 0), specular_ior_level (0.5, >= 0),
+// specular_tint ((1, 1, 1), >= 0), multiscatter (True), layered (True; False: 3.x), shadowing
+// ('correlated', 4.0+; 'separable', 3.x).
 #pragma once
 
 #include "core/params.h"
+#include "materials/glossy.h"
 #include "materials/lambert.h"
 #include "materials/scatter.h"
 
@@ -27,11 +32,14 @@ namespace toyrt {
 struct Principled {
   static constexpr const char* kType = "principled";
   static constexpr const char* kParams =
-      "color, texture (the base colour), roughness (0.5), ior (1.5), specular_ior_level (0.5),\n"
-      "specular_tint ((1, 1, 1)), multiscatter (True): Blender 4.0+'s Principled BSDF, dielectric";
+      "color, texture (the base colour), roughness (0.5), ior (1.45), specular_ior_level (0.5),\n"
+      "specular_tint ((1, 1, 1)), multiscatter (True), layered (True; False: Blender 3.x's sum),\n"
+      "shadowing ('correlated'; 'separable': 3.x): the Principled BSDF, dielectric";
   Lambert base;
   float roughness = 0.5f;  // in [0, 1]
   bool multiscatter = true;
+  bool layered = true;  // the base scaled by what the layer leaves (4.0+), or whole (3.x)
+  GgxShadowing shadowing = GgxShadowing::HeightCorrelated;
   // Derived once from ior, specular_ior_level and specular_tint:
   float eta = 1.5f;           // the IOR whose curve shapes the Fresnel term; 1: no layer
   Vec3 f0{0.04f};             // the layer's reflectance at normal incidence, tint included, <= 1

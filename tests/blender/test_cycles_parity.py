@@ -222,6 +222,25 @@ def scene_metal_sweep(p):
     kit.world((0, 0, 0))
 
 
+def scene_principled(p):
+    # Principled BSDF dielectrics (Metallic 0): a row of balls over a diffuse floor, each its own
+    # (roughness, Specular, tint); the version's default distribution (3.x GGX, 4.0+ Multiscatter
+    # GGX). A tint is a scalar on 3.x and a colour on 4.0+: each ball gets the version's kind.
+    kit.plane("floor", 8.0, kit.diffuse("floor", (0.6, 0.6, 0.6)))
+    new = bpy.app.version >= (4, 0, 0)
+    for i, (rough, specular, tint) in enumerate(p["balls"]):
+        x = (i - (len(p["balls"]) - 1) / 2) * 0.9
+        t = None if tint is None else (tint[1] if new else tint[0])
+        kit.uv_sphere(f"ball{i}", 0.4, (x, 0.0, 0.4),
+                      kit.principled_dielectric(f"principled{i}", p["color"], rough, specular, t))
+    if p["lamp"] == "point":
+        kit.point_light("lamp", (0.8, -1.5, 2.5), 150.0, radius=0.25)
+    else:
+        kit.area_light("panel", (-0.8, -1.2, 2.2), 120.0, 1.2, 0.6, target=(0.0, 0.0, 0.3))
+    camera((0.0, -4.5, 1.6), (0, 0, 0.35))
+    kit.world((0, 0, 0))
+
+
 def scene_diffuse_and_glossy(p):
     # Mix and Add shaders of a Diffuse and a Glossy BSDF: balls at three mix factors and one sum.
     kit.plane("floor", 8.0, kit.diffuse("floor", (0.6, 0.6, 0.6)))
@@ -306,6 +325,16 @@ SCENES_SPEC = [
                                                    lamp="area", mean_limit=0.005, sample_factor=4), 8),
     ("mix_diffuse_glossy", scene_diffuse_and_glossy, dict(balls=[(0.2, 0.3), (0.5, 0.3), (0.8, 0.3), (None, 0.1)],
                                                           mean_limit=0.005, sample_factor=4), 8),
+    # Principled dielectrics: a roughness sweep under a point lamp, and Specular levels and tints
+    # under an area lamp (3.x: a Lambert base for its Burley diffuse, so reported there only).
+    ("principled_sweep_point", scene_principled, dict(balls=[(r, 0.5, None) for r in (0.05, 0.2, 0.4, 0.7, 1.0)],
+                                                      color=(0.7, 0.25, 0.15), lamp="point", mean_limit=0.005,
+                                                      asserted_from=(4, 0, 0), sample_factor=2), 8),
+    ("principled_specular_area", scene_principled, dict(balls=[(0.3, 0.0, None), (0.3, 1.0, None),
+                                                               (0.3, 0.5, (1.0, (1.0, 0.5, 0.2))),
+                                                               (0.15, 2.0, None), (0.6, 0.25, None)],
+                                                        color=(0.2, 0.45, 0.7), lamp="area", mean_limit=0.005,
+                                                        asserted_from=(4, 0, 0), sample_factor=4), 8),
     # Principled metals: measured and reported, not asserted (TOYRT omits the metal Fresnel's
     # grazing brightening and, on 4.x/5.x, the multiscatter energy; docs/blender.md).
     ("metal_sweep", scene_metal_sweep, dict(roughness=[0.05, 0.2, 0.4, 0.7, 1.0], color=(0.9, 0.75, 0.5),
@@ -421,7 +450,8 @@ def main():
         assert img.shape == ref.shape, f"{name}: TOYRT {img.shape} vs Cycles {ref.shape}"
         mean_rel, frac, bias = compare(img, ref)
         ok = mean_rel <= params.get("mean_limit", MEAN_LIMIT) and frac <= PIXEL_LIMIT
-        asserted = tuple(bpy.app.version) < tuple(params.get("asserted_before", (99, 0, 0)))
+        asserted = (tuple(params.get("asserted_from", (0, 0, 0))) <= tuple(bpy.app.version)
+                    < tuple(params.get("asserted_before", (99, 0, 0))))
         save_png(out_dir / f"{name}-toyrt.png", img)
         save_png(out_dir / f"{name}-cycles.png", ref)
         np.save(out_dir / f"{name}-toyrt.npy", img)

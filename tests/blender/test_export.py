@@ -421,6 +421,40 @@ def test_unsupported_node():
     check(np.isfinite(px).all() and px.mean() > 0, "the image is lit (the Toon colour as a diffuse)")
 
 
+def test_principled_specular_layer():
+    """A Principled BSDF with Metallic 0 becomes the 'principled' kind on each Blender as its Cycles
+    shades it: 4.0+ keeps its IOR, Specular IOR Level and tint colour, layered over the base,
+    Multiscatter GGX by default; 3.x's F0 = 0.08 x Specular becomes the layer's IOR, tinted towards
+    the base colour's hue, added to a whole base, with a note for its Burley diffuse; Specular 0
+    leaves the plain Lambert base with no note."""
+    _, _ = addon()
+    from render_toyrt import materials
+
+    new = bpy.app.version >= (4, 0, 0)
+    base = (0.5, 0.4, 0.3)
+    default = materials.material_spec(kit.principled("plain", base))
+    none = materials.material_spec(kit.principled_dielectric("none", base, 0.3, specular=0.0))
+    tinted = materials.material_spec(kit.principled_dielectric("tinted", base, 0.3, specular=1.0,
+                                                               tint=(1.0, 0.5, 0.2) if new else 1.0))
+    check(default.spec.kind == "principled" and default.spec.multiscatter == new
+          and default.spec.layered == new and default.spec.shadowing == ("correlated" if new else "separable"),
+          f"the default Principled material has a specular layer: {default.spec}")
+    check(none.spec.kind == "diffuse" and none.spec.color == base and not none.notes,
+          f"Specular 0: the Lambert base, no note: {none}")
+    t = tinted.spec
+    if new:
+        want = dict(ior=1.5, specular_ior_level=1.0, specular_tint=(1.0, 0.5, 0.2))
+        ok = not tinted.notes
+    else:
+        lum = 0.2126 * base[0] + 0.7152 * base[1] + 0.0722 * base[2]
+        want = dict(ior=(1 + 0.08 ** 0.5) / (1 - 0.08 ** 0.5), specular_ior_level=0.5,
+                    specular_tint=tuple(c / lum for c in base))
+        ok = len(tinted.notes) == 1 and "Burley" in tinted.notes[0]
+    got = dict(ior=t.ior, specular_ior_level=t.specular_ior_level, specular_tint=t.specular_tint)
+    check(ok and t.roughness == 0.3 and all(np.allclose(got[k], want[k], rtol=1e-5) for k in want),
+          f"Specular 1 with a tint: {got} ({want}); notes {tinted.notes}")
+
+
 # ---- 5. cancel and threads ------------------------------------------------------------------------
 
 def os_threads():
@@ -551,6 +585,7 @@ def test_command_line_range():
         print(run.stdout[-2000:], run.stderr[-2000:])
 
 
-PARTS = [test_counts_and_transforms, test_instancing_memory, test_missing_texture, test_unsupported_node, test_cancel,
+PARTS = [test_counts_and_transforms, test_instancing_memory, test_missing_texture, test_unsupported_node,
+         test_principled_specular_layer, test_cancel,
          test_animation, test_command_line_range]
 run_script(PARTS, "export", TMP)

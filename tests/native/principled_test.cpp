@@ -165,3 +165,16 @@ TEST(MultiscatterGgx, ColouredLobeKeepsLessOfEachBounce) {
   EXPECT_GT(a_ms, a_ss);
   EXPECT_LT(a_ms, a_ss + 0.5f * (1.0f - 2.0f * a_ss));  // below c E + c (1 - E) with c = 0.5
 }
+
+TEST(Principled, Blender3xSumKeepsTheWholeBaseUnderTheSameLayer) {
+  const Params p3 = args({{"color", Vec3(0.6f)}, {"layered", false}, {"shadowing", std::string("separable")},
+                          {"multiscatter", false}});
+  const Params p4 = args({{"color", Vec3(0.6f)}, {"shadowing", std::string("separable")}, {"multiscatter", false}});
+  const ShadingPoint hit = hit_from(direction(0.9, 0.2));
+  const Scatter s3 = scatter(principled(p3), hit, kContext), s4 = scatter(principled(p4), hit, kContext);
+  EXPECT_EQ(s3.f, Vec3(0.6f) * kInvPi);
+  EXPECT_LT(s4.f.x, s3.f.x);
+  const Vec3 wi = direction(0.5, 3.0);
+  EXPECT_EQ(evaluate_lobe(s3.glossy, wi).f, evaluate_lobe(s4.glossy, wi).f);
+  EXPECT_EQ(s3.glossy.shadowing, GgxShadowing::Separable);
+}

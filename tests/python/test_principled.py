@@ -1,0 +1,63 @@
+"""The Principled material through the module: closed-form pixels at normal incidence under a
+point light straight above an orthographic one-pixel camera, where the GGX lobe's value is
+D(n) G2 F / 4 = F0 / (4 pi alpha^2) (G2 = 1 there, F = F0 on the normal), and bad input refused
+by name."""
+import math
+
+import numpy as np
+import pytest
+import toyrt
+
+
+def floor(**material):
+    s = toyrt.Scene()
+    s.add_material("principled", **material)
+    s.add_mesh(np.float32([[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]]), [[0, 1, 2], [0, 2, 3]], material_ids=0)
+    s.background = (0.0, 0.0, 0.0)
+    s.add_point_light((0.0, 0.0, 2.0), 100.0)
+    s.commit()
+    m = np.eye(4)
+    m[2, 3] = 5.0
+    return s.render(dict(type="ORTHO", ortho_scale=1e-3, resolution_x=1, resolution_y=1, matrix_world=m),
+                    samples=16)[0, 0, :3]
+
+
+IRRADIANCE = 100.0 / (4 * math.pi) / 4.0   # a 100 W point 2 m above: W / (4 pi r^2)
+
+
+def test_unlayered_rough_principled_is_lambert_plus_f0_over_4_pi():
+    # Blender 3.x's sum: the whole base plus the lobe; roughness 1: alpha 1, D(n) = 1 / pi.
+    color = np.array([0.6, 0.3, 0.1])
+    got = floor(color=tuple(color), roughness=1.0, ior=1.5, layered=False, multiscatter=False,
+                shadowing="separable")
+    np.testing.assert_allclose(got, (color / math.pi + 0.04 / (4 * math.pi)) * IRRADIANCE, rtol=1e-4)
+
+
+def test_specular_tint_and_level_scale_f0():
+    got = floor(color=(0.0, 0.0, 0.0), roughness=1.0, ior=1.5, specular_ior_level=1.0,
+                specular_tint=(1.0, 0.5, 0.0), layered=False, multiscatter=False)
+    np.testing.assert_allclose(got, np.array([0.08, 0.04, 0.0]) / (4 * math.pi) * IRRADIANCE, rtol=1e-4, atol=1e-9)
+
+
+def test_layering_takes_from_the_base_what_the_layer_reflects():
+    color = (0.6, 0.3, 0.1)
+    layered = floor(color=color, roughness=1.0, ior=1.5, multiscatter=False)
+    whole = floor(color=color, roughness=1.0, ior=1.5, multiscatter=False, layered=False)
+    # Same lobe; the base is scaled by one factor in (1 - 1, 1 - F0]: the layer's albedo at wo.
+    lobe = 0.04 / (4 * math.pi) * IRRADIANCE
+    factor = (layered - lobe) / (whole - lobe)
+    assert np.allclose(factor, factor[0], rtol=2e-3) and 0.5 < factor[0] <= 0.96 + 1e-6
+
+
+def test_no_layer_at_ior_1_or_level_0_is_the_diffuse_material():
+    for kw in (dict(ior=1.0), dict(specular_ior_level=0.0)):
+        got = floor(color=(0.6, 0.3, 0.1), **kw)
+        np.testing.assert_allclose(got, np.array([0.6, 0.3, 0.1]) / math.pi * IRRADIANCE, rtol=1e-4)
+
+
+@pytest.mark.parametrize("bad", [dict(ior=0.0), dict(roughness=math.nan), dict(specular_ior_level=-0.5),
+                                 dict(specular_tint=(1.0, math.nan, 1.0)), dict(shadowing="smith")])
+def test_bad_parameters_are_refused_by_name(bad):
+    s = toyrt.Scene()
+    with pytest.raises(ValueError, match=next(iter(bad))):
+        s.add_material("principled", **bad)
