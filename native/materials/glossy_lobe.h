@@ -30,8 +30,8 @@ struct GlossyLobe {
 inline Vec3 lobe_fresnel(const GlossyLobe& lobe, const Vec3& wi) {
   if (lobe.ior == 0.0f) return Vec3(1.0f);
   const Vec3 h = glm::normalize(lobe.wo + wi);
-  const float s = std::clamp((fresnel_dielectric(glm::dot(lobe.wo, h), lobe.ior) - lobe.ior_f0) / (1.0f - lobe.ior_f0),
-                             0.0f, 1.0f);
+  const float s =
+      std::clamp((fresnel_dielectric(glm::dot(lobe.wo, h), lobe.ior) - lobe.ior_f0) / (1.0f - lobe.ior_f0), 0.0f, 1.0f);
   return glm::mix(lobe.f0, Vec3(1.0f), s);
 }
 

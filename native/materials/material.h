@@ -29,9 +29,9 @@ inline int32_t texture_of(const Material& material) {
   return std::visit([](const auto& m) { return texture_index(m); }, material);
 }
 
-// A material of kind `kind` ("diffuse", "refraction", "glass", "glossy", "diffuse_glossy", "principled": the kTypes) from its
-// parameters. Throws std::invalid_argument for another kind (listing the known ones), a bad value or an argument the
-// kind does not read. Texture ids are checked against the scene's textures by Scene::add_material.
+// A material of kind `kind` ("diffuse", "refraction", "glass", "glossy", "diffuse_glossy", "principled": the kTypes)
+// from its parameters. Throws std::invalid_argument for another kind (listing the known ones), a bad value or an
+// argument the kind does not read. Texture ids are checked against the scene's textures by Scene::add_material.
 inline constexpr const char* kDefaultMaterialKind = Lambert::kType;  // Blender's default surface
 inline Material make_material(std::string_view kind, const Params& params) {
   return make_from_params<Material>(kind, params, "material", "kind");

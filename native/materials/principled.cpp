@@ -35,8 +35,9 @@ Principled Principled::from_params(const Params& params) {
   m.eta_f0 = f0_from_ior(m.eta);
   m.f0 = glm::clamp(f0 * tint, Vec3(0.0f), Vec3(1.0f));
   // Fss: the same blend at the curve's average, F_avg(eta) remapped as the curve is.
-  const float s = m.eta_f0 < 1.0f ? std::clamp((fresnel_dielectric_average(m.eta) - m.eta_f0) / (1.0f - m.eta_f0), 0.0f, 1.0f)
-                                  : 1.0f;
+  const float s = m.eta_f0 < 1.0f
+                      ? std::clamp((fresnel_dielectric_average(m.eta) - m.eta_f0) / (1.0f - m.eta_f0), 0.0f, 1.0f)
+                      : 1.0f;
   m.fss = glm::mix(m.f0, Vec3(1.0f), s);
   return m;
 }

@@ -41,10 +41,10 @@ struct Principled {
   bool layered = true;  // the base scaled by what the layer leaves (4.0+), or whole (3.x)
   GgxShadowing shadowing = GgxShadowing::HeightCorrelated;
   // Derived once from ior, specular_ior_level and specular_tint:
-  float eta = 1.5f;           // the IOR whose curve shapes the Fresnel term; 1: no layer
-  Vec3 f0{0.04f};             // the layer's reflectance at normal incidence, tint included, <= 1
-  float eta_f0 = 0.04f;       // F0(eta)
-  Vec3 fss{0.0f};             // the layer's average single-bounce Fresnel (multiscatter)
+  float eta = 1.5f;      // the IOR whose curve shapes the Fresnel term; 1: no layer
+  Vec3 f0{0.04f};        // the layer's reflectance at normal incidence, tint included, <= 1
+  float eta_f0 = 0.04f;  // F0(eta)
+  Vec3 fss{0.0f};        // the layer's average single-bounce Fresnel (multiscatter)
 
   static Principled from_params(const Params& params);
 };

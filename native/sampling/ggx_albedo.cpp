@@ -81,8 +81,9 @@ float ggx_table_ior(int i, int n) {
 double estimate_ggx_albedo(float roughness, float cos_o, int n) {
   const float alpha = ggx_alpha(roughness);
   const Vec3 wo = outgoing(cos_o);
-  return stratified_mean(
-      n, [&](const Vec2& u) { return double(ggx_reflection_sample(alpha, GgxShadowing::HeightCorrelated, wo, u).weight); });
+  return stratified_mean(n, [&](const Vec2& u) {
+    return double(ggx_reflection_sample(alpha, GgxShadowing::HeightCorrelated, wo, u).weight);
+  });
 }
 
 double estimate_ggx_average_albedo(float roughness, int n) {

@@ -25,7 +25,7 @@
 
 namespace toyrt {
 
-inline constexpr int kGgxAlbedoSize = 32;       // E: roughness x cos_o; E_avg: roughness
+inline constexpr int kGgxAlbedoSize = 32;        // E: roughness x cos_o; E_avg: roughness
 inline constexpr int kGgxFresnelBlendSize = 16;  // s: roughness x cos_o x z
 
 float ggx_albedo(float roughness, float cos_o);

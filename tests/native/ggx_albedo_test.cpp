@@ -2,8 +2,8 @@
 // give (a stale file after a change to the lobe fails here: run `make tables`), they agree with
 // Cycles' own tables, which were computed independently by Monte Carlo from Cycles' lobe, and the
 // lookups interpolate and clamp as Cycles' do.
-#include "materials/fresnel.h"
 #include "sampling/ggx_albedo.h"
+#include "materials/fresnel.h"
 
 #include <gtest/gtest.h>
 
@@ -41,8 +41,13 @@ TEST(GgxAlbedo, AgreesWithCyclesTables) {
     int x, y;
     float e;
   };
-  for (const E2& t : {E2{31, 31, 0.306853f}, {16, 31, 0.903873f}, {24, 31, 0.592102f}, {31, 16, 0.443841f},
-                      {24, 8, 0.727744f}, {31, 3, 0.765057f}, {16, 3, 0.893246f}})
+  for (const E2& t : {E2{31, 31, 0.306853f},
+                      {16, 31, 0.903873f},
+                      {24, 31, 0.592102f},
+                      {31, 16, 0.443841f},
+                      {24, 8, 0.727744f},
+                      {31, 3, 0.765057f},
+                      {16, 3, 0.893246f}})
     EXPECT_NEAR(ggx_albedo(t.x / 31.0f, t.y / 31.0f), t.e, 2e-3) << t.x << " " << t.y;
   struct E1 {
     int x;
@@ -54,8 +59,13 @@ TEST(GgxAlbedo, AgreesWithCyclesTables) {
     int x, y, z;
     float s;
   };
-  for (const E3& t : {E3{15, 15, 4, 0.000366f}, {8, 8, 8, 0.037176f}, {15, 2, 10, 0.029883f}, {4, 12, 6, 0.003853f},
-                      {0, 15, 15, 0.0f}, {12, 4, 3, 0.011738f}, {15, 0, 8, 0.057074f}})
+  for (const E3& t : {E3{15, 15, 4, 0.000366f},
+                      {8, 8, 8, 0.037176f},
+                      {15, 2, 10, 0.029883f},
+                      {4, 12, 6, 0.003853f},
+                      {0, 15, 15, 0.0f},
+                      {12, 4, 3, 0.011738f},
+                      {15, 0, 8, 0.057074f}})
     EXPECT_NEAR(ggx_fresnel_blend(t.x / 15.0f, t.y / 15.0f, ggx_table_ior(t.z, 16)), t.s, 2e-3)
         << t.x << " " << t.y << " " << t.z;
 }

@@ -6,9 +6,9 @@
 // converges to the mirror; grazing and degenerate directions give finite numbers; bad roughness
 // and colours have a defined result.
 #include "sampling/ggx.h"
+#include "hemisphere.h"
 #include "materials/glossy.h"
 #include "materials/material.h"
-#include "hemisphere.h"
 #include "statistics.h"
 
 #include <gtest/gtest.h>

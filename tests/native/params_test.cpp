@@ -77,7 +77,8 @@ TEST(Params, UnknownTypeListsTheKnownOnes) {
   EXPECT_EQ(refusal([] { make_light("HEMI", {}); }),
             "unknown light type 'HEMI': expected 'POINT', 'AREA', 'SPOT' or 'SUN'");
   EXPECT_EQ(refusal([] { make_material("metal", {}); }),
-            "unknown material kind 'metal': expected 'diffuse', 'refraction', 'glass', 'glossy', 'diffuse_glossy' or 'principled'");
+            "unknown material kind 'metal': expected 'diffuse', 'refraction', 'glass', 'glossy', 'diffuse_glossy' or "
+            "'principled'");
 }
 
 TEST(Params, AllowedUnreadArgumentsPass) {

@@ -4,10 +4,10 @@
 // rest; a white multiscatter lobe reflects everything; Specular IOR Level 0 or IOR 1 is plain
 // Lambert; the lobe's sampled weights equal f cos / pdf with its Fresnel term; bad parameters have
 // a defined answer.
-#include "materials/glossy.h"
-#include "materials/material.h"
 #include "materials/principled.h"
 #include "hemisphere.h"
+#include "materials/glossy.h"
+#include "materials/material.h"
 
 #include <gtest/gtest.h>
 
@@ -42,14 +42,14 @@ Vec3 furnace(const Scatter& sc) {
   constexpr int kN = 256;
   Vec3 sum(0.0f);
   for (int i = 0; i < kN; ++i)
-    for (int j = 0; j < kN; ++j)
-      sum += sample_lobe(sc.glossy, Vec2((i + 0.5f) / kN, (j + 0.5f) / kN)).weight;
+    for (int j = 0; j < kN; ++j) sum += sample_lobe(sc.glossy, Vec2((i + 0.5f) / kN, (j + 0.5f) / kN)).weight;
   return base + sum / float(kN * kN);
 }
 
 // The same albedo by quadrature of the lobe's value: checks evaluate_lobe where the lobe is wide.
 float lobe_integral(const GlossyLobe& lobe) {
-  return float(hemisphere_integral([&](const Vec3& wi) { return double(evaluate_lobe(lobe, wi).f.x) * wi.z; }, 1024, 256));
+  return float(
+      hemisphere_integral([&](const Vec3& wi) { return double(evaluate_lobe(lobe, wi).f.x) * wi.z; }, 1024, 256));
 }
 
 }  // namespace
@@ -81,10 +81,10 @@ TEST(Principled, NormalIncidenceOnASmoothLayerReflectsF0AndTheBaseTheRest) {
   EXPECT_NEAR(s.weight.x, 0.04f, 1e-3f);
   // Specular IOR Level 1 doubles F0; Specular Tint scales it per channel.
   const Principled tinted = principled(args({{"roughness", 0.0f},
-                                              {"ior", 1.5},
-                                              {"specular_ior_level", 1.0},
-                                              {"specular_tint", Vec3(1.0f, 0.5f, 0.0f)},
-                                              {"multiscatter", false}}));
+                                             {"ior", 1.5},
+                                             {"specular_ior_level", 1.0},
+                                             {"specular_tint", Vec3(1.0f, 0.5f, 0.0f)},
+                                             {"multiscatter", false}}));
   const BsdfSample t = sample_lobe(scatter(tinted, hit_from(Vec3(0, 0, 1)), kContext).glossy, Vec2(0.3f, 0.7f));
   EXPECT_NEAR(t.weight.x, 0.08f, 1e-3f);
   EXPECT_NEAR(t.weight.y, 0.04f, 1e-3f);
@@ -93,7 +93,7 @@ TEST(Principled, NormalIncidenceOnASmoothLayerReflectsF0AndTheBaseTheRest) {
 
 TEST(Principled, NoSpecularLayerIsPlainLambert) {
   for (const Params& p : std::vector<Params>{args({{"color", Vec3(0.3f, 0.6f, 0.9f)}, {"specular_ior_level", 0.0}}),
-                          args({{"color", Vec3(0.3f, 0.6f, 0.9f)}, {"ior", 1.0}})}) {
+                                             args({{"color", Vec3(0.3f, 0.6f, 0.9f)}, {"ior", 1.0}})}) {
     const Scatter sc = scatter(principled(p), hit_from(direction(0.7, 0.1)), kContext);
     EXPECT_EQ(sc.kind, Scatter::Kind::Diffuse);
     EXPECT_EQ(sc.f, Vec3(0.3f, 0.6f, 0.9f) * kInvPi);
@@ -105,9 +105,9 @@ TEST(Principled, SampledWeightIsFCosOverPdf) {
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   for (int k = 0; k < 2000; ++k) {
     const Principled m = principled(args({{"roughness", u(rng)},
-                                           {"ior", 1.0 + 2.0 * u(rng)},
-                                           {"specular_tint", Vec3(u(rng), u(rng), u(rng))},
-                                           {"multiscatter", k % 2 == 0}}));
+                                          {"ior", 1.0 + 2.0 * u(rng)},
+                                          {"specular_tint", Vec3(u(rng), u(rng), u(rng))},
+                                          {"multiscatter", k % 2 == 0}}));
     const Scatter sc = scatter(m, hit_from(direction(1.5 * u(rng), 6.0 * u(rng))), kContext);
     const BsdfSample s = sample_lobe(sc.glossy, Vec2(u(rng), u(rng)));
     if (!(s.pdf > 0.0f)) continue;
@@ -137,11 +137,11 @@ TEST(Principled, BadParametersAreRefusedOrClamped) {
   // denser medium: total internal reflection) is finite. Cycles' layering estimate reads the
   // table of 1 / ior there, which misses the internal reflection, so that sum may exceed 1 as
   // it does in Cycles.
-  const Vec3 level = furnace(scatter(principled(args({{"specular_ior_level", 1e6}})), hit_from(direction(1.0, 0.0)), kContext));
+  const Vec3 level =
+      furnace(scatter(principled(args({{"specular_ior_level", 1e6}})), hit_from(direction(1.0, 0.0)), kContext));
   EXPECT_NEAR(level.x, 1.0f, 0.01f);
   EXPECT_TRUE(is_finite(furnace(scatter(principled(args({{"ior", 0.5}})), hit_from(direction(1.0, 0.0)), kContext))));
-  EXPECT_EQ(std::string(std::visit([](const auto& m) { return m.kType; },
-                                   make_material("principled", args({})))),
+  EXPECT_EQ(std::string(std::visit([](const auto& m) { return m.kType; }, make_material("principled", args({})))),
             "principled");
 }
 
@@ -167,8 +167,8 @@ TEST(MultiscatterGgx, ColouredLobeKeepsLessOfEachBounce) {
 }
 
 TEST(Principled, Blender3xSumKeepsTheWholeBaseUnderTheSameLayer) {
-  const Params p3 = args({{"color", Vec3(0.6f)}, {"layered", false}, {"shadowing", std::string("separable")},
-                          {"multiscatter", false}});
+  const Params p3 = args(
+      {{"color", Vec3(0.6f)}, {"layered", false}, {"shadowing", std::string("separable")}, {"multiscatter", false}});
   const Params p4 = args({{"color", Vec3(0.6f)}, {"shadowing", std::string("separable")}, {"multiscatter", false}});
   const ShadingPoint hit = hit_from(direction(0.9, 0.2));
   const Scatter s3 = scatter(principled(p3), hit, kContext), s4 = scatter(principled(p4), hit, kContext);
