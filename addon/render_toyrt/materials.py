@@ -55,6 +55,7 @@ class MaterialSpec:
     specular_ior_level: float = 0.5                          # 'principled' (4.0+'s socket)
     specular_tint: tuple[float, float, float] = (1.0, 1.0, 1.0)  # 'principled': the layer's F0 tint
     layered: bool = True                                     # 'principled': 4.0+ (False: 3.x's sum)
+    metallic: bool = False                                   # 'principled': Metallic 1, a metal of the base colour
     emission: tuple[float, float, float] = (0.0, 0.0, 0.0)   # colour x strength, linear radiance
     emission_sampling: str = "AUTO"                           # Blender 4.x's names (3.x: AUTO or NONE)
 
@@ -68,7 +69,7 @@ class MaterialSpec:
             args.update(multiscatter=self.multiscatter)
         if self.kind == "principled":
             args.update(specular_ior_level=self.specular_ior_level, specular_tint=self.specular_tint,
-                        layered=self.layered)
+                        layered=self.layered, metallic=self.metallic)
         if self.kind == "diffuse_glossy":
             args.update(diffuse_weight=self.diffuse_weight, glossy_color=self.glossy_color)
         return args
@@ -398,6 +399,8 @@ def _principled(name, node, notes):
     emission = _emission(name, input_socket(node, "Emission Color", "Emission"),  # 4.0+ / 3.x
                          input_socket(node, "Emission Strength"), notes)
     base, image = _color_material(name, input_socket(node, "Base Color"), notes)
+    if base.texture is None:
+        base = replace(base, color=_finite_color(name, base.color, "base colour", notes))
     layer = _specular_layer(name, node, base, extras, notes)
     if extras:
         notes.append(f"material '{name}': Principled {', '.join(extras)} (not modelled)")
@@ -456,14 +459,12 @@ def _specular_layer(name, node, base, extras, notes):
 
 
 def _metal(name, node, notes):
-    """Principled BSDF with Metallic 1: a glossy lobe tinted by the base colour at every angle,
-    emission kept. What it leaves out goes in the one note: Cycles brightens metals towards white
-    at grazing (3.x by its Fresnel blend, 4.x+ by F82 tint), and the coat, anisotropy, other
-    distributions and a linked base colour."""
-    extras = ["grazing Fresnel brightening"]
-    base = input_socket(node, "Base Color")
-    if base is not None and linked_node(base) is not None:
-        extras.append(f"base colour from {linked_node(base).bl_idname}")
+    """Principled BSDF with Metallic 1: a metal layer whose reflectance at normal incidence is the
+    base colour (or its texture), no base under it, emission kept. 4.0+: F82-tint Fresnel with
+    Specular Tint, Multiscatter GGX by default; 3.x: the dielectric curve of the Specular's IOR
+    blended from the base colour to white. The coat, anisotropy and other distributions go in the
+    one note."""
+    extras = []
     coat = input_socket(node, "Coat Weight", "Clearcoat")
     if coat is not None and (coat.is_linked or coat.default_value > 0.0):
         extras.append("coat")
@@ -471,15 +472,34 @@ def _metal(name, node, notes):
     if aniso is not None and (aniso.is_linked or aniso.default_value > 0.0):
         extras.append("anisotropy")
     distribution = getattr(node, "distribution", "GGX")
-    if distribution != "GGX":   # 4.x/5.x default to Multiscatter GGX
-        extras.append("multiscatter GGX" if distribution == "MULTI_GGX" else f"{distribution.title()} distribution")
-    notes.append(f"material '{name}': Principled metal without {', '.join(extras)} (glossy of its base colour)")
-    spec = _glossy_spec(name, None, input_socket(node, "Roughness"), notes)
-    if base is not None:
-        spec = replace(spec, color=_finite_color(name, base.default_value, "base colour", notes))
+    new = _blender_version() >= (4, 0, 0)
+    if distribution not in ("GGX", "MULTI_GGX"):
+        extras.append(f"{distribution.title()} distribution (GGX)")
+    elif distribution == "MULTI_GGX" and not new:
+        extras.append("Multiscatter GGX of Blender 3.x (single-scatter GGX)")
+    if extras:
+        notes.append(f"material '{name}': Principled metal without {', '.join(extras)}")
+    base, image = _color_material(name, input_socket(node, "Base Color"), notes)
+    if base.texture is None:
+        base = replace(base, color=_finite_color(name, base.color, "base colour", notes))
+    rough = _constant(name, input_socket(node, "Roughness"), "roughness", 0.5, notes, 0.0, 1.0)
+    if new:
+        tint_sock = input_socket(node, "Specular Tint")
+        tint = (1.0, 1.0, 1.0)
+        if tint_sock is not None and hasattr(tint_sock.default_value, "__len__"):
+            if tint_sock.is_linked:
+                notes.append(f"material '{name}': linked Specular Tint (its constant colour)")
+            tint = _finite_color(name, tint_sock.default_value, "Specular Tint", notes)
+        layer = dict(ior=1.5, specular_tint=tint, multiscatter=distribution == "MULTI_GGX", shadowing="correlated",
+                     layered=True)
+    else:
+        specular = _constant(name, input_socket(node, "Specular"), "Specular", 0.5, notes, 0.0, 1e30)
+        root = min(0.08 * specular, 0.99) ** 0.5
+        layer = dict(ior=(1.0 + root) / (1.0 - root), multiscatter=False, shadowing="separable", layered=False)
+    spec = replace(base, kind="principled", roughness=rough, metallic=True, **layer)
     emission = _emission(name, input_socket(node, "Emission Color", "Emission"),
                          input_socket(node, "Emission Strength"), notes)
-    return replace(spec, emission=emission), None
+    return replace(spec, emission=emission), image
 
 
 def _color_material(name, sock, notes):

@@ -6,6 +6,8 @@
 // critical angle (sin_t >= 1) F = 1: total internal reflection.
 #pragma once
 
+#include "core/math.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -46,6 +48,25 @@ inline float fresnel_dielectric_average(float eta) {
     sum += double(fresnel_dielectric(mu, eta)) * mu;
   }
   return float(double(mu_c) * mu_c + 2.0 * sum * (1.0 - mu_c) / kN);
+}
+
+// Blender 4.0+'s metal Fresnel, F82-tint (Hoffman 2023, "Generalization of Adobe's Fresnel
+// Model"): Schlick's curve less a dip near grazing, F(c) = mix(f0, 1, (1 - c)^5) - b c (1 - c)^6,
+// clamped to [0, 1], where b makes F at c = 1/7 (about 82 degrees) Schlick's value there times
+// the tint: b = Schlick(1/7) (1 - tint) / ((1/7) (6/7)^6).
+inline Vec3 f82_tint_b(const Vec3& f0, const Vec3& tint) {
+  constexpr float k = 6.0f / 7.0f, k5 = (k * k) * (k * k) * k;
+  return glm::mix(f0, Vec3(1.0f), k5) * (7.0f / (k5 * k)) * (Vec3(1.0f) - tint);
+}
+inline Vec3 fresnel_f82(float c, const Vec3& f0, const Vec3& b) {
+  c = std::clamp(c, 0.0f, 1.0f);
+  const float m = 1.0f - c, m5 = (m * m) * (m * m) * m;
+  return glm::clamp(glm::mix(f0, Vec3(1.0f), m5) - b * (c * m5 * m), Vec3(0.0f), Vec3(1.0f));
+}
+// Its hemispherical average 2 int F(mu) mu dmu, term by term (without the clamp):
+// 2 int mu (1 - mu)^5 = 1 / 21 and 2 int mu^2 (1 - mu)^6 = 2 B(3, 7) = 1 / 126.
+inline Vec3 f82_average(const Vec3& f0, const Vec3& b) {
+  return glm::mix(f0, Vec3(1.0f), 1.0f / 21.0f) - b * (1.0f / 126.0f);
 }
 
 }  // namespace toyrt

@@ -2,7 +2,8 @@
 // needs three things of it without knowing the material: its value and pdf for a light's
 // direction (next-event estimation, MIS), and a sampled direction to continue the path along.
 // Plain data: the shading frame, wo in it, the tint and alpha, and the Fresnel term: none (the
-// tint alone, Blender's Glossy BSDF), or Principled's dielectric blend (materials/principled.h).
+// tint alone, Blender's Glossy BSDF), Principled's dielectric blend, or 4.0+'s metal F82-tint
+// (materials/principled.h).
 #pragma once
 
 #include "core/math.h"
@@ -10,7 +11,16 @@
 #include "sampling/frame.h"
 #include "sampling/ggx.h"
 
+#include <algorithm>
+#include <cstdint>
+
 namespace toyrt {
+
+enum class LobeFresnel : uint8_t {
+  None,        // the tint alone
+  Dielectric,  // mix(f0, 1, s), s the curve of `ior` remapped to [0, 1]: (F_ior - F0(ior)) / (1 - F0(ior))
+  F82Tint,     // Schlick's mix(f0, 1, (1 - c)^5) less f82_b c (1 - c)^6 (Blender 4.0+'s metals)
+};
 
 struct GlossyLobe {
   Frame frame{Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};  // z: the shading normal on wo's side
@@ -18,21 +28,26 @@ struct GlossyLobe {
   Vec3 tint{0.0f};  // the Fresnel term as Blender's Glossy BSDF has it: the colour, at every angle
   float alpha = kGgxMinAlpha;
   GgxShadowing shadowing = GgxShadowing::Separable;
-  // Principled's dielectric Fresnel (Blender 4.0+): F = mix(f0, 1, s) times the tint, where s is
-  // the interface's own curve remapped to [0, 1], (F_ior(wo.h) - F0(ior)) / (1 - F0(ior)), so
-  // f0 sets the strength at normal incidence and ior the shape. ior 0: no Fresnel term.
+  // The Fresnel term on the microfacet normal, times the tint: f0 sets its strength at normal
+  // incidence; the dielectric curve's shape comes from ior, the metal's dip towards grazing from
+  // f82_b.
+  LobeFresnel fresnel = LobeFresnel::None;
   Vec3 f0{1.0f};
-  float ior = 0.0f;
+  float ior = 1.0f;
   float ior_f0 = 0.0f;  // F0(ior)
+  Vec3 f82_b{0.0f};
 };
 
 // The Fresnel factor for the microfacet normal between wo and wi (local, unit, both above).
 inline Vec3 lobe_fresnel(const GlossyLobe& lobe, const Vec3& wi) {
-  if (lobe.ior == 0.0f) return Vec3(1.0f);
+  if (lobe.fresnel == LobeFresnel::None) return Vec3(1.0f);
   const Vec3 h = glm::normalize(lobe.wo + wi);
-  const float s =
-      std::clamp((fresnel_dielectric(glm::dot(lobe.wo, h), lobe.ior) - lobe.ior_f0) / (1.0f - lobe.ior_f0), 0.0f, 1.0f);
-  return glm::mix(lobe.f0, Vec3(1.0f), s);
+  const float c = std::clamp(glm::dot(lobe.wo, h), 0.0f, 1.0f);
+  if (lobe.fresnel == LobeFresnel::Dielectric) {
+    const float s = std::clamp((fresnel_dielectric(c, lobe.ior) - lobe.ior_f0) / (1.0f - lobe.ior_f0), 0.0f, 1.0f);
+    return glm::mix(lobe.f0, Vec3(1.0f), s);
+  }
+  return fresnel_f82(c, lobe.f0, lobe.f82_b);
 }
 
 struct BsdfEval {

@@ -19,6 +19,7 @@ Principled Principled::from_params(const Params& params) {
   m.multiscatter = params.flag("multiscatter", m.multiscatter);
   m.layered = params.flag("layered", m.layered);
   m.shadowing = params.has("shadowing") ? shadowing_from_params(params) : m.shadowing;
+  m.metallic = params.flag("metallic", m.metallic);
   const float ior = float(params.number("ior", 1.45));  // every kind's default (the binding's)
   if (!(ior > 0.0f) || !std::isfinite(ior)) throw std::invalid_argument("principled: ior must be finite and > 0");
   const float level = float(params.non_negative("specular_ior_level", 0.5));
@@ -33,6 +34,7 @@ Principled Principled::from_params(const Params& params) {
     if (ior < 1.0f) m.eta = 1.0f / m.eta;
   }
   m.eta_f0 = f0_from_ior(m.eta);
+  m.specular_tint = tint;
   m.f0 = glm::clamp(f0 * tint, Vec3(0.0f), Vec3(1.0f));
   // Fss: the same blend at the curve's average, F_avg(eta) remapped as the curve is.
   const float s = m.eta_f0 < 1.0f
@@ -42,11 +44,38 @@ Principled Principled::from_params(const Params& params) {
   return m;
 }
 
+namespace {
+
+// A metal layer of reflectance f0 (the base colour, clamped to [0, 1]) at normal incidence.
+Scatter metal(const Principled& m, const ShadingPoint& s, const Vec3& base_color) {
+  GlossyLobe lobe = oriented_lobe(s, m.roughness, m.shadowing);
+  lobe.f0 = glm::clamp(base_color, Vec3(0.0f), Vec3(1.0f));
+  lobe.tint = Vec3(1.0f);
+  if (!m.layered) {
+    // 3.x: the dielectric curve of the Specular's IOR, blended from the base colour to white.
+    lobe.fresnel = LobeFresnel::Dielectric;
+    lobe.ior = m.eta;
+    lobe.ior_f0 = m.eta_f0;
+    return Scatter::glossy_lobe(lobe);
+  }
+  // 4.0+: F82-tint (materials/fresnel.h), the tint at most 1.
+  lobe.fresnel = LobeFresnel::F82Tint;
+  lobe.f82_b = f82_tint_b(lobe.f0, glm::min(m.specular_tint, Vec3(1.0f)));
+  if (m.multiscatter)
+    lobe.tint = multiscatter_scale(m.roughness, lobe.wo.z,
+                                   glm::clamp(f82_average(lobe.f0, lobe.f82_b), Vec3(0.0f), Vec3(1.0f)));
+  return Scatter::glossy_lobe(lobe);
+}
+
+}  // namespace
+
 Scatter scatter(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx) {
   const Vec3 albedo = lambert_albedo(m.base, *ctx.textures, s.uv);
+  if (m.metallic) return metal(m, s, albedo);
   if (m.eta == 1.0f) return Scatter::diffuse(lambert_f(albedo));
   GlossyLobe lobe = oriented_lobe(s, m.roughness, m.shadowing);
   const float mu = lobe.wo.z;
+  lobe.fresnel = LobeFresnel::Dielectric;
   lobe.f0 = m.f0;
   lobe.ior = m.eta;
   lobe.ior_f0 = m.eta_f0;

@@ -211,8 +211,8 @@ def scene_glossy_sweep(p):
 
 
 def scene_metal_sweep(p):
-    # Principled BSDF, Metallic 1, at the sweep's roughness values: TOYRT's glossy of the base colour
-    # against Cycles' metal Fresnel (brighter towards grazing) and, on 4.x/5.x, its multiscatter GGX.
+    # Principled BSDF, Metallic 1, at the sweep's roughness values (Blender's defaults otherwise: 3.x
+    # GGX, 4.0+ Multiscatter GGX and a white Specular Tint).
     kit.plane("floor", 8.0, kit.diffuse("floor", (0.6, 0.6, 0.6)))
     for i, rough in enumerate(p["roughness"]):
         x = (i - (len(p["roughness"]) - 1) / 2) * 0.9
@@ -335,10 +335,10 @@ SCENES_SPEC = [
                                                                (0.15, 2.0, None), (0.6, 0.25, None)],
                                                         color=(0.2, 0.45, 0.7), lamp="area", mean_limit=0.005,
                                                         asserted_from=(4, 0, 0), sample_factor=4), 8),
-    # Principled metals: measured and reported, not asserted (TOYRT omits the metal Fresnel's
-    # grazing brightening and, on 4.x/5.x, the multiscatter energy; docs/blender.md).
+    # Principled metals (Metallic 1): 3.x's Fresnel blend from the base colour, 4.0+'s F82-tint
+    # with Multiscatter GGX.
     ("metal_sweep", scene_metal_sweep, dict(roughness=[0.05, 0.2, 0.4, 0.7, 1.0], color=(0.9, 0.75, 0.5),
-                                            asserted_before=(0, 0, 0), sample_factor=2), 8),
+                                            mean_limit=0.005, sample_factor=2), 8),
     # Depth of field: a hexagonal aperture focused on a focus object (docs/render.md).
     ("depth_of_field", scene_depth_of_field, dict(boxes=[(-1.0, -3.0), (0.0, 0.0), (1.2, 3.0)], uv_repeat=12.0,
                                                   fstop=0.1, blades=6, rotation=0.3, camera=(0.0, -6.0, 1.0),

@@ -178,3 +178,38 @@ TEST(Principled, Blender3xSumKeepsTheWholeBaseUnderTheSameLayer) {
   EXPECT_EQ(evaluate_lobe(s3.glossy, wi).f, evaluate_lobe(s4.glossy, wi).f);
   EXPECT_EQ(s3.glossy.shadowing, GgxShadowing::Separable);
 }
+
+TEST(PrincipledMetal, F82TintScalesSchlickAt82DegreesAndAveragesInClosedForm) {
+  const Vec3 f0(0.9f, 0.6f, 0.3f), tint(1.0f, 0.7f, 0.2f);
+  const Vec3 b = f82_tint_b(f0, tint);
+  const float c = 1.0f / 7.0f, m5 = std::pow(1.0f - c, 5.0f);
+  const Vec3 schlick = glm::mix(f0, Vec3(1.0f), m5);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(fresnel_f82(c, f0, b)[i], schlick[i] * tint[i], 1e-5f);
+  EXPECT_EQ(fresnel_f82(1.0f, f0, b), f0);
+  EXPECT_EQ(f82_tint_b(f0, Vec3(1.0f)), Vec3(0.0f));
+  // The closed-form average against a fine midpoint rule (F stays inside [0, 1] here).
+  constexpr int kN = 1 << 16;
+  Vec3 sum(0.0f);
+  for (int k = 0; k < kN; ++k) {
+    const float mu = (k + 0.5f) / kN;
+    sum += 2.0f * mu * fresnel_f82(mu, f0, b) / float(kN);
+  }
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(f82_average(f0, b)[i], sum[i], 1e-4f);
+}
+
+TEST(PrincipledMetal, SmoothMetalReflectsItsBaseColourHeadOnAndWhiteLightFully) {
+  for (const bool layered : {true, false}) {
+    const Principled m = principled(args({{"color", Vec3(0.9f, 0.5f, 0.2f)}, {"metallic", true},
+                                          {"roughness", 0.0f}, {"layered", layered}, {"multiscatter", false}}));
+    const Scatter sc = scatter(m, hit_from(Vec3(0, 0, 1)), kContext);
+    EXPECT_EQ(sc.f, Vec3(0.0f));  // no base under a metal
+    const Vec3 w = sample_lobe(sc.glossy, Vec2(0.4f, 0.1f)).weight;
+    EXPECT_NEAR(w.x, 0.9f, 1e-3f);
+    EXPECT_NEAR(w.z, 0.2f, 1e-3f);
+  }
+  // A white metal with the multiscatter compensation returns all light at every roughness.
+  for (const float rough : {0.3f, 0.7f, 1.0f}) {
+    const Principled white = principled(args({{"color", Vec3(1.0f)}, {"metallic", true}, {"roughness", rough}}));
+    EXPECT_NEAR(furnace(scatter(white, hit_from(direction(0.8, 0.0)), kContext)).x, 1.0f, 5e-3f) << rough;
+  }
+}
