@@ -199,8 +199,11 @@ TEST(PrincipledMetal, F82TintScalesSchlickAt82DegreesAndAveragesInClosedForm) {
 
 TEST(PrincipledMetal, SmoothMetalReflectsItsBaseColourHeadOnAndWhiteLightFully) {
   for (const bool layered : {true, false}) {
-    const Principled m = principled(args({{"color", Vec3(0.9f, 0.5f, 0.2f)}, {"metallic", true},
-                                          {"roughness", 0.0f}, {"layered", layered}, {"multiscatter", false}}));
+    const Principled m = principled(args({{"color", Vec3(0.9f, 0.5f, 0.2f)},
+                                          {"metallic", true},
+                                          {"roughness", 0.0f},
+                                          {"layered", layered},
+                                          {"multiscatter", false}}));
     const Scatter sc = scatter(m, hit_from(Vec3(0, 0, 1)), kContext);
     EXPECT_EQ(sc.f, Vec3(0.0f));  // no base under a metal
     const Vec3 w = sample_lobe(sc.glossy, Vec2(0.4f, 0.1f)).weight;
