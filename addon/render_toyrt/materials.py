@@ -55,7 +55,7 @@ class MaterialSpec:
     specular_ior_level: float = 0.5                          # 'principled' (4.0+'s socket)
     specular_tint: tuple[float, float, float] = (1.0, 1.0, 1.0)  # 'principled': the layer's F0 tint
     layered: bool = True                                     # 'principled': 4.0+ (False: 3.x's sum)
-    metallic: bool = False                                   # 'principled': Metallic 1, a metal of the base colour
+    metallic: float = 0.0                                    # 'principled': Metallic (1: a metal of the base colour)
     emission: tuple[float, float, float] = (0.0, 0.0, 0.0)   # colour x strength, linear radiance
     emission_sampling: str = "AUTO"                           # Blender 4.x's names (3.x: AUTO or NONE)
 
@@ -383,8 +383,7 @@ def _principled(name, node, notes):
     if metal is not None and not metal.is_linked and metal.default_value >= 0.999:
         return _metal(name, node, notes)
     extras = []
-    if metal is not None and (metal.is_linked or metal.default_value > 0.0):
-        extras.append("metallic")
+    metallic = _constant(name, metal, "Metallic", 0.0, notes, 0.0, 1.0)
     if trans is not None and (trans.is_linked or trans.default_value > 0.0):
         extras.append("partial transmission")
     for label, names in (("coat", ("Coat Weight", "Clearcoat")), ("sheen", ("Sheen Weight", "Sheen")),
@@ -404,7 +403,12 @@ def _principled(name, node, notes):
     layer = _specular_layer(name, node, base, extras, notes)
     if extras:
         notes.append(f"material '{name}': Principled {', '.join(extras)} (not modelled)")
-    spec = base if layer is None else replace(base, kind="principled", **layer)
+    if layer is None and metallic > 0.0:   # no dielectric layer, but a metal beside the base
+        new = _blender_version() >= (4, 0, 0)
+        layer = dict(roughness=_constant(name, input_socket(node, "Roughness"), "roughness", 0.5, notes, 0.0, 1.0),
+                     ior=1.0, multiscatter=new and getattr(node, "distribution", "GGX") == "MULTI_GGX",
+                     shadowing="correlated" if new else "separable", layered=new)
+    spec = base if layer is None else replace(base, kind="principled", metallic=metallic, **layer)
     return replace(spec, emission=emission), image
 
 
@@ -496,7 +500,7 @@ def _metal(name, node, notes):
         specular = _constant(name, input_socket(node, "Specular"), "Specular", 0.5, notes, 0.0, 1e30)
         root = min(0.08 * specular, 0.99) ** 0.5
         layer = dict(ior=(1.0 + root) / (1.0 - root), multiscatter=False, shadowing="separable", layered=False)
-    spec = replace(base, kind="principled", roughness=rough, metallic=True, **layer)
+    spec = replace(base, kind="principled", roughness=rough, metallic=1.0, **layer)
     emission = _emission(name, input_socket(node, "Emission Color", "Emission"),
                          input_socket(node, "Emission Strength"), notes)
     return replace(spec, emission=emission), image

@@ -19,7 +19,8 @@ Principled Principled::from_params(const Params& params) {
   m.multiscatter = params.flag("multiscatter", m.multiscatter);
   m.layered = params.flag("layered", m.layered);
   m.shadowing = params.has("shadowing") ? shadowing_from_params(params) : m.shadowing;
-  m.metallic = params.flag("metallic", m.metallic);
+  const double metallic = params.number("metallic", m.metallic);
+  m.metallic = float(std::clamp(metallic, 0.0, 1.0));
   const float ior = float(params.number("ior", 1.45));  // every kind's default (the binding's)
   if (!(ior > 0.0f) || !std::isfinite(ior)) throw std::invalid_argument("principled: ior must be finite and > 0");
   const float level = float(params.non_negative("specular_ior_level", 0.5));
@@ -46,8 +47,8 @@ Principled Principled::from_params(const Params& params) {
 
 namespace {
 
-// A metal layer of reflectance f0 (the base colour, clamped to [0, 1]) at normal incidence.
-Scatter metal(const Principled& m, const ShadingPoint& s, const Vec3& base_color) {
+// A metal lobe of reflectance f0 (the base colour, clamped to [0, 1]) at normal incidence.
+GlossyLobe metal_lobe(const Principled& m, const ShadingPoint& s, const Vec3& base_color) {
   GlossyLobe lobe = oriented_lobe(s, m.roughness, m.shadowing);
   lobe.f0 = glm::clamp(base_color, Vec3(0.0f), Vec3(1.0f));
   lobe.tint = Vec3(1.0f);
@@ -56,7 +57,7 @@ Scatter metal(const Principled& m, const ShadingPoint& s, const Vec3& base_color
     lobe.fresnel = LobeFresnel::Dielectric;
     lobe.ior = m.eta;
     lobe.ior_f0 = m.eta_f0;
-    return Scatter::glossy_lobe(lobe);
+    return lobe;
   }
   // 4.0+: F82-tint (materials/fresnel.h), the tint at most 1.
   lobe.fresnel = LobeFresnel::F82Tint;
@@ -64,34 +65,65 @@ Scatter metal(const Principled& m, const ShadingPoint& s, const Vec3& base_color
   if (m.multiscatter)
     lobe.tint = multiscatter_scale(m.roughness, lobe.wo.z,
                                    glm::clamp(f82_average(lobe.f0, lobe.f82_b), Vec3(0.0f), Vec3(1.0f)));
-  return Scatter::glossy_lobe(lobe);
+  return lobe;
+}
+
+// The dielectric layer of reflectance f0 at normal incidence, and the share of the base it leaves.
+struct Layer {
+  GlossyLobe lobe;
+  float base = 1.0f;
+};
+Layer dielectric_layer(const Principled& m, const ShadingPoint& s, const Vec3& f0) {
+  Layer layer{oriented_lobe(s, m.roughness, m.shadowing)};
+  GlossyLobe& lobe = layer.lobe;
+  const float mu = lobe.wo.z;
+  lobe.fresnel = LobeFresnel::Dielectric;
+  lobe.f0 = f0;
+  lobe.ior = m.eta;
+  lobe.ior_f0 = m.eta_f0;
+  lobe.tint = m.multiscatter ? multiscatter_scale(m.roughness, mu, m.fss) : Vec3(1.0f);
+  if (m.layered) {
+    // The layer's albedo at wo: mix(F0, 1, s) with s the table's mean blend (Cycles' estimate),
+    // times the multiscatter darkening its closure weight carries (the scale over 1 / E, Cycles'
+    // energy_scale); the base gets the rest.
+    const Vec3 layer_albedo = glm::mix(f0, Vec3(1.0f), ggx_fresnel_blend(m.roughness, mu, m.eta));
+    const Vec3 covered = m.multiscatter ? lobe.tint * ggx_albedo(m.roughness, mu) * layer_albedo : layer_albedo;
+    layer.base = std::clamp(1.0f - std::max({covered.x, covered.y, covered.z}), 0.0f, 1.0f);
+  }
+  return layer;
+}
+
+Scatter lobe_over(const GlossyLobe& lobe, const Vec3& f) {
+  Scatter sc = Scatter::glossy_lobe(lobe);
+  sc.f = f;
+  return sc;
 }
 
 }  // namespace
 
 Scatter scatter(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx) {
   const Vec3 albedo = lambert_albedo(m.base, *ctx.textures, s.uv);
-  if (m.metallic) return metal(m, s, albedo);
-  if (m.eta == 1.0f) return Scatter::diffuse(lambert_f(albedo));
-  GlossyLobe lobe = oriented_lobe(s, m.roughness, m.shadowing);
-  const float mu = lobe.wo.z;
-  lobe.fresnel = LobeFresnel::Dielectric;
-  lobe.f0 = m.f0;
-  lobe.ior = m.eta;
-  lobe.ior_f0 = m.eta_f0;
-  lobe.tint = m.multiscatter ? multiscatter_scale(m.roughness, mu, m.fss) : Vec3(1.0f);
-  float base = 1.0f;
-  if (m.layered) {
-    // The layer's albedo at wo: mix(F0, 1, s) with s the table's mean blend (Cycles' estimate),
-    // times the multiscatter darkening its closure weight carries (the scale over 1 / E, Cycles'
-    // energy_scale); the base gets the rest.
-    const Vec3 layer_albedo = glm::mix(m.f0, Vec3(1.0f), ggx_fresnel_blend(m.roughness, mu, m.eta));
-    const Vec3 covered = m.multiscatter ? lobe.tint * ggx_albedo(m.roughness, mu) * layer_albedo : layer_albedo;
-    base = std::clamp(1.0f - std::max({covered.x, covered.y, covered.z}), 0.0f, 1.0f);
+  if (m.metallic >= 1.0f) return Scatter::glossy_lobe(metal_lobe(m, s, albedo));
+  const float dielectric = 1.0f - m.metallic;
+  if (!m.layered) {
+    // 3.x: one lobe whose F0 goes from the dielectric's to the base colour with Metallic, over
+    // the base weighted 1 - Metallic.
+    if (m.eta == 1.0f && m.metallic == 0.0f) return Scatter::diffuse(lambert_f(albedo));
+    const Vec3 f0 = glm::mix(m.f0, glm::clamp(albedo, Vec3(0.0f), Vec3(1.0f)), m.metallic);
+    return lobe_over(dielectric_layer(m, s, f0).lobe, dielectric * lambert_f(albedo));
   }
-  Scatter sc = Scatter::glossy_lobe(lobe);
-  sc.f = base * lambert_f(albedo);
-  return sc;
+  // 4.0+: Metallic mixes a metal with the dielectric layer over its base. The base is always
+  // there; of the two lobes one is drawn with probability its weight (its value then counts
+  // once, unweighted), which is what Cycles does when it picks a closure to continue with.
+  if (m.eta == 1.0f) {
+    if (m.metallic == 0.0f) return Scatter::diffuse(lambert_f(albedo));
+    if (ctx.lobe_uniform() < m.metallic) return lobe_over(metal_lobe(m, s, albedo), dielectric * lambert_f(albedo));
+    return Scatter::diffuse(dielectric * lambert_f(albedo));
+  }
+  const Layer layer = dielectric_layer(m, s, m.f0);
+  const Vec3 f = dielectric * layer.base * lambert_f(albedo);
+  if (m.metallic > 0.0f && ctx.lobe_uniform() < m.metallic) return lobe_over(metal_lobe(m, s, albedo), f);
+  return lobe_over(layer.lobe, f);
 }
 
 }  // namespace toyrt

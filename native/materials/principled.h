@@ -8,9 +8,11 @@
 //     energy layering without a random walk, so the sum reflects at most what came in.
 //   - Multiscatter GGX (Principled's default distribution in 4.0+) adds the microfacets' inter-
 //     reflections back to the layer (materials/multiscatter.h); plain GGX does not.
-// With metallic True (Metallic 1) there is no base: the layer is a metal whose F0 is the base
-// colour (a texture's at the hit), 4.0+'s F82-tint Fresnel (Specular Tint the colour at 82
-// degrees relative to Schlick's), or 3.x's dielectric curve blend from the base colour.
+// With metallic 1 there is no base: the layer is a metal whose F0 is the base colour (a
+// texture's at the hit), 4.0+'s F82-tint Fresnel (Specular Tint the colour at 82 degrees relative
+// to Schlick's), or 3.x's dielectric curve blend from the base colour. Between 0 and 1, 4.0+
+// mixes the metal and the dielectric (one of the two lobes drawn per hit); 3.x blends one
+// lobe's F0 from the dielectric's to the base colour and weights the base 1 - metallic.
 // Blender 3.x's Principled (layered False, shadowing 'separable') adds the same kind of layer to
 // a base it leaves whole: F0 = 0.08 Specular times its tint colour, the curve of the IOR with
 // that F0 (the add-on converts); its Burley diffuse is taken as Lambert (the add-on's note).
@@ -20,7 +22,7 @@
 // Parameters (add_material('principled', ...)): color ((0.8, 0.8, 0.8)), texture (the base
 // colour), roughness (0.5, clamped to [0, 1]), ior (1.45, every kind's; > 0), specular_ior_level (0.5, >= 0),
 // specular_tint ((1, 1, 1), >= 0), multiscatter (True), layered (True; False: 3.x), shadowing
-// ('correlated', 4.0+; 'separable', 3.x), metallic (False).
+// ('correlated', 4.0+; 'separable', 3.x), metallic (0, clamped to [0, 1]).
 #pragma once
 
 #include "core/params.h"
@@ -37,13 +39,13 @@ struct Principled {
   static constexpr const char* kParams =
       "color, texture (the base colour), roughness (0.5), ior (1.45), specular_ior_level (0.5),\n"
       "specular_tint ((1, 1, 1)), multiscatter (True), layered (True; False: Blender 3.x's sum),\n"
-      "shadowing ('correlated'; 'separable': 3.x), metallic (False): the Principled BSDF, dielectric or metal";
+      "shadowing ('correlated'; 'separable': 3.x), metallic (0): the Principled BSDF";
   Lambert base;
   float roughness = 0.5f;  // in [0, 1]
   bool multiscatter = true;
   bool layered = true;  // the base scaled by what the layer leaves (4.0+), or whole (3.x)
   GgxShadowing shadowing = GgxShadowing::HeightCorrelated;
-  bool metallic = false;  // Metallic 1: a metal of the base colour, no base
+  float metallic = 0.0f;  // in [0, 1]; 1: a metal of the base colour, no base
   Vec3 specular_tint{1.0f};
   // Derived once from ior, specular_ior_level and specular_tint:
   float eta = 1.5f;      // the IOR whose curve shapes the Fresnel term; 1: no layer

@@ -37,6 +37,10 @@ struct MaterialContext {
   // path vertex, computed only when asked for, so a diffuse hit pays for none.
   uint32_t pixel = 0, sample = 0, dimension = 0, seed = 0;
   float uniform() const { return sobol_owen_1d(pixel, sample, dimension, seed); }
+  // Another, for a material that picks one of its lobes where the integrator also samples lights
+  // (the lights' choice reads `dimension`: one number for both would correlate them).
+  uint32_t lobe_dimension = 0;
+  float lobe_uniform() const { return sobol_owen_1d(pixel, sample, lobe_dimension, seed); }
 };
 
 struct SpecularSample {

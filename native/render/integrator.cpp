@@ -285,8 +285,13 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     // whether the path goes on along `ray`. Always inlined: with the glossy cases GCC made the
     // lambda a function of its own, and the Lambert path paid for the call (cachegrind,
     // docs/render.md "A scene pays for what it uses").
-    const MaterialContext ctx{
-        &scene.textures(), depth < settings.split_depth, pixel, sample, vertex_dimension(depth, 0), settings.seed};
+    const MaterialContext ctx{&scene.textures(),
+                              depth < settings.split_depth,
+                              pixel,
+                              sample,
+                              vertex_dimension(depth, 0),
+                              settings.seed,
+                              vertex_dimension(depth, kDimsPerVertex - 6)};
     const bool go_on = std::visit(
         [&](const auto& material) __attribute__((always_inline)) {
           const Scatter sc = scatter(material, ShadingPoint{wo, s.ng, s.ns, s.uv}, ctx);

@@ -453,6 +453,11 @@ def test_principled_specular_layer():
     got = dict(ior=t.ior, specular_ior_level=t.specular_ior_level, specular_tint=t.specular_tint)
     check(ok and t.roughness == 0.3 and all(np.allclose(got[k], want[k], rtol=1e-5) for k in want),
           f"Specular 1 with a tint: {got} ({want}); notes {tinted.notes}")
+    half = kit.principled_dielectric("half_metal", base, 0.3)
+    half.node_tree.nodes["Principled BSDF"].inputs["Metallic"].default_value = 0.4
+    h = materials.material_spec(half)
+    check(h.spec.kind == "principled" and abs(h.spec.metallic - 0.4) < 1e-6 and not any("etallic" in n for n in h.notes),
+          f"Metallic 0.4 is modelled (a mix of metal and dielectric): {h}")
 
 
 # ---- 5. cancel and threads ------------------------------------------------------------------------

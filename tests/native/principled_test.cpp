@@ -200,7 +200,7 @@ TEST(PrincipledMetal, F82TintScalesSchlickAt82DegreesAndAveragesInClosedForm) {
 TEST(PrincipledMetal, SmoothMetalReflectsItsBaseColourHeadOnAndWhiteLightFully) {
   for (const bool layered : {true, false}) {
     const Principled m = principled(args({{"color", Vec3(0.9f, 0.5f, 0.2f)},
-                                          {"metallic", true},
+                                          {"metallic", 1.0},
                                           {"roughness", 0.0f},
                                           {"layered", layered},
                                           {"multiscatter", false}}));
@@ -212,7 +212,45 @@ TEST(PrincipledMetal, SmoothMetalReflectsItsBaseColourHeadOnAndWhiteLightFully) 
   }
   // A white metal with the multiscatter compensation returns all light at every roughness.
   for (const float rough : {0.3f, 0.7f, 1.0f}) {
-    const Principled white = principled(args({{"color", Vec3(1.0f)}, {"metallic", true}, {"roughness", rough}}));
+    const Principled white = principled(args({{"color", Vec3(1.0f)}, {"metallic", 1.0}, {"roughness", rough}}));
     EXPECT_NEAR(furnace(scatter(white, hit_from(direction(0.8, 0.0)), kContext)).x, 1.0f, 5e-3f) << rough;
   }
+}
+
+TEST(PrincipledMetal, PartlyMetallicIsTheMixOfMetalAndDielectricInExpectation) {
+  // 4.0+: one of the two lobes per hit, drawn with its weight; the mean over the draws is
+  // metallic x metal + (1 - metallic) x dielectric, and the base is (1 - metallic) of the
+  // dielectric's in every draw.
+  const Params common = args({{"color", Vec3(0.8f, 0.4f, 0.2f)}, {"roughness", 0.4f}, {"ior", 1.5}});
+  auto with = [&](double metallic) {
+    Params p = common;
+    p.set("metallic", metallic);
+    return principled(p);
+  };
+  const ShadingPoint hit = hit_from(direction(0.6, 0.3));
+  const Scatter metal = scatter(with(1.0), hit, kContext), dielectric = scatter(with(0.0), hit, kContext);
+  const Principled mixed = with(0.3);
+  const Vec3 expected = 0.3f * furnace(metal) + 0.7f * furnace(dielectric);
+  Vec3 mean(0.0f);
+  constexpr int kDraws = 64;
+  int metal_draws = 0;
+  for (uint32_t k = 0; k < kDraws; ++k) {
+    MaterialContext ctx = kContext;
+    ctx.sample = k;
+    ctx.lobe_dimension = 7;
+    const Scatter sc = scatter(mixed, hit, ctx);
+    EXPECT_EQ(sc.f, 0.7f * dielectric.f);
+    metal_draws += sc.glossy.fresnel == LobeFresnel::F82Tint;
+    mean += furnace(sc) / float(kDraws);
+  }
+  EXPECT_NEAR(metal_draws, 0.3 * kDraws, 2.0);  // stratified Sobol draws
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean[c], expected[c], 0.02f) << c;
+  // 3.x: one lobe, F0 blended to the base colour; the base weighted 1 - metallic.
+  Params p3 = common;
+  p3.set("metallic", 0.3).set("layered", false).set("multiscatter", false);
+  const Scatter sc3 = scatter(principled(p3), hit_from(Vec3(0, 0, 1)), kContext);
+  const Vec3 w = sample_lobe(sc3.glossy, Vec2(0.5f, 0.5f)).weight;
+  EXPECT_NEAR(sc3.f.x * kPi, 0.7f * 0.8f, 1e-5f);
+  EXPECT_EQ(sc3.glossy.f0, glm::mix(Vec3(0.04f), Vec3(0.8f, 0.4f, 0.2f), 0.3f));
+  EXPECT_GT(w.x, w.z);
 }
