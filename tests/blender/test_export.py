@@ -456,7 +456,8 @@ def test_principled_specular_layer():
     half = kit.principled_dielectric("half_metal", base, 0.3)
     half.node_tree.nodes["Principled BSDF"].inputs["Metallic"].default_value = 0.4
     h = materials.material_spec(half)
-    check(h.spec.kind == "principled" and abs(h.spec.metallic - 0.4) < 1e-6 and not any("etallic" in n for n in h.notes),
+    check(h.spec.kind == "principled" and abs(h.spec.metallic - 0.4) < 1e-6
+          and not any("etallic" in n for n in h.notes),
           f"Metallic 0.4 is modelled (a mix of metal and dielectric): {h}")
 
 
