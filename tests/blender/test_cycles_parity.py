@@ -548,9 +548,12 @@ def write_doc(results):
         "difference of 0.5 % (the materials issue's limit), at 2x (point lamp) and 4x (area lamp, mix) the "
         "samples: the sharp balls' highlights are the noisiest pixels of both renders. The Glossy node is set to "
         "GGX: 4.x/5.x default to Multiscatter GGX, which TOYRT renders as single-scatter GGX (noted).",
-        "- metal_sweep (Principled, Metallic 1, Blender's defaults otherwise) is reported, not asserted: TOYRT's "
-        "glossy of the base colour has neither the metal Fresnel's brightening towards grazing nor, on 4.x/5.x, "
-        "the multiscatter GGX energy (measured: 3.4 +0.14 % signed, 5.0 -4.1 %).",
+        "- Principled BSDF (docs/render.md, 'Principled BSDF and Multiscatter GGX'): principled_sweep_point and "
+        "principled_specular_area (Metallic 0: a Lambert base under a GGX layer) are asserted from 4.0, where "
+        "TOYRT renders Cycles' model (energy layering, Multiscatter GGX); on 3.x they are reported: Cycles 3.x's "
+        "Burley diffuse (darker towards grazing, with a roughness-dependent retro-reflection) is Lambert in "
+        "TOYRT. metal_sweep (Metallic 1, Blender's defaults otherwise: 3.x GGX with its Fresnel blend from the "
+        "base colour, 4.0+ Multiscatter GGX with F82-tint) is asserted on both.",
         "",
     ]
     DOC.write_text("\n".join(lines))
