@@ -547,7 +547,8 @@ def write_doc(results):
         "diffuse floor, Cycles with glossy bounces 8 and diffuse bounces 0; these scenes pass at a mean "
         "difference of 0.5 % (the materials issue's limit), at 2x (point lamp) and 4x (area lamp, mix) the "
         "samples: the sharp balls' highlights are the noisiest pixels of both renders. The Glossy node is set to "
-        "GGX: 4.x/5.x default to Multiscatter GGX, which TOYRT renders as single-scatter GGX (noted).",
+        "GGX (4.x/5.x default to Multiscatter GGX, which TOYRT renders as Cycles compensates it; 3.x's is a "
+        "random walk, rendered as single-scatter GGX and noted).",
         "- Principled BSDF (docs/render.md, 'Principled BSDF and Multiscatter GGX'): principled_sweep_point and "
         "principled_specular_area (Metallic 0: a Lambert base under a GGX layer) are asserted from 4.0, where "
         "TOYRT renders Cycles' model (energy layering, Multiscatter GGX); on 3.x they are reported: Cycles 3.x's "
