@@ -111,7 +111,7 @@ tables: native
 
 # Copies addon/render_toyrt + the module into Blender's user add-ons folder when they changed, and
 # enables the add-on in the user's preferences once (see the script).
-addon: native
+addon: native venv
 	@BLENDER=$(BLENDER) BUILD_DIR=$(BUILD) scripts/install-addon.sh
 
 # The per-level builds (three wheels and build-levels) compile the same core for the same three

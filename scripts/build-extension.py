@@ -12,6 +12,10 @@
     for it, so both sit in one folder), without the manifest (Blender 4.2+ would take a zip holding
     one for an extension): dist/render_toyrt-<version>-legacy-linux_x64.zip.
 
+Both carry Open Image Denoise for the Denoise setting: the extension lists the wheels of pyoidn,
+cffi and pycparser beside TOYRT's, the legacy zip holds them unpacked in vendor/
+(scripts/vendor-pyoidn.py: the CPU device only), since its Blenders cannot pip-install.
+
     .venv/bin/python scripts/build-extension.py --dist dist
 """
 import argparse
@@ -67,7 +71,13 @@ def build_extension(wheels: list[Path], dist: Path, work: Path) -> list[Path]:
     (stage / "wheels").mkdir()
     for wheel in wheels:
         shutil.copy2(wheel, stage / "wheels")
-    listed = ", ".join(f'"./wheels/{w.name}"' for w in wheels)
+    # Open Image Denoise for the Denoise setting (addon/render_toyrt/denoise.py): pyoidn and cffi for
+    # each Python of the build, pycparser (cffi's parser); Blender installs them with the add-on.
+    pythons = sorted({w.name.split("-")[2].replace("cp3", "3.") for w in wheels})
+    denoiser = denoiser_wheels(pythons, work / "denoiser-wheels")
+    for wheel in denoiser:
+        shutil.copy2(wheel, stage / "wheels")
+    listed = ", ".join(f'"./wheels/{w.name}"' for w in wheels + denoiser)
     with open(stage / "blender_manifest.toml", "a") as f:
         f.write(f"\n# Added by scripts/build-extension.py: the wheels of this build.\nwheels = [{listed}]\n")
     tool = blender_ext()
@@ -80,6 +90,18 @@ def build_extension(wheels: list[Path], dist: Path, work: Path) -> list[Path]:
         run_tool(tool, "validate", str(zip_path))
         print(f"extension: {zip_path} ({zip_path.stat().st_size // 1024} KB; validated by {tool.name})")
     return built
+
+
+def denoiser_wheels(pythons: list[str], folder: Path) -> list[Path]:
+    """The wheels of pyoidn, pycparser and cffi (one per Python) at the versions
+    requirements-test.txt pins, downloaded from PyPI (pip's cache makes a second build offline)."""
+    pins = {line.split("==")[0]: line.strip() for line in (REPO / "requirements-test.txt").read_text().splitlines()
+            if line.startswith(("pyoidn==", "cffi==", "pycparser=="))}
+    base = [sys.executable, "-m", "pip", "download", "-q", "--no-deps", "--only-binary=:all:", "-d", str(folder),
+            "--platform", "manylinux2014_x86_64", "--implementation", "cp"]
+    for python in pythons:
+        subprocess.run(base + ["--python-version", python] + list(pins.values()), check=True)
+    return sorted(folder.glob("*.whl"))
 
 
 def build_legacy(wheels: list[Path], dist: Path, version: str) -> Path:
@@ -104,8 +126,17 @@ def build_legacy(wheels: list[Path], dist: Path, version: str) -> Path:
                         info.external_attr = 0o755 << 16
                         z.writestr(info, wheel.read(name), zipfile.ZIP_DEFLATED)
                         written.add(name)
+        # Open Image Denoise for these Pythons, which cannot pip-install into Blender: vendor/.
+        vendor = REPO / "build" / "vendor-legacy"
+        subprocess.run([sys.executable, str(REPO / "scripts" / "vendor-pyoidn.py"), "--target", str(vendor),
+                        "--python", "3.10", "--python", "3.11"], check=True)
+        for path in sorted(vendor.rglob("*")):
+            if path.is_file():
+                info = zipfile.ZipInfo(f"{ADDON}/vendor/{path.relative_to(vendor)}", (2026, 1, 1, 0, 0, 0))
+                info.external_attr = (path.stat().st_mode & 0o777) << 16
+                z.writestr(info, path.read_bytes(), zipfile.ZIP_DEFLATED)
     pythons = ", ".join(sorted(w.name.split("-")[2].replace("cp3", "3.") for w in legacy))
-    print(f"legacy add-on: {out} ({out.stat().st_size // 1024} KB; Python {pythons})")
+    print(f"legacy add-on: {out} ({out.stat().st_size // 1024} KB; Python {pythons}; with Open Image Denoise)")
     return out
 
 

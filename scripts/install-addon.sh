@@ -24,14 +24,15 @@ paths_cache=$BUILD_DIR/blender-paths-$key.txt
 enabled_stamp=$BUILD_DIR/.stamp-addon-enabled-$key
 
 # --- 1. Blender's user folders (asked once) ------------------------------------------------------
-if [[ ! -s $paths_cache ]]; then
+if [[ ! -s $paths_cache ]] || ! grep -q '^TOYRT_PY=' "$paths_cache"; then
   echo "addon: asking Blender for its user folders"
   out=$("$BLENDER" -b --factory-startup --python-exit-code 1 --python-expr \
-"import bpy
+"import bpy, sys
 print('TOYRT_ADDONS_DIR=' + bpy.utils.user_resource('SCRIPTS', path='addons'))
-print('TOYRT_CONFIG_DIR=' + bpy.utils.user_resource('CONFIG'))" 2>&1) || { echo "$out" >&2; exit 1; }
-  grep -E '^TOYRT_(ADDONS|CONFIG)_DIR=/' <<<"$out" > "$paths_cache.tmp" || true
-  if [[ $(wc -l < "$paths_cache.tmp") -ne 2 ]]; then
+print('TOYRT_CONFIG_DIR=' + bpy.utils.user_resource('CONFIG'))
+print('TOYRT_PY=%d.%d' % sys.version_info[:2])" 2>&1) || { echo "$out" >&2; exit 1; }
+  grep -E '^TOYRT_((ADDONS|CONFIG)_DIR=/|PY=)' <<<"$out" > "$paths_cache.tmp" || true
+  if [[ $(wc -l < "$paths_cache.tmp") -ne 3 ]]; then
     echo "$out" >&2; echo "addon: could not read Blender's user folders" >&2; rm -f "$paths_cache.tmp"; exit 1
   fi
   mv "$paths_cache.tmp" "$paths_cache"
@@ -58,7 +59,7 @@ manifest() {  # manifest DIR [EXTRA_FILE]
 }
 want=$(manifest "$SRC" "${modules[0]}")
 have=""
-if [[ -d $DEST ]]; then have=$(manifest "$DEST"); fi
+if [[ -d $DEST ]]; then have=$(manifest "$DEST" | grep -v '  \./vendor/' || true); fi
 if [[ "$want" == "$have" ]]; then
   echo "addon: $DEST is up to date"
 else
@@ -74,6 +75,19 @@ else
   cp -p "${modules[0]}" "$tmp"/
   rm -rf "$DEST"
   mv "$tmp" "$DEST"
+fi
+
+# --- 2b. Open Image Denoise for the Denoise setting: Debian's Blender runs the system Python, which
+# has no pyoidn (and is externally managed), so it goes into the add-on's vendor/ folder as in the
+# legacy zip (scripts/vendor-pyoidn.py; kept in $BUILD_DIR/vendor, copied when its stamp differs).
+VENDOR_PY=${VENDOR_PY:-.venv/bin/python}
+py_version=$(sed -n 's/^TOYRT_PY=//p' "$paths_cache")
+"$VENDOR_PY" scripts/vendor-pyoidn.py --target "$BUILD_DIR/vendor" --python "$py_version"
+if ! cmp -s "$BUILD_DIR/vendor/VENDORED.txt" "$DEST/vendor/VENDORED.txt"; then
+  rm -rf "$DEST/vendor" "$DEST/.vendor.tmp"
+  cp -a "$BUILD_DIR/vendor" "$DEST/.vendor.tmp"
+  mv "$DEST/.vendor.tmp" "$DEST/vendor"
+  echo "addon: Open Image Denoise (pyoidn $py_version) vendored into $DEST/vendor"
 fi
 
 # --- 3. enable it in the user's preferences, once --------------------------------------------------

@@ -128,7 +128,7 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         if passes.black(wanted):
             report.note("passes left black (TOYRT does not produce them yet): " + ", ".join(passes.black(wanted)),
                         self.report)
-        computed = [p.native for p in wanted if p.native]
+        computed = list(dict.fromkeys(p.native for p in wanted if p.native))  # once each (Normal, Denoising Normal)
         denoising = settings.use_denoising and denoise.available() is None
         if settings.use_denoising and not denoising:
             report.note(denoise.available(), self.report)  # the frame is still rendered, not denoised
@@ -176,7 +176,7 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         """The whole frame once more, every pass beside Combined (tiles stream Combined only) and,
         when denoising, the render before it as the Noisy Image pass; the Cryptomatte layers and
         their manifests in the result's metadata."""
-        from . import cryptomatte
+        from . import cryptomatte, denoise
         from .passes import NOISY
 
         height, width = image.shape[:2]
@@ -190,6 +190,8 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             if target is None:
                 continue  # not registered by Blender for this layer (it should be): nothing to fill
             values = computed.get(p.native) if p.native else None
+            if values is not None and p.albedo:
+                values = denoise.albedo(values)
             if values is None:
                 values = np.zeros((height, width, len(p.channels)), np.float32)  # a pass TOYRT leaves black
             _set_rect(target.rect, np.ascontiguousarray(values[::-1]))

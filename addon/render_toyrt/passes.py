@@ -20,6 +20,7 @@ class Pass(NamedTuple):
     channels: str   # channel ids, one letter per channel
     kind: str       # register_pass's type
     native: str | None  # the core's pass (render(passes=...)); None: left black
+    albedo: bool = False  # the denoiser's albedo: the core's pass clipped to [0, 1] (denoise.albedo)
 
     @property
     def name(self) -> str:
@@ -57,9 +58,36 @@ PASSES = (
 _MIST_FALLOFF = {"QUADRATIC": 2.0, "LINEAR": 1.0, "INVERSE_QUADRATIC": 0.5}
 
 
+# Cycles' Denoising Data passes (its view_layer.cycles.denoising_store_passes; TOYRT's is
+# view_layer.toyrt.denoising_store_passes): the denoiser's auxiliary images, for denoising in the
+# compositor. Cycles' list changed in 5.x (seen in 5.3's Cycles add-on; 3.4 and 5.0 have the first).
+# Albedo and Normal are what TOYRT's denoiser reads (denoise.py), Depth is the Depth pass; the
+# specular albedo and roughness TOYRT does not produce are left black, noted as any such pass.
+_DENOISING_DATA_3 = (
+    Pass("denoising_store_passes", "Denoising Normal", "Denoising Normal", "XYZ", "VECTOR", "normal"),
+    Pass("denoising_store_passes", "Denoising Albedo", "Denoising Albedo", "RGB", "COLOR", "diffuse_color", True),
+    Pass("denoising_store_passes", "Denoising Depth", "Denoising Depth", "Z", "VALUE", "depth"),
+)
+_DENOISING_DATA_5_1 = (
+    _DENOISING_DATA_3[1],
+    Pass("denoising_store_passes", "Denoising Specular Albedo", "Denoising Specular Albedo", "RGB", "COLOR", None),
+    _DENOISING_DATA_3[0],
+    Pass("denoising_store_passes", "Denoising Roughness", "Denoising Roughness", "X", "VALUE", None),
+    _DENOISING_DATA_3[2],
+)
+
+
+def denoising_data(view_layer) -> tuple[Pass, ...]:
+    """The Denoising Data passes when the View Layer stores them (after every other pass, as Cycles lists them)."""
+    settings = getattr(view_layer, "toyrt", None)
+    if settings is None or not settings.denoising_store_passes:
+        return ()
+    return _DENOISING_DATA_5_1 if bpy.app.version >= (5, 1, 0) else _DENOISING_DATA_3
+
+
 def enabled(view_layer) -> list[Pass]:
     """The passes the View Layer turns on, in Cycles' order (Combined is always there)."""
-    return [p for p in PASSES if getattr(view_layer, p.prop, False)]
+    return [p for p in PASSES if getattr(view_layer, p.prop, False)] + list(denoising_data(view_layer))
 
 
 def register(engine, scene, view_layer) -> None:

@@ -29,19 +29,58 @@ class ToyrtPanel:
         return context.engine in cls.COMPAT_ENGINES
 
 
-class RENDER_PT_toyrt(ToyrtPanel, bpy.types.Panel):
-    bl_label = "TOYRT"
+class ToyrtRenderPanel(ToyrtPanel):
+    """A panel of the Render tab, laid out as Cycles lays out its own: labels in the left column
+    (use_property_split), no animation dots."""
     bl_context = "render"
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        settings = context.scene.toyrt
+        self.layout.use_property_split = True
+        self.layout.use_property_decorate = False
+        self.draw_settings(self.layout, context.scene.toyrt)
+
+
+# TOYRT's settings grouped as Cycles groups its own (Sampling > Viewport / Render / Lights / Advanced,
+# each Denoise under its sampling panel; Light Paths; Performance), with labels short enough for the
+# Properties editor of Blender's default layout: each label is a short name here, the long one is
+# its tooltip (tests/blender/test_ui_layout.py measures each label in Blender's real window).
+class RENDER_PT_toyrt_sampling(ToyrtRenderPanel, bpy.types.Panel):
+    bl_label = "Sampling"
+
+    def draw_settings(self, layout, settings):
         # A native module that did not load (wrong Python, missing file) is said here, not only in
         # the console, where a user who installed from the UI would never look.
         problem = sys.modules[__package__].load_error
-        for i, line in enumerate(textwrap.wrap(problem, 70)):
+        for i, line in enumerate(textwrap.wrap(problem, 50)):
             layout.label(text=line, icon="ERROR" if i == 0 else "BLANK1")
+
+
+class RENDER_PT_toyrt_sampling_viewport(ToyrtRenderPanel, bpy.types.Panel):
+    bl_label = "Viewport"
+    bl_parent_id = "RENDER_PT_toyrt_sampling"
+
+    def draw_settings(self, layout, settings):
+        layout.prop(settings, "viewport_samples", text="Max Samples")
+
+
+class RENDER_PT_toyrt_sampling_viewport_denoise(ToyrtRenderPanel, bpy.types.Panel):
+    bl_label = "Denoise"
+    bl_parent_id = "RENDER_PT_toyrt_sampling_viewport"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.toyrt, "use_preview_denoising", text="")
+
+    def draw_settings(self, layout, settings):
+        layout.active = settings.use_preview_denoising
+        layout.label(text="Open Image Denoise, after each pass")
+
+
+class RENDER_PT_toyrt_sampling_render(ToyrtRenderPanel, bpy.types.Panel):
+    bl_label = "Render"
+    bl_parent_id = "RENDER_PT_toyrt_sampling"
+
+    def draw_settings(self, layout, settings):
         row = layout.row(heading="Noise Threshold")
         row.prop(settings, "use_adaptive_sampling", text="")
         sub = row.row()
@@ -50,16 +89,78 @@ class RENDER_PT_toyrt(ToyrtPanel, bpy.types.Panel):
         layout.prop(settings, "samples", text="Max Samples" if settings.use_adaptive_sampling else "Samples")
         col = layout.column()
         col.active = settings.use_adaptive_sampling
-        col.prop(settings, "adaptive_min_samples")
-        layout.prop(settings, "time_limit")
-        layout.prop(settings, "viewport_samples")
-        layout.prop(settings, "area_light_sampling")
-        layout.prop(settings, "light_sampling")
-        layout.prop(settings, "builder")
-        layout.prop(settings, "max_specular_depth")
-        layout.prop(settings, "seed")
-        layout.prop(settings, "use_denoising")
-        layout.label(text=f"Threads: {context.scene.render.threads} (Performance settings)")
+        col.prop(settings, "adaptive_min_samples", text="Min Samples")
+        layout.prop(settings, "time_limit", text="Time Limit")
+
+
+class RENDER_PT_toyrt_sampling_render_denoise(ToyrtRenderPanel, bpy.types.Panel):
+    bl_label = "Denoise"
+    bl_parent_id = "RENDER_PT_toyrt_sampling_render"
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.toyrt, "use_denoising", text="")
+
+    def draw_settings(self, layout, settings):
+        layout.active = settings.use_denoising
+        layout.label(text="Open Image Denoise, albedo and normal")
+
+
+class RENDER_PT_toyrt_sampling_lights(ToyrtRenderPanel, bpy.types.Panel):
+    bl_label = "Lights"
+    bl_parent_id = "RENDER_PT_toyrt_sampling"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw_settings(self, layout, settings):
+        layout.prop(settings, "light_sampling", text="Sampling")
+        layout.prop(settings, "area_light_sampling", text="Area Lights")
+
+
+class RENDER_PT_toyrt_sampling_advanced(ToyrtRenderPanel, bpy.types.Panel):
+    bl_label = "Advanced"
+    bl_parent_id = "RENDER_PT_toyrt_sampling"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw_settings(self, layout, settings):
+        layout.prop(settings, "seed", text="Seed")
+
+
+class RENDER_PT_toyrt_light_paths(ToyrtRenderPanel, bpy.types.Panel):
+    """TOYRT's light transport: direct light at every vertex, paths only through glossy and
+    specular lobes, so the one bounce limit Cycles splits by kind is the specular one here."""
+    bl_label = "Light Paths"
+
+    def draw_settings(self, layout, settings):
+        pass
+
+
+class RENDER_PT_toyrt_light_paths_max_bounces(ToyrtRenderPanel, bpy.types.Panel):
+    bl_label = "Max Bounces"
+    bl_parent_id = "RENDER_PT_toyrt_light_paths"
+
+    def draw_settings(self, layout, settings):
+        layout.prop(settings, "max_specular_depth", text="Specular")
+
+
+class RENDER_PT_toyrt_performance(ToyrtRenderPanel, bpy.types.Panel):
+    bl_label = "Performance"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw_settings(self, layout, settings):
+        render = bpy.context.scene.render
+        col = layout.column()
+        col.prop(render, "threads_mode")
+        sub = col.column()
+        sub.enabled = render.threads_mode == "FIXED"
+        sub.prop(render, "threads")
+        layout.prop(settings, "builder", text="BVH Builder")
+
+
+RENDER_PANELS = (
+    RENDER_PT_toyrt_sampling, RENDER_PT_toyrt_sampling_viewport, RENDER_PT_toyrt_sampling_viewport_denoise,
+    RENDER_PT_toyrt_sampling_render, RENDER_PT_toyrt_sampling_render_denoise, RENDER_PT_toyrt_sampling_lights,
+    RENDER_PT_toyrt_sampling_advanced, RENDER_PT_toyrt_light_paths, RENDER_PT_toyrt_light_paths_max_bounces,
+    RENDER_PT_toyrt_performance,
+)
 
 
 class VIEWLAYER_PT_toyrt_passes(ToyrtPanel, bpy.types.Panel):
@@ -112,7 +213,8 @@ def _panels():
 
 
 def register() -> None:
-    bpy.utils.register_class(RENDER_PT_toyrt)
+    for cls in RENDER_PANELS:
+        bpy.utils.register_class(cls)
     bpy.utils.register_class(VIEWLAYER_PT_toyrt_passes)
     bpy.utils.register_class(VIEWLAYER_PT_toyrt_passes_cryptomatte)
     for panel in _panels():
@@ -124,4 +226,5 @@ def unregister() -> None:
         panel.COMPAT_ENGINES.discard("TOYRT")
     bpy.utils.unregister_class(VIEWLAYER_PT_toyrt_passes_cryptomatte)
     bpy.utils.unregister_class(VIEWLAYER_PT_toyrt_passes)
-    bpy.utils.unregister_class(RENDER_PT_toyrt)
+    for cls in reversed(RENDER_PANELS):
+        bpy.utils.unregister_class(cls)

@@ -8,7 +8,8 @@
                           display-space shader (colour management applies)
     render thread      -> a coarse pass (1 sample at 1/4 resolution), then passes of 1, 1, 2, 4,
                           ... 16 samples of the one Sobol-Owen sequence (render(first_sample=...)),
-                          accumulated up to scene.toyrt.viewport_samples; then it ends: no CPU
+                          accumulated up to scene.toyrt.viewport_samples (each shown denoised
+                          with Viewport Denoise on: denoise.py); then it ends: no CPU
                           used until the next change. The native render releases the GIL and
                           polls a stop flag every 10 ms, so a restart waits a few ms at most.
 
@@ -86,6 +87,7 @@ class ViewportSession:
         self.error = None           # why the last render thread stopped early, shown in the view's header
         self._notes_shown = set()   # the fallback notes this session reported (report.commit_notes)
         self.first_pass_ms = None   # time from a restart to its first image (the coarse pass)
+        self.denoised_passes = 0    # passes shown denoised (Viewport Denoise)
         _sessions.add(self)
 
     # ---- on Blender's main thread -----------------------------------------------------------------
@@ -95,11 +97,8 @@ class ViewportSession:
         self.cache.sync(depsgraph, None if first else depsgraph.updates)
         scene = depsgraph.scene
         s = scene.toyrt
-        threads = 0 if scene.render.threads_mode == "AUTO" else scene.render.threads
-        self._settings = dict(samples=int(s.viewport_samples), seed=int(s.seed),
-                              max_specular_depth=int(s.max_specular_depth),
-                              area_light_sampling=s.area_light_sampling, light_sampling=s.light_sampling,
-                              threads=threads)
+        self._settings = self._render_settings(scene)
+        threads = self._settings["threads"]
         region = context.region
         rays = float(region.width * region.height * s.viewport_samples * (2 + self.cache.stats.get("lights", 0)))
         # The cost model picks the builder: interactive work (few rays) favours the fast LBVH builds,
@@ -108,6 +107,28 @@ class ViewportSession:
             engine = self._engine()
             report.commit_notes(self.cache.scene, engine.report if engine is not None else None, self._notes_shown)
         self._stale = True
+
+    def _render_settings(self, scene) -> dict:
+        """What the render thread renders with, from TOYRT's settings and Blender's threads."""
+        s = scene.toyrt
+        threads = 0 if scene.render.threads_mode == "AUTO" else scene.render.threads
+        return dict(samples=int(s.viewport_samples), seed=int(s.seed), max_specular_depth=int(s.max_specular_depth),
+                    area_light_sampling=s.area_light_sampling, light_sampling=s.light_sampling, threads=threads,
+                    denoise=self._denoising(s))
+
+    def _denoising(self, settings) -> bool:
+        """Viewport Denoise (scene.toyrt.use_preview_denoising, Cycles' name) when the denoiser loads;
+        when it does not, the one note, once per session, and the image undenoised."""
+        from . import denoise
+
+        if not settings.use_preview_denoising:
+            return False
+        why = denoise.available()
+        if why is not None and why not in self._notes_shown:
+            self._notes_shown.add(why)
+            engine = self._engine()
+            report.note(why, engine.report if engine is not None else None)
+        return why is None
 
     def draw(self, context, depsgraph) -> None:
         import gpu
@@ -118,6 +139,11 @@ class ViewportSession:
             return
         camera = view_camera(context.region, context.region_data)
         key = _view_key(camera)
+        # A change of TOYRT's settings alone (samples, seed, Viewport Denoise...) brings no
+        # view_update: it is seen here, as the view is.
+        settings = self._render_settings(depsgraph.scene)
+        if settings != self._settings:
+            self._settings, self._stale = settings, True
         if self._stale or key != self._view:
             self._restart(camera, key)
         if self.error is not None:
@@ -178,8 +204,11 @@ class ViewportSession:
     def _run(self, camera, settings, stop, started):
         import time
 
+        from . import denoise
+
         scene = self.cache.scene
         target = settings.pop("samples")
+        denoising = settings.pop("denoise")
         version = 0
         try:
             w, h = camera["resolution_x"], camera["resolution_y"]
@@ -191,18 +220,28 @@ class ViewportSession:
             version += 1
             self._publish(version, image, 0)
             total, done, count = None, 0, 1
+            aux = {}
             while done < target and not stop.is_set():
                 count = min(count, target - done)
-                image = scene.render(camera, samples=count, first_sample=done, should_cancel=stop.is_set, **settings)
+                image = scene.render(camera, samples=count, first_sample=done, should_cancel=stop.is_set,
+                                     passes=list(denoise.AUXILIARIES) if denoising else None, **settings)
                 if scene.last_render["cancelled"]:
                     return
                 image *= count
                 total = image if total is None else total + image
+                if denoising:
+                    # The albedo and normal of every sample so far, weighted as the image is.
+                    for name in denoise.AUXILIARIES:
+                        aux[name] = aux.get(name, 0.0) + scene.last_passes[name] * count
                 done += count
                 version += 1
                 self.samples_done = done
                 self.passes += 1
-                self._publish(version, total / done, done)
+                mean = total / done
+                if denoising:
+                    mean = denoise.denoise(mean, {name: value / done for name, value in aux.items()})
+                    self.denoised_passes += 1
+                self._publish(version, mean, done)
                 count = min(count * 2, MAX_PASS_SAMPLES)
         except Exception as err:  # shown by draw() in the view's header; the thread ends either way
             self.error = str(err)

@@ -246,6 +246,38 @@ def denoising_lowers_the_error_or_says_why_not():
     check(not any("denoising skipped" in ln for ln in printed.splitlines()), "no note when the denoiser runs")
 
 
+def denoising_data_passes_hold_what_the_denoiser_reads():
+    """view_layer.toyrt.denoising_store_passes (Cycles' view_layer.cycles.denoising_store_passes)
+    adds Cycles' Denoising Data passes under its names on the running Blender: the albedo is the
+    Diffuse Color clipped to [0, 1], the normal the Normal pass, the depth the Depth pass; what
+    TOYRT does not produce (5.1+: specular albedo, roughness) is black with the one note."""
+    build_scene()
+    layer = bpy.context.view_layer
+    layer.toyrt.denoising_store_passes = True
+    try:
+        p, result, printed = render("TOYRT", 4, "_denoising_data")
+    finally:
+        layer.toyrt.denoising_store_passes = False
+    new_list = bpy.app.version >= (5, 1, 0)
+    expected = (["Denoising Albedo", "Denoising Specular Albedo", "Denoising Normal", "Denoising Roughness",
+                 "Denoising Depth"] if new_list else ["Denoising Normal", "Denoising Albedo", "Denoising Depth"])
+    check(result == {"FINISHED"} and all(n in p for n in expected),
+          f"Cycles' Denoising Data passes are written ({sorted(n for n in p if n.startswith('Denoising'))})")
+    check(np.array_equal(p["Denoising Normal"], p["Normal"]), "Denoising Normal is the Normal pass")
+    check(np.array_equal(p["Denoising Depth"][..., 0], p["Depth"][..., 0]), "Denoising Depth is the Depth pass")
+    check(np.array_equal(p["Denoising Albedo"], np.clip(p[NAMES["diffuse"]], 0.0, 1.0)),
+          "Denoising Albedo is the Diffuse Color within [0, 1]")
+    # The floor's albedo is its colour where it is seen (its pass index is 2).
+    floor = interior(p[NAMES["object"]]) & (p[NAMES["object"]][..., 0] == 2)
+    check(np.allclose(p["Denoising Albedo"][floor], COLOURS["floor"], atol=1e-6),
+          "the floor's albedo is its material colour")
+    if new_list:
+        black = [n for n in ("Denoising Specular Albedo", "Denoising Roughness") if np.any(p[n])]
+        check(not black, f"the passes TOYRT does not produce are black ({black})")
+        check("Denoising Roughness" in printed, "and named in the note")
+
+
 run_script([passes_are_switched_where_blender_users_look, toyrt_passes_against_closed_forms,
             toyrt_passes_equal_cycles, each_view_layer_gets_its_own_passes,
-            denoising_lowers_the_error_or_says_why_not], "passes", TMP)
+            denoising_lowers_the_error_or_says_why_not, denoising_data_passes_hold_what_the_denoiser_reads],
+           "passes", TMP)

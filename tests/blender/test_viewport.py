@@ -15,7 +15,9 @@ the progressive render, screenshot the area and measure; the outer part checks t
 4. Rendered mode and the render engine toggled 50 times: no viewport session or render thread is
    left, the OS thread count and the memory do not grow from toggle 10 to toggle 50;
 5. a file is opened while a viewport render is running: the session and its thread are gone;
-6. Blender quits while a viewport render is running (the process exits 0).
+6. Blender quits while a viewport render is running (the process exits 0);
+7. Viewport Denoise (scene.toyrt.use_preview_denoising) shows each pass denoised: the noise of a
+   patch of wall drops to under half.
 """
 import json
 import os
@@ -74,6 +76,12 @@ def check(r):
     assert m["meshes_exported"] == 1 and m["mesh_bvhs_built"] == 1, m
     mat = r["material_edit"]
     assert mat["materials_converted"] == 1 and mat["meshes_exported"] == 0 and mat["mesh_bvhs_built"] == 0, mat
+
+    # Viewport Denoise: every pass after the coarse one shown denoised (the vendored pyoidn on Debian's
+    # Blender, scripts/vendor-pyoidn.py), the wall's noise well down.
+    d = r["denoise"]
+    assert d["error"] is None and d["denoised_passes"] >= 3, d
+    assert d["denoised"] < 0.5 * d["plain"], d
 
     assert r["file_load"] == dict(sessions_left=0, viewport_threads_left=0), r["file_load"]
     tog = r["toggles"]
@@ -162,7 +170,10 @@ def inner(result_path):
             if cond():
                 return True
             if time.perf_counter() > state["deadline"]:
-                raise RuntimeError(f"waited 120 s for: {label}")
+                s = session()
+                seen = s and dict(restarts=s.restarts, samples_done=s.samples_done, rendering=s.rendering,
+                                  error=s.error, denoised_passes=s.denoised_passes)
+                raise RuntimeError(f"waited 120 s for: {label} (session: {seen}, restarts before: {state['restarts']})")
             return False
         step.label = label
         return step
@@ -218,6 +229,28 @@ def inner(result_path):
 
     def edit_material():
         bpy.data.materials["red"].node_tree.nodes["Diffuse BSDF"].inputs["Color"].default_value = (0.9, 0.1, 0.1, 1)
+
+    def wall_noise():
+        """Pixel noise of the newest viewport image on a 15 x 15 patch of the red wall: the standard
+        deviation of each pixel's difference from the mean of its 8 neighbours (what the lighting's
+        smooth gradient leaves out), in the red channel."""
+        window, area, region = view3d()
+        xy = location_3d_to_region_2d(region, area.spaces[0].region_3d, (-0.999, 0.3, 1.2))
+        image = session()._latest[1][..., 0]
+        row, col = image.shape[0] - 1 - int(xy.y), int(xy.x)
+        patch = image[row - 8:row + 9, col - 8:col + 9]
+        around = sum(np.roll(np.roll(patch, dy, 0), dx, 1) for dy in (-1, 0, 1) for dx in (-1, 0, 1)) - patch
+        return float((patch - around / 8.0)[1:-1, 1:-1].std())
+
+    def noise_plain():
+        out["denoise"] = dict(plain=wall_noise())
+        state["restarts"] = session().restarts
+        scene.toyrt.use_preview_denoising = True
+
+    def noise_denoised():
+        s = session()
+        out["denoise"].update(denoised=wall_noise(), denoised_passes=s.denoised_passes, error=s.error)
+        scene.toyrt.use_preview_denoising = False
 
     toggles = {"n": 0}
 
@@ -286,6 +319,7 @@ def inner(result_path):
               do(tr_before), do(edit_transform), wait_for(restarted, "render after a transform edit"), do(tr_after),
               do(me_before), do(edit_mesh), wait_for(restarted, "render after a mesh edit"), do(me_after),
               do(ma_before), do(edit_material), wait_for(restarted, "render after a material edit"), do(ma_after),
+              do(noise_plain), wait_for(restarted, "render with Viewport Denoise"), do(noise_denoised),
               do(measure_session), toggle_once, do(after_toggles),
               wait_for(lambda: not viewport._sessions, "sessions freed after leaving Rendered mode"),
               do(toggles_done),

@@ -34,7 +34,7 @@ import bpy  # noqa: I001  (Blender starts here, reading the variables above)
 import addon_utils
 
 sys.path[:0] = [str(HERE.parent / "blender"), str(HERE.parent.parent / "scenes")]
-from closed_form import build_scene, render_error
+from closed_form import build_scene, denoiser_lowers_noise, render_error
 from harness import captured_output, check, run_script
 
 EXT_MODULE = "bl_ext.user_default.render_toyrt"
@@ -73,6 +73,12 @@ def the_extension_installs_and_renders():
     build_scene()
     err = render_error(home / "extension.exr")
     check(err < 0.01, f"the render matches I cos / r^2 (max error {err:.4f} of the peak)")
+    # Blender installed the denoiser's wheels beside toyrt's (a venv's own pyoidn may come first on the path).
+    installed = sorted(p.parent.name for p in home.rglob("site-packages/*/__init__.py")
+                       if p.parent.name in ("pyoidn", "cffi", "pycparser"))
+    check(len(installed) == 3, f"pyoidn, cffi and pycparser are installed from the extension's wheels ({installed})")
+    ok, where, noise = denoiser_lowers_noise(EXT_MODULE)
+    check(ok, f"and Open Image Denoise denoises ({where}; noise {noise})")
 
 
 def the_farm_recipe_enables_it_with_addons():

@@ -69,7 +69,7 @@ def inside_blender():
     import bpy
 
     sys.path[:0] = [str(HERE.parent / "blender"), str(HERE.parent.parent / "scenes")]
-    from closed_form import build_scene, render_error
+    from closed_form import build_scene, denoiser_lowers_noise, render_error
     from harness import check, run_script
 
     zip_path, home = (Path(p) for p in sys.argv[sys.argv.index("--") + 1:][:2])
@@ -101,6 +101,9 @@ def inside_blender():
         err = render_error(home / "legacy.exr")
         check(err < 0.01, f"the render matches I cos / r^2 (max error {err:.4f} of the peak;"
               f" builder {bpy.context.scene.toyrt.builder})")
+        ok, where, noise = denoiser_lowers_noise("render_toyrt")
+        check(ok and "/render_toyrt/vendor/pyoidn/" in where,
+              f"the zip's Open Image Denoise loads from its vendor/ folder and denoises ({where}; noise {noise})")
 
     run_script([the_legacy_zip_installs_and_renders], f"legacy add-on (Blender {bpy.app.version_string})")
 
