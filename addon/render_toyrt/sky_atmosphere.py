@@ -4,8 +4,8 @@ types: single scattering of sunlight in a spherical atmosphere of air (Rayleigh)
 precomputation (its spectral tables are not used), so its result differs (docs/lights.md).
 
   - Earth radius 6360 km, atmosphere top 6420 km, the viewer at the node's altitude;
-  - air: scale height 8 km, scattering from the refractive index (Edlen's dispersion of standard
-    air) by beta = 8 pi^3 (n^2 - 1)^2 / (3 N lambda^4) x the King factor 1.048, phase
+  - air: scale height 8 km, scattering from the refractive index (Edlen's dispersion, at 0 C
+    and 101325 Pa) by beta = 8 pi^3 (n^2 - 1)^2 / (3 N lambda^4) x the King factor 1.048, phase
     3 (1 + mu^2) / (16 pi);
   - aerosols: scale height 1.2 km, scattering 2e-5 / m (extinction 1.11 x), the Cornette-Shanks
     phase with g = 0.76;
@@ -15,14 +15,18 @@ precomputation (its spectral tables are not used), so its result differs (docs/l
   - XYZ by the CIE 1931 matching functions in Wyman, Sloan and Shirley's multi-lobe Gaussian fit
     (JCGT 2013), 380-780 nm in 20 nm steps, then linear Rec.709 (sky.XYZ_TO_REC709).
 
-The node's densities scale air, aerosols and ozone. Single scattering factors into
-P_air(mu) R(view) + P_aerosol(mu) M(view), mu the cosine to the sun, R and M smooth in the view's
-elevation and azimuth from the sun: they are tabulated on a grid (denser towards the horizon) and
-interpolated, the phase functions evaluated exactly per texel. Below the horizon the horizon's sky
-fades to black by (1 + 2.5 z)^3 (z > -0.4), as Blender's Nishita does. The sun disc (sun_disc):
-the sun's transmitted radiance x sun_intensity over the disc, limb darkening's mean 0.8 kept as
-energy; a disc narrower than two texels goes into the texels around its centre (bilinear weights)
-with the same power, so it lights the scene right but looks like a blurred dot."""
+The view ray is cut into 32 segments evaluated at their middles, each attenuated by the column up
+to its far end (Blender's discretisation: near the horizon, where a segment is tens of kilometres
+of dense air, it sets the colour, and the exact integral would be bluer than Cycles' sky); the
+column towards the sun by a 12-point rule. The node's densities scale air, aerosols and ozone.
+Single scattering factors into P_air(mu) R(view) + P_aerosol(mu) M(view), mu the cosine to the
+sun, R and M smooth in the view's elevation and azimuth from the sun: they are tabulated on a grid
+(denser towards the horizon) and interpolated, the phase functions evaluated exactly per texel.
+Below the horizon the horizon's sky fades to black by (1 + 2.5 z)^3 (z > -0.4), as Blender's
+Nishita does. The sun disc (sun_disc): the sun's transmitted radiance x sun_intensity over the
+disc, limb darkening's mean 0.8 kept as energy; a disc narrower than two texels goes into the
+texels around its centre (bilinear weights) with the same power, so it lights the scene right but
+looks like a blurred dot."""
 from __future__ import annotations
 
 import math
@@ -40,8 +44,9 @@ STEP = 20.0
 
 def _air_scattering(lam_nm):
     sigma2 = (1e3 / lam_nm) ** 2                          # (1 / micrometres)^2
-    n1 = 1e-8 * (8342.13 + 2406030.0 / (130.0 - sigma2) + 15997.0 / (38.9 - sigma2))   # Edlen 1966
-    number = 2.547e25                                     # molecules / m^3, 15 C, 101325 Pa
+    n1 = 1e-8 * (8342.13 + 2406030.0 / (130.0 - sigma2) + 15997.0 / (38.9 - sigma2))   # Edlen 1966, 15 C
+    n1 *= 288.15 / 273.15                                 # n - 1 grows with the density: air at 0 C
+    number = 2.687e25                                     # molecules / m^3 at 0 C, 101325 Pa
     lam = lam_nm * 1e-9
     return 8 * math.pi ** 3 * ((1 + n1) ** 2 - 1) ** 2 / (3 * number * lam ** 4) * 1.048
 
@@ -104,7 +109,7 @@ def _xyz(spectrum):
     return spectrum @ CMF * STEP
 
 
-def scattering_tables(sun, altitude, scale, n_elevation=64, n_azimuth=33, steps=24):
+def scattering_tables(sun, altitude, scale, n_elevation=64, n_azimuth=33, steps=32):
     """XYZ of the air's and the aerosols' single scattering without their phase functions, on a
     grid of view elevations (0 .. pi/2, as (k / (n - 1))^2) x azimuths from the sun (0 .. pi):
     two (n_elevation, n_azimuth, 3) arrays."""
@@ -118,8 +123,8 @@ def scattering_tables(sun, altitude, scale, n_elevation=64, n_azimuth=33, steps=
     s = (np.arange(steps) + 0.5)[None, None, :] * ds[..., None]
     p = origin + s[..., None] * view[..., None, :]                  # (E, A, steps, 3)
     dens = _densities(np.linalg.norm(p, axis=-1) - EARTH, scale)
-    # Column densities from the viewer to each sample: the samples before it and half its own.
-    to_viewer = [np.cumsum(d, -1) * ds[..., None] - 0.5 * d * ds[..., None] for d in dens]
+    # Column densities from the viewer through each sample's segment (see the module docstring).
+    to_viewer = [np.cumsum(d, -1) * ds[..., None] for d in dens]
     sun_dir = np.broadcast_to(np.asarray(sun, float), p.shape)
     to_sun = _optical_depths(p, sun_dir, scale)
     # The Earth's shadow: the sun below a sample's horizon (its ray meets the ground).
@@ -142,8 +147,9 @@ def phase_aerosol(mu):
 
 
 def sun_direction(elevation, rotation):
-    """Blender's sun_elevation / sun_rotation as a unit vector (rotation 0: towards +Y)."""
-    return np.array([-math.cos(elevation) * math.sin(rotation), math.cos(elevation) * math.cos(rotation),
+    """Blender's sun_elevation / sun_rotation as a unit vector: rotation 0 towards +Y, turning
+    towards +X (clockwise seen from above), as Cycles places it."""
+    return np.array([math.cos(elevation) * math.sin(rotation), math.cos(elevation) * math.cos(rotation),
                      math.sin(elevation)])
 
 
