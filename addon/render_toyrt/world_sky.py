@@ -22,6 +22,12 @@ MAP_WIDTH, MAP_HEIGHT = 1024, 512
 # Blender's identifiers, per version: 3.4-4.x PREETHAM, HOSEK_WILKIE, NISHITA; 5.0 PREETHAM,
 # HOSEK_WILKIE, SINGLE_SCATTERING, MULTIPLE_SCATTERING.
 ANALYTIC = ("PREETHAM", "HOSEK_WILKIE")
+# Hosek-Wilkie is drawn as Preetham at this brightness: Cycles' Hosek-Wilkie sky (its fitted
+# dataset, in its own units) is 0.10-0.23 x its Preetham sky's mean luminance above the horizon
+# for turbidity 2-8 and the sun 10-60 degrees up, 0.16 the geometric mean (measured from Cycles
+# 3.4 renders of both; docs/lights.md). The distribution still differs (Hosek-Wilkie's brighter
+# circumsolar region): 20-60 % mean difference after scaling.
+HOSEK_AS_PREETHAM = 0.16
 ATMOSPHERE = ("NISHITA", "SINGLE_SCATTERING", "MULTIPLE_SCATTERING")
 
 
@@ -45,6 +51,8 @@ def sky_map(settings: tuple) -> np.ndarray:
     if kind in ANALYTIC:
         radiance = sky.Preetham.make(settings[1], settings[2]).radiance
         pixels = sky.bake(radiance, MAP_WIDTH, MAP_HEIGHT)
+        if kind == "HOSEK_WILKIE":
+            pixels *= np.float32(HOSEK_AS_PREETHAM)
     else:
         from .sky_atmosphere import atmosphere_map
 
@@ -56,7 +64,8 @@ def sky_map(settings: tuple) -> np.ndarray:
 def sky_notes(name: str, settings: tuple) -> list[str]:
     kind = settings[0]
     if kind == "HOSEK_WILKIE":
-        return [f"world '{name}': Sky Texture Hosek-Wilkie drawn as Preetham (same sun and turbidity)"]
+        return [f"world '{name}': Sky Texture Hosek-Wilkie drawn as Preetham (same sun and turbidity, "
+                f"x {HOSEK_AS_PREETHAM} for Cycles' brightness)"]
     if kind in ATMOSPHERE:
         return [f"world '{name}': Sky Texture {kind.replace('_', ' ').title()} drawn by TOYRT's own "
                 "single-scattering atmosphere (Rayleigh + Mie; not Blender's precomputed sky)"]

@@ -5,7 +5,8 @@
 #   Preetham          the camera looking up sees the model's value x the Background
 #                     strength; a floor under it gets albedo / pi x the model's irradiance (the
 #                     model integrated over the hemisphere here, independently of the baked map)
-#   Hosek-Wilkie      drawn as Preetham with the same sun and turbidity, with one note
+#   Hosek-Wilkie      drawn as Preetham with the same sun and turbidity (x a measured brightness
+#                     factor), with one note
 #   an edit           the viewport's sync sends the new map into the world's one texture
 #   the atmosphere    Nishita (3.4-4.x), Single / Multiple Scattering (5.0): a blue sky, a sunlit
 #   types             floor brighter than the sky alone lights it, finite pixels, one note
@@ -100,10 +101,12 @@ def test_hosek_wilkie_is_drawn_as_preetham_with_one_note():
     kit.sky_world("HOSEK_WILKIE", **PREETHAM)
     notes = notes_of_export()
     result, px = render("hosek")
-    expected = model().radiance(UP)
+    from render_toyrt.world_sky import HOSEK_AS_PREETHAM
+    expected = HOSEK_AS_PREETHAM * model().radiance(UP)
     check(result == {"FINISHED"} and np.allclose(px.mean(0), expected, rtol=1e-3)
           and notes.count("Hosek-Wilkie drawn as Preetham") == 1,
-          f"Hosek-Wilkie: Preetham's zenith {np.round(px.mean(0), 4)} and one note ({notes.strip()!r})")
+          f"Hosek-Wilkie: Preetham's sky x {HOSEK_AS_PREETHAM} {np.round(px.mean(0), 4)} and one note "
+          f"({notes.strip()!r})")
 
 
 def test_an_edited_sky_is_sent_again_into_its_texture():
