@@ -1,7 +1,8 @@
-"""TOYRT's own sky for Blender's Nishita (2.90-4.x) and 5.0's Single / Multiple Scattering
-types: single scattering of sunlight in a spherical atmosphere of air (Rayleigh) and aerosols
-(Mie), with ozone absorption, integrated here from physical formulas and constants; not Blender's
-precomputation (its spectral tables are not used), so its result differs (docs/lights.md).
+"""TOYRT's own sky for Blender's Nishita (2.90-4.x) and 5.0's Single / Multiple Scattering types:
+single scattering (and, for Multiple Scattering, an approximation of the rest) of sunlight in a
+spherical atmosphere of air (Rayleigh) and aerosols (Mie), with ozone absorption, integrated here
+from physical formulas and constants; not Blender's precomputation (its spectral tables are not
+used), so its result differs (docs/lights.md).
 
   - Earth radius 6360 km, atmosphere top 6420 km, the viewer at the node's altitude;
   - air: scale height 8 km, scattering from the refractive index (Edlen's dispersion, at 0 C
@@ -26,7 +27,12 @@ Below the horizon the horizon's sky fades to black by (1 + 2.5 z)^3 (z > -0.4), 
 Nishita does. The sun disc (sun_disc): the sun's transmitted radiance x sun_intensity over the
 disc, limb darkening's mean 0.8 kept as energy; a disc narrower than two texels goes into the
 texels around its centre (bilinear weights) with the same power, so it lights the scene right but
-looks like a blurred dot."""
+looks like a blurred dot.
+
+For 5.0's Multiple Scattering (multiple=True) light scattered more than once is added
+(sky_multiple.py), the rays below the horizon end at the ground (the air between the viewer and
+the ground, no fade), and each segment is attenuated to its middle: the sky Cycles precomputes for
+this type has the horizon of the exact integral."""
 from __future__ import annotations
 
 import math
@@ -76,6 +82,7 @@ SUN_E, CMF = _solar_irradiance(LAMBDA), _cmf(LAMBDA)
 
 
 def _densities(height, scale):
+    height = np.maximum(height, 0.0)   # points inside the Earth (rays towards a set sun) are unlit anyway
     ozone = np.clip(np.where(height < 25e3, (height - 10e3) / 15e3, (40e3 - height) / 15e3), 0.0, None)
     return np.exp(-height / AIR_H) * scale[0], np.exp(-height / AEROSOL_H) * scale[1], ozone * scale[2]
 
@@ -109,22 +116,29 @@ def _xyz(spectrum):
     return spectrum @ CMF * STEP
 
 
-def scattering_tables(sun, altitude, scale, n_elevation=64, n_azimuth=33, steps=32):
+def scattering_tables(sun, altitude, scale, n_elevation=64, n_azimuth=33, steps=32, multiple=None):
     """XYZ of the air's and the aerosols' single scattering without their phase functions, on a
     grid of view elevations (0 .. pi/2, as (k / (n - 1))^2) x azimuths from the sun (0 .. pi):
-    two (n_elevation, n_azimuth, 3) arrays."""
+    two (n_elevation, n_azimuth, 3) arrays; with `multiple` (sky_multiple's table) a third, the
+    light scattered more than once (isotropic: no phase function to apply)."""
     el = (math.pi / 2) * (np.arange(n_elevation) / (n_elevation - 1)) ** 2
+    if multiple is not None:   # also below the horizon: -el .. el, (2 n_elevation - 1) rows
+        el = np.concatenate([-el[:0:-1], el])
     az = np.linspace(0.0, math.pi, n_azimuth) + math.atan2(sun[1], sun[0])
     e, a = np.meshgrid(el, az, indexing="ij")
     view = np.stack([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)], -1)
     origin = np.array([0.0, 0.0, EARTH + altitude])
-    length = _to_top(origin, view)
+    # A ray ends at the top of the atmosphere, or at the ground below the horizon.
+    b = view @ origin
+    disc = b * b - (origin @ origin - EARTH * EARTH)
+    length = np.where((disc > 0) & (b < 0), -b - np.sqrt(np.maximum(disc, 0.0)), _to_top(origin, view))
     ds = length / steps
     s = (np.arange(steps) + 0.5)[None, None, :] * ds[..., None]
     p = origin + s[..., None] * view[..., None, :]                  # (E, A, steps, 3)
     dens = _densities(np.linalg.norm(p, axis=-1) - EARTH, scale)
     # Column densities from the viewer through each sample's segment (see the module docstring).
-    to_viewer = [np.cumsum(d, -1) * ds[..., None] for d in dens]
+    to_viewer = [np.cumsum(d, -1) * ds[..., None] - (0.0 if multiple is None else 0.5) * d * ds[..., None]
+                 for d in dens]
     sun_dir = np.broadcast_to(np.asarray(sun, float), p.shape)
     to_sun = _optical_depths(p, sun_dir, scale)
     # The Earth's shadow: the sun below a sample's horizon (its ray meets the ground).
@@ -134,7 +148,15 @@ def scattering_tables(sun, altitude, scale, n_elevation=64, n_azimuth=33, steps=
     weight = (t * SUN_E) * ds[..., None, None]                      # (E, A, steps, wavelengths)
     air = _xyz((weight * dens[0][..., None]).sum(2) * BETA_AIR)
     aerosol = _xyz((weight * dens[1][..., None]).sum(2) * AEROSOL_SCATTERING)
-    return air, aerosol
+    if multiple is None:
+        return air, aerosol
+    from .sky_multiple import lookup
+
+    r = np.linalg.norm(p, axis=-1)
+    psi = lookup(multiple, r - EARTH, (p * sun_dir).sum(-1) / r)
+    sigma = dens[0][..., None] * BETA_AIR + dens[1][..., None] * AEROSOL_SCATTERING
+    view_t = _transmittance(*to_viewer)
+    return air, aerosol, _xyz((view_t * sigma * psi).sum(2) * ds[..., None])
 
 
 def phase_air(mu):
@@ -162,32 +184,46 @@ def sun_radiance(sun, altitude, scale) -> np.ndarray:
     return _xyz(_transmittance(*depths)[0] * SUN_E)
 
 
-def atmosphere_map(elevation, rotation, altitude, air, aerosol, ozone, disc, size, intensity, *, width, height):
-    """The (height, width, 3) float32 equirectangular map of the sky (module docstring)."""
+def atmosphere_map(elevation, rotation, altitude, air, aerosol, ozone, disc, size, intensity, *, width, height,
+                   multiple=False):
+    """The (height, width, 3) float32 equirectangular map of the sky (module docstring); with
+    `multiple`, light scattered more than once added (sky_multiple.py)."""
     sun = sun_direction(elevation, rotation)
     altitude = min(max(altitude, 0.0), 59e3)
     scale = (max(air, 0.0), max(aerosol, 0.0), max(ozone, 0.0))
-    air_t, aerosol_t = scattering_tables(sun, altitude, scale)
+    if multiple:
+        from .sky_multiple import multiple_scattering_table
+
+        air_t, aerosol_t, ms_t = scattering_tables(sun, altitude, scale, multiple=multiple_scattering_table(scale))
+    else:
+        air_t, aerosol_t = scattering_tables(sun, altitude, scale)
+        ms_t = np.zeros_like(air_t)
     d = texel_directions(width, height).astype(np.float32)
     # The tables' elevation index depends on the texel's row only and the azimuth index on its
-    # column only: interpolate along rows, then columns. Below the horizon: the horizon's row.
-    el = np.maximum(np.arcsin(np.clip(d[:, 0, 2], -1.0, 1.0)), 4e-4)
-    fi = np.sqrt(el / (math.pi / 2)) * (air_t.shape[0] - 1)
+    # column only: interpolate along rows, then columns. Below the horizon: the horizon's row
+    # (single scattering, faded below) or the rays to the ground (multiple).
+    el = np.arcsin(np.clip(d[:, 0, 2], -1.0, 1.0))
+    if multiple:
+        n = (air_t.shape[0] + 1) // 2
+        fi = (n - 1) * (1.0 + np.sign(el) * np.sqrt(np.abs(el) / (math.pi / 2)))
+    else:
+        fi = np.sqrt(np.maximum(el, 4e-4) / (math.pi / 2)) * (air_t.shape[0] - 1)
     i0 = np.clip(np.floor(fi).astype(int), 0, air_t.shape[0] - 2)
     ti = (fi - i0)[:, None, None]
-    tables = np.concatenate([air_t, aerosol_t], -1)
-    rows = (tables[i0] * (1 - ti) + tables[i0 + 1] * ti).astype(np.float32)   # (height, azimuths, 6)
+    tables = np.concatenate([air_t, aerosol_t, ms_t], -1)
+    rows = (tables[i0] * (1 - ti) + tables[i0 + 1] * ti).astype(np.float32)   # (height, azimuths, 9)
     azimuth = np.arctan2(d[0, :, 1], d[0, :, 0])
     rel = np.abs(np.angle(np.exp(1j * (azimuth - math.atan2(sun[1], sun[0])))))
     fj = rel / math.pi * (air_t.shape[1] - 1)
     j0 = np.clip(np.floor(fj).astype(int), 0, air_t.shape[1] - 2)
     tj = (fj - j0)[None, :, None].astype(np.float32)
-    xyz6 = rows[:, j0] * (1 - tj) + rows[:, j0 + 1] * tj                        # (height, width, 6)
+    xyz9 = rows[:, j0] * (1 - tj) + rows[:, j0 + 1] * tj                        # (height, width, 9)
     # Below the horizon the horizon's sky at the same azimuth, its phase functions included.
     horizontal = np.stack([np.cos(azimuth), np.sin(azimuth)], -1) @ np.asarray(sun[:2])
-    mu = np.where((d[..., 2] < math.sin(4e-4)), horizontal[None, :], d @ sun.astype(np.float32))
-    xyz = phase_air(mu)[..., None] * xyz6[..., :3] + phase_aerosol(mu)[..., None] * xyz6[..., 3:]
-    fade = np.where(d[..., 2] < 0.0, np.clip(1.0 + 2.5 * d[..., 2], 0.0, None) ** 3, 1.0)
+    below = (d[..., 2] < math.sin(4e-4)) & (not multiple)
+    mu = np.where(below, horizontal[None, :], d @ sun.astype(np.float32))
+    xyz = phase_air(mu)[..., None] * xyz9[..., :3] + phase_aerosol(mu)[..., None] * xyz9[..., 3:6] + xyz9[..., 6:]
+    fade = np.where((d[..., 2] < 0.0) & (not multiple), np.clip(1.0 + 2.5 * d[..., 2], 0.0, None) ** 3, 1.0)
     rgb = np.maximum(xyz @ XYZ_TO_REC709.T, 0.0) * fade[..., None]
     if disc and elevation > 0.0 and size > 0.0:
         _add_sun(rgb, d, sun, sun_radiance(sun, altitude, scale) @ XYZ_TO_REC709.T * intensity, size)

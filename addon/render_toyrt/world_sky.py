@@ -56,7 +56,8 @@ def sky_map(settings: tuple) -> np.ndarray:
     else:
         from .sky_atmosphere import atmosphere_map
 
-        pixels = atmosphere_map(*settings[1:], width=MAP_WIDTH, height=MAP_HEIGHT)
+        pixels = atmosphere_map(*settings[1:], width=MAP_WIDTH, height=MAP_HEIGHT,
+                                multiple=kind == "MULTIPLE_SCATTERING")
     pixels.setflags(write=False)
     return pixels
 
@@ -66,6 +67,9 @@ def sky_notes(name: str, settings: tuple) -> list[str]:
     if kind == "HOSEK_WILKIE":
         return [f"world '{name}': Sky Texture Hosek-Wilkie drawn as Preetham (same sun and turbidity, "
                 f"x {HOSEK_AS_PREETHAM} for Cycles' brightness)"]
+    if kind == "MULTIPLE_SCATTERING":
+        return [f"world '{name}': Sky Texture Multiple Scattering drawn by TOYRT's own atmosphere (single "
+                "scattering + Hillaire's multiple-scattering approximation; not Blender's precomputed sky)"]
     if kind in ATMOSPHERE:
         return [f"world '{name}': Sky Texture {kind.replace('_', ' ').title()} drawn by TOYRT's own "
                 "single-scattering atmosphere (Rayleigh + Mie; not Blender's precomputed sky)"]

@@ -152,7 +152,7 @@ def test_the_atmosphere_types_give_a_blue_sky_a_sunlit_floor_and_a_note():
         _, no_disc = render(f"{kind}_floor_no_disc")
         lit, sky_only = floor.mean(0), no_disc.mean(0)
         check(result == {"FINISHED"} and np.isfinite(floor).all() and zenith[2] > zenith[0] > 0
-              and lit[1] > 2.0 * sky_only[1] > 0 and notes.count("single-scattering atmosphere") == 1,
+              and lit[1] > 2.0 * sky_only[1] > 0 and notes.count("drawn by TOYRT's own") == 1,
               f"{kind}: zenith {np.round(zenith, 3)} (blue), floor {np.round(lit, 3)} with the sun's disc, "
               f"{np.round(sky_only, 3)} without; one note ({notes.strip()!r})")
 

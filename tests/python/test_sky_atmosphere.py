@@ -11,6 +11,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "addon"))
 from render_toyrt import sky  # noqa: E402
 from render_toyrt import sky_atmosphere as atm  # noqa: E402
+from render_toyrt import sky_multiple as multiple  # noqa: E402
 
 W, H = 256, 128
 
@@ -69,3 +70,30 @@ def test_below_the_horizon_the_horizons_sky_fades_to_black():
     for u in undone[1:]:
         np.testing.assert_allclose(u, undone[0], rtol=1e-4)
     assert undone[0].min() > 0 and not img[z < -0.4].any() and np.all(np.isfinite(img))
+
+
+def test_multiple_scattering_scales_with_the_density_and_the_ground():
+    # Psi (light arriving after two or more scatterings, per unit scattering coefficient): in a thin
+    # atmosphere over a black ground it is light scattered once on the way, so it doubles with the
+    # density; over a bright ground it is mostly the ground's reflection of the sun, which does not.
+    def psi(density, albedo):
+        return multiple.multiple_scattering_table((density, density, density), albedo)[0, 12]  # sea level, sun up
+    black = psi(2e-3, 0.0) / psi(1e-3, 0.0)
+    np.testing.assert_allclose(black, 2.0, rtol=0.01)
+    bright = psi(2e-3, 0.3) / psi(1e-3, 0.3)
+    assert np.all(np.abs(bright - 1.0) < 0.1)
+    assert np.all(multiple.multiple_scattering_table((1.0, 1.0, 1.0)) >= 0)
+
+
+def test_multiple_scattering_adds_light_bluer_than_single_scattering():
+    def maps(density):
+        args = (math.radians(30), 0.4, 100.0, density, density, density, False, 0.01, 1.0)
+        return [atm.atmosphere_map(*args, width=W, height=H, multiple=m) for m in (False, True)]
+    z = sky.texel_directions(W, H)[..., 2]
+    up = z > 0.05
+    single, more = maps(1.0)
+    assert np.all(more[up] >= single[up] * (1 - 1e-6))
+    gain = more[-1].mean(0) / single[-1].mean(0) - 1
+    assert np.all(gain > 0.3) and gain[2] > gain[0]
+    # The ground below the horizon: the air between the viewer (100 m up) and the ground.
+    assert np.all(np.isfinite(more)) and more[z < -0.05].mean() > 0
