@@ -225,7 +225,7 @@ def atmosphere_map(elevation, rotation, altitude, air, aerosol, ozone, disc, siz
     xyz = phase_air(mu)[..., None] * xyz9[..., :3] + phase_aerosol(mu)[..., None] * xyz9[..., 3:6] + xyz9[..., 6:]
     fade = np.where((d[..., 2] < 0.0) & (not multiple), np.clip(1.0 + 2.5 * d[..., 2], 0.0, None) ** 3, 1.0)
     rgb = np.maximum(xyz @ XYZ_TO_REC709.T, 0.0) * fade[..., None]
-    if disc and elevation > 0.0 and size > 0.0:
+    if disc and sun[2] > 0.0 and size > 0.0:   # (an elevation past 90 degrees turns the sun round, as in Cycles)
         _add_sun(rgb, d, sun, sun_radiance(sun, altitude, scale) @ XYZ_TO_REC709.T * intensity, size)
     return np.nan_to_num(rgb, nan=0.0, posinf=0.0, neginf=0.0).astype(np.float32)
 

@@ -50,6 +50,9 @@ def test_the_sun_rotation_turns_from_plus_y_towards_plus_x_as_in_cycles():
     np.testing.assert_allclose(atm.sun_direction(0.0, 0.0), [0, 1, 0], atol=1e-12)
     np.testing.assert_allclose(atm.sun_direction(0.0, math.pi / 2), [1, 0, 0], atol=1e-12)
     np.testing.assert_allclose(atm.sun_direction(math.pi / 2, 1.0), [0, 0, 1], atol=1e-12)
+    # Past the zenith the sun comes down on the other side (Cycles wraps the angles so).
+    np.testing.assert_allclose(atm.sun_direction(math.radians(120), 0.3),
+                               atm.sun_direction(math.radians(60), 0.3 + math.pi), atol=1e-12)
 
 
 def test_the_sky_is_symmetric_about_the_suns_vertical_and_blue_at_the_zenith():
