@@ -80,10 +80,14 @@ def sky_environment(name: str, node, strength: float, notes: list):
     """The world's Sky Texture `node` feeding a Background of `strength`, as an EnvironmentSpec."""
     from .world import EnvironmentSpec, mapping_matrix
 
-    settings = sky_settings(node)
-    if not all(math.isfinite(v) for v in _numbers(settings)):
+    kind = str(getattr(node, "sky_type", ""))
+    settings = sky_settings(node) if kind in ANALYTIC + ATMOSPHERE else ("BLACK", kind)
+    if settings[0] == "BLACK":
+        notes.append(f"world '{name}': Sky Texture type {kind} (black)")
+        pixels = np.zeros((1, 1, 3), np.float32)
+    elif not all(math.isfinite(v) for v in _numbers(settings)):
         notes.append(f"world '{name}': Sky Texture with non-finite settings (black)")
-        settings = ("PREETHAM", (0.0, 0.0, -1.0), 2.2)   # a sun below the horizon: black
+        settings = ("BLACK", "non-finite")
         pixels = np.zeros((1, 1, 3), np.float32)
     else:
         notes.extend(sky_notes(name, settings))

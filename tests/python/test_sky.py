@@ -136,7 +136,7 @@ def test_a_floor_under_the_baked_sky_gets_the_models_irradiance():
     np.testing.assert_allclose(out[..., :3].mean((0, 1)), irradiance / np.pi, rtol=0.01)
 
 
-def test_non_finite_settings_are_noted_and_black():
+def test_non_finite_settings_and_unknown_types_are_noted_and_black():
     class Node:
         sky_type, sun_direction, turbidity = "PREETHAM", (0.0, float("nan"), 1.0), 2.2
         inputs = {}
@@ -144,3 +144,7 @@ def test_non_finite_settings_are_noted_and_black():
     env = world_sky.sky_environment("w", Node(), 1.0, notes)
     assert notes == ["world 'w': Sky Texture with non-finite settings (black)"]
     assert np.all(np.isfinite(env.pixels)) and not env.pixels.any()
+    Node.sky_type = "A_FUTURE_SKY"
+    notes.clear()
+    env = world_sky.sky_environment("w", Node(), 1.0, notes)
+    assert notes == ["world 'w': Sky Texture type A_FUTURE_SKY (black)"] and not env.pixels.any()
