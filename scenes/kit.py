@@ -380,6 +380,26 @@ def environment_world(image, strength=1.0, rotation=(0.0, 0.0, 0.0)):
     return world
 
 
+def sky_world(sky_type, strength=1.0, **settings):
+    """The world as a Sky Texture of `sky_type` (Blender's identifiers: PREETHAM, HOSEK_WILKIE,
+    NISHITA; 5.0 SINGLE_SCATTERING, MULTIPLE_SCATTERING) into a Background of `strength`, with
+    the node's settings by their property names (sun_direction, turbidity, sun_elevation, ...)."""
+    world = bpy.data.worlds.new("sky")
+    world.use_nodes = True
+    nodes, links = world.node_tree.nodes, world.node_tree.links
+    background = nodes.get("Background") or nodes.new("ShaderNodeBackground")
+    background.inputs["Strength"].default_value = strength
+    texture = nodes.new("ShaderNodeTexSky")
+    texture.sky_type = sky_type
+    for key, value in settings.items():
+        setattr(texture, key, value)
+    links.new(texture.outputs["Color"], background.inputs["Color"])
+    output = nodes.get("World Output") or nodes.new("ShaderNodeOutputWorld")
+    links.new(background.outputs["Background"], output.inputs["Surface"])
+    bpy.context.scene.world = world
+    return world
+
+
 def world(color, lights_diffuse=True):
     """A constant background of linear RGB `color`, or none (black, lighting nothing) for None.
     lights_diffuse=False: seen by camera, glossy and transmission rays but lighting no diffuse

@@ -384,7 +384,7 @@ class SceneSync(MaterialSync):
         if spec.environment is not None:
             # Its notes (a missing image) again for every render, as a material's texture's are.
             env = spec.environment
-            tid = self._texture_id(env.texture, env.image) if not env.texture.placeholder else self._placeholder_id()
+            tid = self._environment_texture_id(env, self.world)
         if spec != self.world:
             self.scene.background = spec.background
             if spec.background_lighting is not None:

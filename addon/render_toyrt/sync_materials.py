@@ -53,6 +53,22 @@ class MaterialSync:
         self._note(self.texture_notes[key])
         return tid
 
+    def _environment_texture_id(self, env, sent_world) -> int:
+        """The texture id of a world's environment (world.EnvironmentSpec): its image's, or for a
+        map the add-on computed (a Sky Texture) one texture per world, whose pixels are sent again
+        when the settings they come from differ from the world sent before (`sent_world`)."""
+        if env.pixels is None:
+            return self._texture_id(env.texture, env.image) if not env.texture.placeholder else self._placeholder_id()
+        tid = self.textures.get(env.texture)
+        if tid is None:
+            tid = self.textures[env.texture] = self.scene.add_texture(env.pixels, srgb=False)
+            self.texture_notes[env.texture] = ()
+        else:
+            before = sent_world.environment if sent_world is not None else None
+            if before is None or before.texture != env.texture or before.computed_from != env.computed_from:
+                self.scene.set_texture(tid, env.pixels, srgb=False)
+        return tid
+
     def _placeholder_id(self) -> int:
         tid = self.textures.get(PLACEHOLDER)
         if tid is None:

@@ -1,5 +1,5 @@
-"""Blender's world -> WorldSpec: the background colour, or an Environment Texture, and whether
-the world lights diffuse surfaces.
+"""Blender's world -> WorldSpec: the background colour, or an Environment Texture or a Sky Texture
+(an environment map world_sky.py computes), and whether the world lights diffuse surfaces.
 
 Plain data only; sync.py sets toyrt.Scene.background / background_lighting / set_environment
 from it (the environment's image gets its texture id through the material sync's texture table)."""
@@ -18,6 +18,10 @@ class EnvironmentSpec:
     strength: tuple[float, float, float]           # the Background's strength x a constant colour factor
     matrix: tuple[tuple[float, ...], ...]          # world direction -> the map's frame, (3, 3) rows
     image: object = field(default=None, compare=False)
+    # A map the add-on computed (a Sky Texture's, world_sky.py): its (height, width, 3) float32
+    # pixels, and the settings it was computed from (compared: an edit sends the map again).
+    pixels: object = field(default=None, compare=False)
+    computed_from: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -32,8 +36,8 @@ class WorldSpec:
 def world_spec(bl_scene) -> WorldSpec:
     """The scene's world as the core's background: a plain colour (a Background node's colour
     times its strength, or the node-less world colour), or an Environment Texture feeding the
-    Background's colour (equirectangular, through an optional Mapping node); anything else is
-    black."""
+    Background's colour (equirectangular, through an optional Mapping node), or a Sky Texture
+    there (its model as such a map); anything else is black."""
     world = bl_scene.world
     if world is None:
         return WorldSpec((0.0, 0.0, 0.0), None)
@@ -52,9 +56,12 @@ def world_spec(bl_scene) -> WorldSpec:
             if not color.is_linked:
                 return WorldSpec(tuple(c * s for c in rgb(color.default_value)), lighting, visible_camera=camera)
             source = linked_node(color)
-            if source is not None and source.type == "TEX_ENVIRONMENT":
+            kind = source.type if source is not None else None
+            if kind in ("TEX_ENVIRONMENT", "TEX_SKY"):
+                from .world_sky import sky_environment  # here: world_sky reads this module's types
+
                 notes: list[str] = []
-                env = _environment(world.name, source, s, notes)
+                env = (_environment if kind == "TEX_ENVIRONMENT" else sky_environment)(world.name, source, s, notes)
                 return WorldSpec((0.0, 0.0, 0.0), lighting, tuple(notes), env, visible_camera=camera)
     return WorldSpec((0.0, 0.0, 0.0), lighting, (f"world '{world.name}': not a plain colour (black)",),
                      visible_camera=camera)
@@ -65,7 +72,7 @@ def _environment(name, node, strength, notes) -> EnvironmentSpec:
         notes.append(f"world '{name}': environment projection {node.projection} (equirectangular)")
     if getattr(node, "interpolation", "Linear") != "Linear":
         notes.append(f"world '{name}': environment interpolation {node.interpolation} (bilinear)")
-    matrix = _mapping(name, input_socket(node, "Vector"), notes)
+    matrix = mapping_matrix(name, input_socket(node, "Vector"), notes)
     image = node.image
     if image is None:
         notes.append(f"world '{name}': Environment Texture without an image (magenta)")
@@ -76,7 +83,7 @@ def _environment(name, node, strength, notes) -> EnvironmentSpec:
     return EnvironmentSpec(key, (strength,) * 3, rows, image)
 
 
-def _mapping(name, vector, notes) -> np.ndarray:
+def mapping_matrix(name, vector, notes) -> np.ndarray:
     """The (3, 3) matrix taking world directions to the map's frame: identity for an unlinked
     vector (the ray's direction) or Generated coordinates; a Mapping node's rotation and scale
     (Point and Vector: R diag(scale); Texture: its inverse)."""

@@ -352,6 +352,21 @@ SCENES_SPEC = [
 ]
 
 
+
+# A Preetham Sky Texture world (issue 13: the add-on bakes the model into an environment map) lights
+# a diffuse floor and ball; the camera sees the sky above the floor's far edge. Preetham exists in
+# Blender 3.4 to 5.0, so it is asserted on each (the mean limit 0.5 %).
+def scene_sky_preetham(p):
+    kit.plane("floor", 8.0, kit.diffuse("white", (0.8, 0.8, 0.8)))
+    kit.uv_sphere("ball", 0.5, (0.0, 0.0, 0.5), kit.diffuse("orange", (0.7, 0.45, 0.25)))
+    kit.sky_world("PREETHAM", strength=p["strength"], sun_direction=p["sun"], turbidity=p["turbidity"])
+    camera(p["camera"], (0.0, 0.0, 0.6))
+
+
+SCENES_SPEC.append(("sky_preetham", scene_sky_preetham, dict(sun=(0.5, -0.4, 0.77), turbidity=2.5, strength=1.0,
+                                                             camera=(0.0, -6.0, 1.2), mean_limit=0.005,
+                                                             sample_factor=2), 0))
+
 # ---- Cycles ------------------------------------------------------------------------------------
 
 def render_cycles(scene, path):
