@@ -11,7 +11,7 @@
 #   make bench-trace  ray-tracing benchmark against Embree -> docs/bench-trace.md
 #   make bench-lbvh   builders (LBVH, SAH, Embree) from 10K to 4M triangles -> docs/lbvh-bench.md, lbvh.png
 #   make bench-blender TOYRT against Cycles in Blender: time to Cycles' 64-spp error, peak memory -> docs/blender-bench.md
-#   make bench        speed against accuracy vs Cycles, Mitsuba 3, Embree, Open3D -> docs/results.md (BENCH_QUICK=1: smoke run)
+#   make bench        speed against accuracy vs Cycles, Mitsuba 3, Embree, Open3D -> docs/results.md, denoising -> docs/denoise-bench.md (BENCH_QUICK=1: smoke run)
 #   make fuzz         libFuzzer over scene building and ray queries (FUZZ_SECONDS=60) -> docs/robustness.md
 #   make sanitize     C++ and Python tests on an AddressSanitizer + UBSan build (build-asan/)
 #   make test-levels  the watertight, oracle, BVH, query and fuzz suites at each x86-64 level of the wheels (build-levels/)
@@ -174,8 +174,9 @@ test-blender:
 # The same tests under a current Blender: the bpy module from PyPI (requirements-test.txt), one
 # process per file, the add-on and the module copied into a temporary user folder
 # (tests/blender/run_with_bpy.py). Command-line parts are skipped there (no blender executable).
-# test_viewport.py drives Debian's Blender with a window under Xvfb (the bpy module has no UI).
-BPY_TESTS := $(filter-out tests/blender/test_viewport.py,$(BLENDER_TESTS))
+# test_viewport.py and test_ui_layout.py drive Debian's Blender with a window under Xvfb (the bpy
+# module has no UI).
+BPY_TESTS := $(filter-out tests/blender/test_viewport.py tests/blender/test_ui_layout.py,$(BLENDER_TESTS))
 test-bpy:
 	@passed=0; for t in $(BPY_TESTS); do \
 		echo "bpy: $$t"; start=$$(date +%s); \
@@ -244,6 +245,8 @@ bench: addon $(BENCH_STAMP)
 	$(VENV)/bin/python bench/run.py --build $(BUILD) --blender $(BLENDER) $(if $(BENCH_QUICK),--quick)
 	@# The exact queries against Open3D and trimesh: wrong answers on aligned sets, speed -> docs/queries-bench.md
 	$(VENV)/bin/python bench/queries_bench.py --build $(BUILD) $(if $(BENCH_QUICK),--quick)
+	@# Denoising (OIDN in both engines) and adaptive sampling against Cycles, under bpy 5.0 -> docs/denoise-bench.md
+	$(VENV)/bin/python tests/blender/run_with_bpy.py bench/denoise_bench.py --build $(BUILD) $(if $(BENCH_QUICK),--quick)
 
 # ---- robustness: fuzzing and sanitizers (docs/robustness.md) ----------------------------------------
 # Both use their own build directories beside $(BUILD): a clang build for libFuzzer

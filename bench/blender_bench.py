@@ -304,9 +304,10 @@ def main():
     out.write_text(json.dumps(result, indent=1))
 
 
-try:
-    main()
-except Exception:
-    import traceback
-    traceback.print_exc()
-    sys.exit(1)
+if __name__ == "__main__":  # as blender --python runs it; bench/denoise_bench.py imports its parts
+    try:
+        main()
+    except Exception:
+        import traceback
+        traceback.print_exc()
+        sys.exit(1)
