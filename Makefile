@@ -292,7 +292,8 @@ test-levels: apt
 sanitize: apt venv
 	@[ -f $(SAN_BUILD)/CMakeCache.txt ] || cmake -S . -B $(SAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 		-DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
-		-DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" $(CMAKE_ARGS) || { rm -f $(SAN_BUILD)/CMakeCache.txt; exit 1; }
+		-DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DTOYRT_BUILD_BENCH=OFF $(CMAKE_ARGS) \
+		|| { rm -f $(SAN_BUILD)/CMakeCache.txt; exit 1; }
 	@env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL cmake --build $(SAN_BUILD) -j$(JOBS)
 	$(SAN_ENV) ctest --test-dir $(SAN_BUILD) --output-on-failure --no-tests=error -j$(JOBS)
 	@# The interpreter is not built with ASan: its runtime must be loaded first, and libstdc++ with
