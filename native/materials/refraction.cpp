@@ -65,7 +65,11 @@ DielectricRoughness checked_roughness(DielectricRoughness rough) {
 }
 
 DielectricRoughness roughness_from_params(const Params& params) {
-  return {float(params.number("roughness", 0.0)), shadowing_from_params(params)};
+  const std::string distribution = params.text("distribution", "ggx");
+  if (distribution != "ggx" && distribution != "beckmann")
+    throw std::invalid_argument("refraction: distribution must be 'ggx' or 'beckmann', not '" + distribution + "'");
+  return {float(params.number("roughness", 0.0)), shadowing_from_params(params),
+          distribution == "ggx" ? MicrofacetDistribution::Ggx : MicrofacetDistribution::Beckmann};
 }
 
 }  // namespace
@@ -97,6 +101,7 @@ bool rough_dielectric(const ShadingPoint& s, float ior, const DielectricRoughnes
   lobe->frame = g.frame;
   lobe->wo = g.wo;
   lobe->alpha = alpha;
+  lobe->distribution = rough.distribution;
   lobe->shadowing = rough.shadowing;
   lobe->eta = glm::dot(s.wo, s.ng) > 0.0f ? ior : 1.0f / ior;
   lobe->kind = kind;

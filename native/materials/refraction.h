@@ -15,7 +15,7 @@
 //
 // Roughness: above kDielectricMinAlpha (and for ior not within 1e-4 of 1, where refraction does not
 // bend and a transmission lobe would be a delta) both answer a rough dielectric lobe
-// (materials/dielectric_lobe.h, GGX, alpha = roughness^2) instead of specular branches; below it
+// (materials/dielectric_lobe.h, GGX or Beckmann, alpha = roughness^2) instead of specular branches; below it
 // the specular answer, which the lobe converges to (materials_test).
 //
 // No 1 / eta^2 radiance scaling is applied on refraction: Cycles applies none, and a closed
@@ -35,10 +35,11 @@ namespace toyrt {
 inline constexpr float kDielectricMinAlpha = 1e-3f;
 
 // The rough lobe's settings, shared by both: roughness (0, clamped to [0, 1]; finite), shadowing
-// ('separable' 3.x, 'correlated' 4.0+).
+// ('separable' 3.x, 'correlated' 4.0+), distribution ('ggx', 'beckmann': Cycles' names, lower case).
 struct DielectricRoughness {
   float roughness = 0.0f;
   GgxShadowing shadowing = GgxShadowing::Separable;
+  MicrofacetDistribution distribution = MicrofacetDistribution::Ggx;
 };
 
 // Parameters of both (add_material('refraction' or 'glass', ...)): ior (1.45, Blender's
@@ -48,8 +49,8 @@ struct DielectricRoughness {
 struct PerfectRefraction {
   static constexpr const char* kType = "refraction";
   static constexpr const char* kParams =
-      "ior (1.45), roughness (0; alpha = roughness^2, GGX), shadowing ('separable' 3.x, 'correlated' 4.0+):\n"
-      "refraction without reflection, Blender's Refraction BSDF";
+      "ior (1.45), roughness (0; alpha = roughness^2), distribution ('ggx', 'beckmann'), shadowing\n"
+      "('separable' 3.x, 'correlated' 4.0+): refraction without reflection, Blender's Refraction BSDF";
   float ior = 1.45f;  // Blender's default; must be positive and finite
   DielectricRoughness rough;
   static PerfectRefraction make(float ior, DielectricRoughness rough = {});
@@ -59,8 +60,9 @@ struct PerfectRefraction {
 struct FresnelDielectric {
   static constexpr const char* kType = "glass";
   static constexpr const char* kParams =
-      "ior (1.45), roughness (0; alpha = roughness^2, GGX), shadowing ('separable' 3.x, 'correlated' 4.0+),\n"
-      "fresnel ('microfacet' 4.0+, 'macro' 3.x): Fresnel reflection and refraction, Blender's Glass BSDF";
+      "ior (1.45), roughness (0; alpha = roughness^2), distribution ('ggx', 'beckmann'), shadowing\n"
+      "('separable' 3.x, 'correlated' 4.0+), fresnel ('microfacet' 4.0+, 'macro' 3.x): Fresnel reflection and "
+      "refraction, Blender's Glass BSDF";
   float ior = 1.45f;
   DielectricRoughness rough;
   bool macro_fresnel = false;

@@ -11,6 +11,7 @@
 #include "materials/dielectric_lobe.h"
 #include "materials/material.h"
 #include "materials/refraction.h"
+#include "sampling/beckmann.h"
 #include "statistics.h"
 
 #include <gtest/gtest.h>
@@ -28,8 +29,10 @@ using toyrt::testing::hemisphere_integral;
 namespace {
 
 DielectricLobe lobe_at(DielectricKind kind, float alpha, float eta, double theta_o,
-                       GgxShadowing shadowing = GgxShadowing::Separable) {
+                       GgxShadowing shadowing = GgxShadowing::Separable,
+                       MicrofacetDistribution distribution = MicrofacetDistribution::Ggx) {
   DielectricLobe lobe;
+  lobe.distribution = distribution;
   lobe.wo = direction(theta_o, 0.4);
   lobe.alpha = alpha;
   lobe.eta = eta;
@@ -56,7 +59,9 @@ SamplerMean sampler_mean(const DielectricLobe& lobe, int n, uint32_t seed) {
   for (int k = 0; k < n; ++k) {
     const BsdfSample s = dielectric_sample_local(lobe, Vec2(u(rng), u(rng)), u(rng));
     const double w = s.weight.x;
-    EXPECT_TRUE(std::isfinite(w) && w >= 0.0 && w <= 1.0 + 1e-5) << w;
+    // GGX's visible normals give weights G2 / G1 <= 1; Beckmann's D cos sampling does not.
+    const bool bounded = lobe.distribution == MicrofacetDistribution::Beckmann || w <= 1.0 + 1e-5;
+    EXPECT_TRUE(std::isfinite(w) && w >= 0.0 && bounded) << w;
     sum += w;
     sum2 += w * w;
     if (s.pdf > 0.0f) {
@@ -73,21 +78,26 @@ SamplerMean sampler_mean(const DielectricLobe& lobe, int n, uint32_t seed) {
 }
 
 constexpr DielectricKind kKinds[] = {DielectricKind::Glass, DielectricKind::Glass3x, DielectricKind::Refraction};
+constexpr MicrofacetDistribution kDistributions[] = {MicrofacetDistribution::Ggx, MicrofacetDistribution::Beckmann};
 
 }  // namespace
 
 TEST(Dielectric, AlbedoByQuadratureEqualsTheSamplersMeanWeight) {
-  for (DielectricKind kind : kKinds) {
-    for (float alpha : {0.15f, 0.4f, 1.0f}) {
-      for (float eta : {1.5f, 1.0f / 1.5f}) {
-        for (double theta_o : {0.2, 0.9, 1.3}) {
-          const DielectricLobe lobe = lobe_at(kind, alpha, eta, theta_o);
-          const double quad = sphere_integral(
-              [&](const Vec3& wi) { return double(dielectric_eval_local(lobe, wi).f.x) * std::abs(wi.z); }, 1536, 384);
-          const SamplerMean m = sampler_mean(lobe, 200000, 11);
-          EXPECT_NEAR(quad, m.weight, 4.0 * m.stderr_weight + 3e-3)
-              << "kind " << int(kind) << " alpha " << alpha << " eta " << eta << " theta_o " << theta_o;
-          EXPECT_LE(quad, 1.0 + 3e-3);
+  for (MicrofacetDistribution dist : kDistributions) {
+    for (DielectricKind kind : kKinds) {
+      for (float alpha : {0.15f, 0.4f, 1.0f}) {
+        for (float eta : {1.5f, 1.0f / 1.5f}) {
+          for (double theta_o : {0.2, 0.9, 1.3}) {
+            const DielectricLobe lobe = lobe_at(kind, alpha, eta, theta_o, GgxShadowing::Separable, dist);
+            const double quad = sphere_integral(
+                [&](const Vec3& wi) { return double(dielectric_eval_local(lobe, wi).f.x) * std::abs(wi.z); }, 1536,
+                384);
+            const SamplerMean m = sampler_mean(lobe, 200000, 11);
+            EXPECT_NEAR(quad, m.weight, 4.0 * m.stderr_weight + 3e-3)
+                << "distribution " << int(dist) << " kind " << int(kind) << " alpha " << alpha << " eta " << eta
+                << " theta_o " << theta_o;
+            EXPECT_LE(quad, 1.0 + 3e-3);
+          }
         }
       }
     }
@@ -118,57 +128,59 @@ TEST(Dielectric, PdfIntegratesToTheSamplersMassAndItsHistogramMatches) {
   constexpr int kTheta = 24, kPhi = 24, kSub = 8, kSamples = 300000;
   std::mt19937 rng(17);
   std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
-  for (DielectricKind kind : kKinds) {
-    for (float alpha : {0.2f, 0.6f}) {
-      for (float eta : {1.5f, 1.0f / 1.5f}) {
-        const DielectricLobe lobe = lobe_at(kind, alpha, eta, 0.8);
-        // Bins: theta in [0, pi] (both hemispheres), phi; the last bin: no sample.
-        std::vector<double> expected(2 * kTheta * kPhi + 1, 0.0);
-        const double dt = M_PI / (2 * kTheta * kSub), dp = 2.0 * M_PI / (kPhi * kSub);
-        double mass = 0.0;
-        for (int i = 0; i < 2 * kTheta * kSub; ++i) {
-          const double theta = (i + 0.5) * dt;
-          for (int j = 0; j < kPhi * kSub; ++j) {
-            const double p =
-                dielectric_eval_local(lobe, direction(theta, (j + 0.5) * dp)).pdf * std::sin(theta) * dt * dp;
-            expected[size_t((i / kSub) * kPhi + j / kSub)] += p * kSamples;
-            mass += p;
+  for (MicrofacetDistribution dist : kDistributions) {
+    for (DielectricKind kind : kKinds) {
+      for (float alpha : {0.2f, 0.6f}) {
+        for (float eta : {1.5f, 1.0f / 1.5f}) {
+          const DielectricLobe lobe = lobe_at(kind, alpha, eta, 0.8, GgxShadowing::Separable, dist);
+          // Bins: theta in [0, pi] (both hemispheres), phi; the last bin: no sample.
+          std::vector<double> expected(2 * kTheta * kPhi + 1, 0.0);
+          const double dt = M_PI / (2 * kTheta * kSub), dp = 2.0 * M_PI / (kPhi * kSub);
+          double mass = 0.0;
+          for (int i = 0; i < 2 * kTheta * kSub; ++i) {
+            const double theta = (i + 0.5) * dt;
+            for (int j = 0; j < kPhi * kSub; ++j) {
+              const double p =
+                  dielectric_eval_local(lobe, direction(theta, (j + 0.5) * dp)).pdf * std::sin(theta) * dt * dp;
+              expected[size_t((i / kSub) * kPhi + j / kSub)] += p * kSamples;
+              mass += p;
+            }
           }
-        }
-        std::vector<double> counts(expected.size(), 0.0);
-        for (int k = 0; k < kSamples; ++k) {
-          const BsdfSample s = dielectric_sample_local(lobe, Vec2(uniform(rng), uniform(rng)), uniform(rng));
-          if (!(s.pdf > 0.0f)) {
-            counts.back() += 1.0;
-            continue;
+          std::vector<double> counts(expected.size(), 0.0);
+          for (int k = 0; k < kSamples; ++k) {
+            const BsdfSample s = dielectric_sample_local(lobe, Vec2(uniform(rng), uniform(rng)), uniform(rng));
+            if (!(s.pdf > 0.0f)) {
+              counts.back() += 1.0;
+              continue;
+            }
+            const double theta = std::acos(std::clamp(double(s.wi.z), -1.0, 1.0));
+            double phi = std::atan2(double(s.wi.y), double(s.wi.x));
+            if (phi < 0.0) phi += 2.0 * M_PI;
+            const int i = std::min(2 * kTheta - 1, int(theta / M_PI * 2 * kTheta));
+            const int j = std::min(kPhi - 1, int(phi / (2.0 * M_PI) * kPhi));
+            counts[size_t(i * kPhi + j)] += 1.0;
           }
-          const double theta = std::acos(std::clamp(double(s.wi.z), -1.0, 1.0));
-          double phi = std::atan2(double(s.wi.y), double(s.wi.x));
-          if (phi < 0.0) phi += 2.0 * M_PI;
-          const int i = std::min(2 * kTheta - 1, int(theta / M_PI * 2 * kTheta));
-          const int j = std::min(kPhi - 1, int(phi / (2.0 * M_PI) * kPhi));
-          counts[size_t(i * kPhi + j)] += 1.0;
-        }
-        const double sampled_mass = 1.0 - counts.back() / kSamples;
-        EXPECT_NEAR(mass, sampled_mass, 5e-3) << "kind " << int(kind) << " alpha " << alpha << " eta " << eta;
-        expected.back() = std::max(0.0, 1.0 - mass) * kSamples;
-        double chi2 = 0.0, pooled_count = 0.0, pooled_expected = 0.0;
-        int bins = 0;
-        for (size_t c = 0; c < counts.size(); ++c) {
-          if (expected[c] < 5.0) {
-            pooled_count += counts[c];
-            pooled_expected += expected[c];
-            continue;
+          const double sampled_mass = 1.0 - counts.back() / kSamples;
+          EXPECT_NEAR(mass, sampled_mass, 5e-3) << "kind " << int(kind) << " alpha " << alpha << " eta " << eta;
+          expected.back() = std::max(0.0, 1.0 - mass) * kSamples;
+          double chi2 = 0.0, pooled_count = 0.0, pooled_expected = 0.0;
+          int bins = 0;
+          for (size_t c = 0; c < counts.size(); ++c) {
+            if (expected[c] < 5.0) {
+              pooled_count += counts[c];
+              pooled_expected += expected[c];
+              continue;
+            }
+            chi2 += (counts[c] - expected[c]) * (counts[c] - expected[c]) / expected[c];
+            ++bins;
           }
-          chi2 += (counts[c] - expected[c]) * (counts[c] - expected[c]) / expected[c];
-          ++bins;
+          if (pooled_expected >= 5.0) {
+            chi2 += (pooled_count - pooled_expected) * (pooled_count - pooled_expected) / pooled_expected;
+            ++bins;
+          }
+          EXPECT_LT(chi2, chi_square_quantile(bins - 1, 1e-4))
+              << "distribution " << int(dist) << " kind " << int(kind) << " alpha " << alpha << " eta " << eta;
         }
-        if (pooled_expected >= 5.0) {
-          chi2 += (pooled_count - pooled_expected) * (pooled_count - pooled_expected) / pooled_expected;
-          ++bins;
-        }
-        EXPECT_LT(chi2, chi_square_quantile(bins - 1, 1e-4))
-            << "kind " << int(kind) << " alpha " << alpha << " eta " << eta;
       }
     }
   }
@@ -177,26 +189,43 @@ TEST(Dielectric, PdfIntegratesToTheSamplersMassAndItsHistogramMatches) {
 TEST(Dielectric, ReflectionIsReciprocalAndTransmissionScalesByTheIndices) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  for (GgxShadowing shadowing : {GgxShadowing::Separable, GgxShadowing::HeightCorrelated}) {
-    for (int k = 0; k < 2000; ++k) {
-      const float alpha = float(0.05 + 0.95 * u(rng)), eta = u(rng) < 0.5 ? 1.5f : 1.0f / 1.5f;
-      const Vec3 a = direction(1.5 * u(rng), 2.0 * M_PI * u(rng));
-      const Vec3 b_up = direction(1.5 * u(rng), 2.0 * M_PI * u(rng));
-      DielectricLobe from_a = lobe_at(DielectricKind::Glass, alpha, eta, 0.0, shadowing);
-      from_a.wo = a;
-      DielectricLobe from_b = from_a;
-      from_b.wo = b_up;
-      const float fab = dielectric_eval_local(from_a, b_up).f.x, fba = dielectric_eval_local(from_b, a).f.x;
-      EXPECT_NEAR(fab, fba, 1e-4f * std::max(1.0f, fab));
-      // Transmission: b below; seen from b the indices swap (eta -> 1 / eta) and the frame flips.
-      const Vec3 b(b_up.x, b_up.y, -b_up.z);
-      DielectricLobe from_below = from_a;
-      from_below.wo = b_up;
-      from_below.eta = 1.0f / eta;
-      const float ft_ab = dielectric_eval_local(from_a, b).f.x;
-      const float ft_ba = dielectric_eval_local(from_below, Vec3(a.x, a.y, -a.z)).f.x;
-      // n_o = 1, n_i = eta (relative): f(a -> b) / eta^2 = f(b -> a) / 1.
-      EXPECT_NEAR(ft_ab / (eta * eta), ft_ba, 1e-3f * std::max(1.0f, ft_ba)) << "alpha " << alpha << " eta " << eta;
+  for (MicrofacetDistribution dist : kDistributions) {
+    for (GgxShadowing shadowing : {GgxShadowing::Separable, GgxShadowing::HeightCorrelated}) {
+      for (int k = 0; k < 2000; ++k) {
+        const float alpha = float(0.05 + 0.95 * u(rng)), eta = u(rng) < 0.5 ? 1.5f : 1.0f / 1.5f;
+        const Vec3 a = direction(1.5 * u(rng), 2.0 * M_PI * u(rng));
+        const Vec3 b_up = direction(1.5 * u(rng), 2.0 * M_PI * u(rng));
+        DielectricLobe from_a = lobe_at(DielectricKind::Glass, alpha, eta, 0.0, shadowing, dist);
+        from_a.wo = a;
+        DielectricLobe from_b = from_a;
+        from_b.wo = b_up;
+        const float fab = dielectric_eval_local(from_a, b_up).f.x, fba = dielectric_eval_local(from_b, a).f.x;
+        EXPECT_NEAR(fab, fba, 1e-4f * std::max(1.0f, fab));
+        // Transmission: b below; seen from b the indices swap (eta -> 1 / eta) and the frame flips.
+        const Vec3 b(b_up.x, b_up.y, -b_up.z);
+        DielectricLobe from_below = from_a;
+        from_below.wo = b_up;
+        from_below.eta = 1.0f / eta;
+        const float ft_ab = dielectric_eval_local(from_a, b).f.x;
+        const float ft_ba = dielectric_eval_local(from_below, Vec3(a.x, a.y, -a.z)).f.x;
+        // n_o = 1, n_i = eta (relative): f(a -> b) / eta^2 = f(b -> a) / 1.
+        EXPECT_NEAR(ft_ab / (eta * eta), ft_ba, 1e-3f * std::max(1.0f, ft_ba)) << "alpha " << alpha << " eta " << eta;
+      }
+    }
+  }
+}
+
+TEST(Beckmann, ProjectedAreaIsOneAndLambdaIsWithinItsFitOfTheErfForm) {
+  for (float alpha : {0.1f, 0.3f, 0.7f, 1.0f}) {
+    const double area = hemisphere_integral([&](const Vec3& m) { return double(beckmann_d(alpha, m)) * m.z; },
+                                            alpha < 0.2f ? 4096 : 1024);
+    EXPECT_NEAR(area, 1.0, 2e-3) << "alpha " << alpha;
+    for (double theta : {0.2, 0.8, 1.2, 1.5}) {
+      const double a = 1.0 / (alpha * std::tan(theta));
+      const double exact = 0.5 * (std::erf(a) - 1.0) + std::exp(-a * a) / (2.0 * a * std::sqrt(M_PI));
+      const double fit = beckmann_lambda(alpha, direction(theta, 0.0));
+      // G1 = 1 / (1 + Lambda): the fit's error in G1 is what shading sees.
+      EXPECT_NEAR(1.0 / (1.0 + fit), 1.0 / (1.0 + exact), 4e-3) << "alpha " << alpha << " theta " << theta;
     }
   }
 }
@@ -279,6 +308,9 @@ TEST(Dielectric, DegenerateDirectionsAndBadParametersHaveDefinedAnswers) {
   Params p;
   p.set("ior", 1.5).set("roughness", 0.3).set("fresnel", std::string("sideways"));
   EXPECT_THROW(make_material("glass", p), std::invalid_argument);
+  Params q;
+  q.set("ior", 1.5).set("roughness", 0.3).set("distribution", std::string("phong"));
+  EXPECT_THROW(make_material("refraction", q), std::invalid_argument);
   // ior 1: nothing bends, whatever the roughness: the specular pass-through.
   const Vec3 ng(0.0f, 0.0f, 1.0f), wo = glm::normalize(Vec3(0.3f, 0.0f, 1.0f));
   const Scatter through = scatter(FresnelDielectric::make(1.0f, {0.5f}), ShadingPoint{wo, ng, ng, Vec2(0.0f)}, {});
