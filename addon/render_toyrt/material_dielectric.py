@@ -29,8 +29,8 @@ def ior_value(name, node, notes) -> float:
 def dielectric_spec(name, node, kind, label, notes):
     """Blender's Glass and Refraction BSDFs: sharp, or a rough GGX or Beckmann dielectric (alpha =
     roughness^2; 3.x's separable masking and Fresnel-weighted pair of lobes, 4.0+'s height-correlated
-    masking and Fresnel term per microfacet). Multiscatter GGX is drawn as single-scatter GGX,
-    noted. Returns a MaterialSpec."""
+    masking and Fresnel term per microfacet). Multiscatter GGX is 4.0+'s energy compensation; 3.x's
+    (a random walk) is drawn as single-scatter GGX, noted. Returns a MaterialSpec."""
     from .materials import MaterialSpec, _blender_version, _constant, _shadowing, input_socket
     color = input_socket(node, "Color")
     if color is not None and (color.is_linked or tuple(color.default_value)[:3] != (1.0, 1.0, 1.0)):
@@ -39,8 +39,13 @@ def dielectric_spec(name, node, kind, label, notes):
     roughness = 0.0
     if distribution != "SHARP":
         roughness = _constant(name, input_socket(node, "Roughness"), "roughness", 0.0, notes, 0.0, 1.0)
-    if roughness > 0.0 and distribution == "MULTI_GGX":
+    new = _blender_version() >= (4, 0, 0)
+    # 4.0+'s Multiscatter GGX glass is the GGX lobe with energy compensation, which the core has;
+    # 3.x's is a random walk between microfacets.
+    multiscatter = new and kind == "glass" and distribution == "MULTI_GGX"
+    if roughness > 0.0 and distribution == "MULTI_GGX" and not multiscatter:
         notes.append(f"material '{name}': Multiscatter GGX {label} (single-scatter GGX: darker at high roughness)")
-    fresnel = "macro" if _blender_version() < (4, 0, 0) else "microfacet"
+    fresnel = "microfacet" if new else "macro"
     return MaterialSpec(kind, ior=ior_value(name, node, notes), roughness=roughness, shadowing=_shadowing(),
-                        fresnel=fresnel, distribution="beckmann" if distribution == "BECKMANN" else "ggx")
+                        fresnel=fresnel, distribution="beckmann" if distribution == "BECKMANN" else "ggx",
+                        multiscatter=multiscatter)

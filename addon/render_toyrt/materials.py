@@ -52,7 +52,7 @@ class MaterialSpec:
     shadowing: str = "separable"
     diffuse_weight: float = 1.0                              # 'diffuse_glossy': the diffuse part's weight
     glossy_color: tuple[float, float, float] = DEFAULT_GREY  # 'diffuse_glossy': the glossy part's colour
-    multiscatter: bool = False                               # 'glossy', 'principled': 4.0+'s Multiscatter GGX
+    multiscatter: bool = False                               # 'glossy', 'principled', 'glass': 4.0+'s Multiscatter GGX
     specular_ior_level: float = 0.5                          # 'principled' (4.0+'s socket)
     specular_tint: tuple[float, float, float] = (1.0, 1.0, 1.0)  # 'principled': the layer's F0 tint
     layered: bool = True                                     # 'principled': 4.0+ (False: 3.x's sum)
@@ -73,7 +73,7 @@ class MaterialSpec:
         if self.kind in ("glass", "refraction"):                    # rough when roughness > 0
             args.update(roughness=self.roughness, shadowing=self.shadowing, distribution=self.distribution)
         if self.kind == "glass":
-            args.update(fresnel=self.fresnel)
+            args.update(fresnel=self.fresnel, multiscatter=self.multiscatter)
         if self.kind == "principled":
             args.update(specular_ior_level=self.specular_ior_level, specular_tint=self.specular_tint,
                         layered=self.layered, metallic=self.metallic)

@@ -77,8 +77,15 @@ DielectricRoughness roughness_from_params(const Params& params) {
 PerfectRefraction PerfectRefraction::make(float ior, DielectricRoughness rough) {
   return {checked_ior(ior), checked_roughness(rough)};
 }
-FresnelDielectric FresnelDielectric::make(float ior, DielectricRoughness rough, bool macro_fresnel) {
-  return {checked_ior(ior), checked_roughness(rough), macro_fresnel};
+FresnelDielectric FresnelDielectric::make(float ior, DielectricRoughness rough, bool macro_fresnel, bool multiscatter) {
+  FresnelDielectric m{checked_ior(ior), checked_roughness(rough), macro_fresnel, nullptr};
+  if (!multiscatter) return m;
+  if (macro_fresnel || rough.distribution != MicrofacetDistribution::Ggx)
+    throw std::invalid_argument("glass: multiscatter needs distribution 'ggx' and fresnel 'microfacet'");
+  const float alpha = ggx_alpha(m.rough.roughness);
+  if (alpha >= kDielectricMinAlpha)
+    m.albedo = std::make_shared<const DielectricAlbedo>(dielectric_albedo(alpha, m.ior, m.rough.shadowing));
+  return m;
 }
 PerfectRefraction PerfectRefraction::from_params(const Params& params) {
   return make(float(params.positive("ior", PerfectRefraction{}.ior)), roughness_from_params(params));
@@ -87,8 +94,8 @@ FresnelDielectric FresnelDielectric::from_params(const Params& params) {
   const std::string fresnel = params.text("fresnel", "microfacet");
   if (fresnel != "microfacet" && fresnel != "macro")
     throw std::invalid_argument("glass: fresnel must be 'microfacet' or 'macro', not '" + fresnel + "'");
-  return make(float(params.positive("ior", FresnelDielectric{}.ior)), roughness_from_params(params),
-              fresnel == "macro");
+  return make(float(params.positive("ior", FresnelDielectric{}.ior)), roughness_from_params(params), fresnel == "macro",
+              params.flag("multiscatter", false));
 }
 
 bool rough_dielectric(const ShadingPoint& s, float ior, const DielectricRoughness& rough, DielectricKind kind,
@@ -149,8 +156,10 @@ Scatter scatter(const PerfectRefraction& m, const ShadingPoint& s, const Materia
 
 Scatter scatter(const FresnelDielectric& m, const ShadingPoint& s, const MaterialContext& ctx) {
   DielectricLobe lobe;
-  if (rough_dielectric(s, m.ior, m.rough, m.macro_fresnel ? DielectricKind::Glass3x : DielectricKind::Glass, &lobe))
+  if (rough_dielectric(s, m.ior, m.rough, m.macro_fresnel ? DielectricKind::Glass3x : DielectricKind::Glass, &lobe)) {
+    if (m.albedo) lobe.tint = Vec3(multiscatter_glass_scale(*m.albedo, glm::dot(s.wo, s.ng) > 0.0f, lobe.wo.z));
     return Scatter::dielectric_lobe(lobe);
+  }
   if (!ctx.split) return Scatter::specular(sample(m, s.wo, s.ng, s.ns, ctx.uniform()));
   // Splitting: both branches, each weighted by its Fresnel term, instead of choosing one with
   // that probability. A light seen in a reflection with F = 0.04 is otherwise an all-or-nothing

@@ -24,9 +24,11 @@
 
 #include "core/math.h"
 #include "core/params.h"
+#include "materials/dielectric_albedo.h"
 #include "materials/scatter.h"
 
 #include <cstdint>
+#include <memory>
 
 namespace toyrt {
 
@@ -61,12 +63,18 @@ struct FresnelDielectric {
   static constexpr const char* kType = "glass";
   static constexpr const char* kParams =
       "ior (1.45), roughness (0; alpha = roughness^2), distribution ('ggx', 'beckmann'), shadowing\n"
-      "('separable' 3.x, 'correlated' 4.0+), fresnel ('microfacet' 4.0+, 'macro' 3.x): Fresnel reflection and "
-      "refraction, Blender's Glass BSDF";
+      "('separable' 3.x, 'correlated' 4.0+), fresnel ('microfacet' 4.0+, 'macro' 3.x), multiscatter (False;\n"
+      "4.0+'s Multiscatter GGX: GGX with fresnel 'microfacet' only): Fresnel reflection and refraction, Blender's\n"
+      "Glass BSDF";
   float ior = 1.45f;
   DielectricRoughness rough;
   bool macro_fresnel = false;
-  static FresnelDielectric make(float ior, DielectricRoughness rough = {}, bool macro_fresnel = false);
+  // Multiscatter GGX (materials/dielectric_albedo.h): the lobe's albedo over cos_o, made once by
+  // make(); null: single scattering (or a sharp material).
+  std::shared_ptr<const DielectricAlbedo> albedo;
+  // Throws std::invalid_argument for multiscatter with Beckmann or the macro Fresnel (Cycles has none).
+  static FresnelDielectric make(float ior, DielectricRoughness rough = {}, bool macro_fresnel = false,
+                                bool multiscatter = false);
   static FresnelDielectric from_params(const Params& params);
 };
 

@@ -465,7 +465,8 @@ def test_rough_glass_and_refraction():
     """Glass and Refraction BSDFs with roughness > 0 become rough dielectrics as the version's Cycles
     shades them: the roughness and distribution kept (GGX, Beckmann), 3.x's Fresnel-weighted lobe
     pair and separable masking, 4.0+'s Fresnel per microfacet and height-correlated masking;
-    Multiscatter GGX glass is single-scatter GGX with a note; roughness 0 stays sharp."""
+    Multiscatter GGX glass is 4.0+'s energy compensation, 3.x's single-scatter GGX with a note;
+    roughness 0 stays sharp."""
     _, _ = addon()
     from render_toyrt import materials
 
@@ -489,8 +490,12 @@ def test_rough_glass_and_refraction():
     b = beck.spec
     check(b.kind == "refraction" and abs(b.roughness - 0.2) < 1e-6 and b.distribution == "beckmann" and not beck.notes,
           f"a rough Beckmann Refraction: {beck}")
-    check(multi.spec.kind == "glass" and multi.spec.distribution == "ggx" and len(multi.notes) == 1
-          and "Multiscatter GGX" in multi.notes[0], f"Multiscatter GGX glass: single-scatter GGX, noted: {multi}")
+    if new:
+        check(multi.spec.kind == "glass" and multi.spec.distribution == "ggx" and multi.spec.multiscatter
+              and not multi.notes, f"Multiscatter GGX glass: 4.0+'s energy compensation: {multi}")
+    else:
+        check(multi.spec.kind == "glass" and not multi.spec.multiscatter and len(multi.notes) == 1
+              and "Multiscatter GGX" in multi.notes[0], f"3.x's Multiscatter GGX glass: single-scatter, noted: {multi}")
     check(sharp.spec.kind == "glass" and sharp.spec.roughness == 0.0 and not sharp.notes, f"roughness 0: {sharp}")
     args = ggx.spec.arguments()
     check(args["roughness"] == g.roughness and args["distribution"] == "ggx" and "fresnel" in args,
