@@ -1,7 +1,11 @@
 #include "materials/dielectric_albedo.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <map>
+#include <mutex>
+#include <tuple>
 
 namespace toyrt {
 namespace {
@@ -40,6 +44,28 @@ DielectricAlbedo dielectric_albedo(float alpha, float ior, GgxShadowing shadowin
     table.leaving[size_t(i)] = albedo_at(alpha, 1.0f / ior, shadowing, cos_o);
   }
   return table;
+}
+
+namespace {
+// Written once per id before the id is handed out (under the mutex), read without a lock.
+std::array<std::atomic<const DielectricAlbedo*>, kMaxDielectricAlbedos> g_tables{};
+}  // namespace
+
+int32_t shared_dielectric_albedo(float alpha, float ior, GgxShadowing shadowing) {
+  static std::mutex mutex;
+  static auto* ids = new std::map<std::tuple<float, float, int>, int32_t>();  // never freed, as the tables
+  const std::lock_guard<std::mutex> lock(mutex);
+  const auto key = std::make_tuple(alpha, ior, int(shadowing));
+  if (auto it = ids->find(key); it != ids->end()) return it->second;
+  const int32_t id = int32_t(ids->size());
+  if (id >= kMaxDielectricAlbedos) return -1;
+  g_tables[size_t(id)].store(new DielectricAlbedo(dielectric_albedo(alpha, ior, shadowing)), std::memory_order_release);
+  (*ids)[key] = id;
+  return id;
+}
+
+const DielectricAlbedo& dielectric_albedo_table(int32_t id) {
+  return *g_tables[size_t(id)].load(std::memory_order_acquire);
 }
 
 float multiscatter_glass_scale(const DielectricAlbedo& table, bool entering, float cos_o) {

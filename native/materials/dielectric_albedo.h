@@ -9,6 +9,7 @@
 #include "materials/dielectric_lobe.h"
 
 #include <array>
+#include <cstdint>
 
 namespace toyrt {
 
@@ -21,6 +22,14 @@ struct DielectricAlbedo {
 // normals at each cos_o, both of each normal's branches weighted by their Fresnel terms (within
 // 1e-3 of a 2M-sample estimate; about 0.25 s per material).
 DielectricAlbedo dielectric_albedo(float alpha, float ior, GgxShadowing shadowing);
+
+// The same, computed once per (alpha, ior, shadowing) in the process and kept for its lifetime
+// (thread-safe), named by a 32-bit id: materials hold the id, so the Material variant keeps its
+// size and stays trivially copyable, as the integrator's Lambert path was measured with. -1 when
+// the process already holds kMaxDielectricAlbedos tables (the material then scatters once).
+inline constexpr int kMaxDielectricAlbedos = 4096;
+int32_t shared_dielectric_albedo(float alpha, float ior, GgxShadowing shadowing);
+const DielectricAlbedo& dielectric_albedo_table(int32_t id);  // id from shared_dielectric_albedo, >= 0
 
 // 1 / E at cos_o (linear in cos_o between the table's points).
 float multiscatter_glass_scale(const DielectricAlbedo& table, bool entering, float cos_o);

@@ -78,13 +78,12 @@ PerfectRefraction PerfectRefraction::make(float ior, DielectricRoughness rough) 
   return {checked_ior(ior), checked_roughness(rough)};
 }
 FresnelDielectric FresnelDielectric::make(float ior, DielectricRoughness rough, bool macro_fresnel, bool multiscatter) {
-  FresnelDielectric m{checked_ior(ior), checked_roughness(rough), macro_fresnel, nullptr};
+  FresnelDielectric m{checked_ior(ior), checked_roughness(rough), macro_fresnel, -1};
   if (!multiscatter) return m;
   if (macro_fresnel || rough.distribution != MicrofacetDistribution::Ggx)
     throw std::invalid_argument("glass: multiscatter needs distribution 'ggx' and fresnel 'microfacet'");
   const float alpha = ggx_alpha(m.rough.roughness);
-  if (alpha >= kDielectricMinAlpha)
-    m.albedo = std::make_shared<const DielectricAlbedo>(dielectric_albedo(alpha, m.ior, m.rough.shadowing));
+  if (alpha >= kDielectricMinAlpha) m.albedo = shared_dielectric_albedo(alpha, m.ior, m.rough.shadowing);
   return m;
 }
 PerfectRefraction PerfectRefraction::from_params(const Params& params) {
@@ -157,7 +156,9 @@ Scatter scatter(const PerfectRefraction& m, const ShadingPoint& s, const Materia
 Scatter scatter(const FresnelDielectric& m, const ShadingPoint& s, const MaterialContext& ctx) {
   DielectricLobe lobe;
   if (rough_dielectric(s, m.ior, m.rough, m.macro_fresnel ? DielectricKind::Glass3x : DielectricKind::Glass, &lobe)) {
-    if (m.albedo) lobe.tint = Vec3(multiscatter_glass_scale(*m.albedo, glm::dot(s.wo, s.ng) > 0.0f, lobe.wo.z));
+    if (m.albedo >= 0)
+      lobe.tint =
+          Vec3(multiscatter_glass_scale(dielectric_albedo_table(m.albedo), glm::dot(s.wo, s.ng) > 0.0f, lobe.wo.z));
     return Scatter::dielectric_lobe(lobe);
   }
   if (!ctx.split) return Scatter::specular(sample(m, s.wo, s.ng, s.ns, ctx.uniform()));

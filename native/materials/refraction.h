@@ -28,7 +28,6 @@
 #include "materials/scatter.h"
 
 #include <cstdint>
-#include <memory>
 
 namespace toyrt {
 
@@ -69,9 +68,9 @@ struct FresnelDielectric {
   float ior = 1.45f;
   DielectricRoughness rough;
   bool macro_fresnel = false;
-  // Multiscatter GGX (materials/dielectric_albedo.h): the lobe's albedo over cos_o, made once by
-  // make(); null: single scattering (or a sharp material).
-  std::shared_ptr<const DielectricAlbedo> albedo;
+  // Multiscatter GGX (materials/dielectric_albedo.h): the id of the lobe's albedo table over
+  // cos_o, made by make() (shared_dielectric_albedo); -1: single scattering (or a sharp material).
+  int32_t albedo = -1;
   // Throws std::invalid_argument for multiscatter with Beckmann or the macro Fresnel (Cycles has none).
   static FresnelDielectric make(float ior, DielectricRoughness rough = {}, bool macro_fresnel = false,
                                 bool multiscatter = false);
