@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .material_dielectric import dielectric_spec, ior_value
 from .material_mix import mix_of_diffuse_and_glossy
 
 DEFAULT_GREY = (0.8, 0.8, 0.8)   # Blender's default surface colour
@@ -51,13 +52,15 @@ class MaterialSpec:
     shadowing: str = "separable"
     diffuse_weight: float = 1.0                              # 'diffuse_glossy': the diffuse part's weight
     glossy_color: tuple[float, float, float] = DEFAULT_GREY  # 'diffuse_glossy': the glossy part's colour
-    multiscatter: bool = False                               # 'glossy', 'principled': 4.0+'s Multiscatter GGX
+    multiscatter: bool = False                               # 'glossy', 'principled', 'glass': 4.0+'s Multiscatter GGX
     specular_ior_level: float = 0.5                          # 'principled' (4.0+'s socket)
     specular_tint: tuple[float, float, float] = (1.0, 1.0, 1.0)  # 'principled': the layer's F0 tint
     layered: bool = True                                     # 'principled': 4.0+ (False: 3.x's sum)
     metallic: float = 0.0                                    # 'principled': Metallic (1: a metal of the base colour)
     emission: tuple[float, float, float] = (0.0, 0.0, 0.0)   # colour x strength, linear radiance
     emission_sampling: str = "AUTO"                           # Blender 4.x's names (3.x: AUTO or NONE)
+    fresnel: str = "microfacet"                              # 'glass': 4.0+'s per microfacet, 3.x's 'macro'
+    distribution: str = "ggx"                                # 'glass', 'refraction': or 'beckmann'
 
     def arguments(self, texture_id: int = -1) -> dict:
         """Keyword arguments of toyrt.Scene.add_material / set_material, with the texture's id."""
@@ -67,6 +70,10 @@ class MaterialSpec:
             args.update(roughness=self.roughness, shadowing=self.shadowing)
         if self.kind in ("glossy", "principled"):
             args.update(multiscatter=self.multiscatter)
+        if self.kind in ("glass", "refraction"):                    # rough when roughness > 0
+            args.update(roughness=self.roughness, shadowing=self.shadowing, distribution=self.distribution)
+        if self.kind == "glass":
+            args.update(fresnel=self.fresnel, multiscatter=self.multiscatter)
         if self.kind == "principled":
             args.update(specular_ior_level=self.specular_ior_level, specular_tint=self.specular_tint,
                         layered=self.layered, metallic=self.metallic)
@@ -270,11 +277,9 @@ def _convert_node(name, node, notes):
         emission = _emission(name, input_socket(node, "Color"), input_socket(node, "Strength"), notes)
         return MaterialSpec("diffuse", color=(0.0, 0.0, 0.0), emission=emission), None
     if t == "BSDF_REFRACTION":
-        _check_sharp(name, node, "Refraction", notes)
-        return MaterialSpec("refraction", ior=_ior(name, node, notes)), None
+        return dielectric_spec(name, node, "refraction", "Refraction", notes), None
     if t == "BSDF_GLASS":
-        _check_sharp(name, node, "Glass", notes)
-        return MaterialSpec("glass", ior=_ior(name, node, notes)), None
+        return dielectric_spec(name, node, "glass", "Glass", notes), None
     # Anything else: the colour it has, as a diffuse, else grey.
     color = input_socket(node, "Color", "Base Color")
     if color is not None and not color.is_linked and hasattr(color.default_value, "__len__"):
@@ -282,24 +287,6 @@ def _convert_node(name, node, notes):
         return _diffuse(rgb(color.default_value))
     notes.append(f"material '{name}': {node.bl_idname} (grey diffuse)")
     return _diffuse(DEFAULT_GREY)
-
-
-def _ior(name, node, notes):
-    sock = input_socket(node, "IOR")
-    if sock is None:
-        return 1.45
-    if sock.is_linked:
-        notes.append(f"material '{name}': linked IOR (its constant value)")
-    return float(sock.default_value)
-
-
-def _check_sharp(name, node, label, notes):
-    rough = input_socket(node, "Roughness")
-    if rough is not None and (rough.is_linked or rough.default_value > 0.0):
-        notes.append(f"material '{name}': rough {label} (sharp)")
-    color = input_socket(node, "Color")
-    if color is not None and (color.is_linked or tuple(color.default_value)[:3] != (1.0, 1.0, 1.0)):
-        notes.append(f"material '{name}': {label} tint (white)")
 
 
 def _blender_version() -> tuple:
@@ -378,7 +365,7 @@ def _principled(name, node, notes):
         rough = input_socket(node, "Roughness")
         if rough is not None and (rough.is_linked or rough.default_value > 0.0):
             notes.append(f"material '{name}': rough Principled transmission (sharp glass)")
-        return MaterialSpec("glass", ior=_ior(name, node, notes)), None
+        return MaterialSpec("glass", ior=ior_value(name, node, notes), roughness=0.0), None
     metal = input_socket(node, "Metallic")
     if metal is not None and not metal.is_linked and metal.default_value >= 0.999:
         return _metal(name, node, notes)

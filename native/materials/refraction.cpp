@@ -1,9 +1,12 @@
 #include "materials/refraction.h"
 
 #include "materials/fresnel.h"
+#include "materials/glossy.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace toyrt {
 namespace {
@@ -55,15 +58,62 @@ SpecularSample scatter_checked(const Vec3& wo, const Interface& f, bool want_ref
   return s;
 }
 
+DielectricRoughness checked_roughness(DielectricRoughness rough) {
+  if (!std::isfinite(rough.roughness)) throw std::invalid_argument("refraction: roughness must be finite");
+  rough.roughness = std::clamp(rough.roughness, 0.0f, 1.0f);
+  return rough;
+}
+
+DielectricRoughness roughness_from_params(const Params& params) {
+  const std::string distribution = params.text("distribution", "ggx");
+  if (distribution != "ggx" && distribution != "beckmann")
+    throw std::invalid_argument("refraction: distribution must be 'ggx' or 'beckmann', not '" + distribution + "'");
+  return {float(params.number("roughness", 0.0)), shadowing_from_params(params),
+          distribution == "ggx" ? MicrofacetDistribution::Ggx : MicrofacetDistribution::Beckmann};
+}
+
 }  // namespace
 
-PerfectRefraction PerfectRefraction::make(float ior) { return {checked_ior(ior)}; }
-FresnelDielectric FresnelDielectric::make(float ior) { return {checked_ior(ior)}; }
+PerfectRefraction PerfectRefraction::make(float ior, DielectricRoughness rough) {
+  return {checked_ior(ior), checked_roughness(rough)};
+}
+FresnelDielectric FresnelDielectric::make(float ior, DielectricRoughness rough, bool macro_fresnel, bool multiscatter) {
+  FresnelDielectric m{checked_ior(ior), checked_roughness(rough), macro_fresnel, -1};
+  if (!multiscatter) return m;
+  if (macro_fresnel || rough.distribution != MicrofacetDistribution::Ggx)
+    throw std::invalid_argument("glass: multiscatter needs distribution 'ggx' and fresnel 'microfacet'");
+  const float alpha = ggx_alpha(m.rough.roughness);
+  if (alpha >= kDielectricMinAlpha) m.albedo = shared_dielectric_albedo(alpha, m.ior, m.rough.shadowing);
+  return m;
+}
 PerfectRefraction PerfectRefraction::from_params(const Params& params) {
-  return make(float(params.positive("ior", PerfectRefraction{}.ior)));
+  return make(float(params.positive("ior", PerfectRefraction{}.ior)), roughness_from_params(params));
 }
 FresnelDielectric FresnelDielectric::from_params(const Params& params) {
-  return make(float(params.positive("ior", FresnelDielectric{}.ior)));
+  const std::string fresnel = params.text("fresnel", "microfacet");
+  if (fresnel != "microfacet" && fresnel != "macro")
+    throw std::invalid_argument("glass: fresnel must be 'microfacet' or 'macro', not '" + fresnel + "'");
+  return make(float(params.positive("ior", FresnelDielectric{}.ior)), roughness_from_params(params), fresnel == "macro",
+              params.flag("multiscatter", false));
+}
+
+bool rough_dielectric(const ShadingPoint& s, float ior, const DielectricRoughness& rough, DielectricKind kind,
+                      DielectricLobe* lobe) {
+  const float alpha = ggx_alpha(rough.roughness);
+  if (alpha < kDielectricMinAlpha || std::abs(ior - 1.0f) < 1e-4f) return false;
+  // The frame as a glossy lobe's (on wo's side, the geometric normal where wo is below the
+  // shading normal's tangent plane); which side wo is on decides eta.
+  const GlossyLobe g = oriented_lobe(s, rough.roughness, rough.shadowing);
+  lobe->frame = g.frame;
+  lobe->wo = g.wo;
+  lobe->alpha = alpha;
+  lobe->distribution = rough.distribution;
+  lobe->shadowing = rough.shadowing;
+  lobe->eta = glm::dot(s.wo, s.ng) > 0.0f ? ior : 1.0f / ior;
+  lobe->kind = kind;
+  lobe->fresnel_macro = kind == DielectricKind::Glass3x ? fresnel_dielectric(g.wo.z, lobe->eta) : 0.0f;
+  lobe->tint = Vec3(1.0f);
+  return true;
 }
 
 SpecularSample sample(const PerfectRefraction& m, const Vec3& wo, const Vec3& ng, const Vec3& ns) {
@@ -98,10 +148,19 @@ int split(const FresnelDielectric& m, const Vec3& wo, const Vec3& ng, const Vec3
 }
 
 Scatter scatter(const PerfectRefraction& m, const ShadingPoint& s, const MaterialContext&) {
+  DielectricLobe lobe;
+  if (rough_dielectric(s, m.ior, m.rough, DielectricKind::Refraction, &lobe)) return Scatter::dielectric_lobe(lobe);
   return Scatter::specular(sample(m, s.wo, s.ng, s.ns));
 }
 
 Scatter scatter(const FresnelDielectric& m, const ShadingPoint& s, const MaterialContext& ctx) {
+  DielectricLobe lobe;
+  if (rough_dielectric(s, m.ior, m.rough, m.macro_fresnel ? DielectricKind::Glass3x : DielectricKind::Glass, &lobe)) {
+    if (m.albedo >= 0)
+      lobe.tint =
+          Vec3(multiscatter_glass_scale(dielectric_albedo_table(m.albedo), glm::dot(s.wo, s.ng) > 0.0f, lobe.wo.z));
+    return Scatter::dielectric_lobe(lobe);
+  }
   if (!ctx.split) return Scatter::specular(sample(m, s.wo, s.ng, s.ns, ctx.uniform()));
   // Splitting: both branches, each weighted by its Fresnel term, instead of choosing one with
   // that probability. A light seen in a reflection with F = 0.04 is otherwise an all-or-nothing

@@ -13,35 +13,74 @@
 // on the geometrically right side, at the price of a small discontinuity where the fallback
 // starts.
 //
+// Roughness: above kDielectricMinAlpha (and for ior not within 1e-4 of 1, where refraction does not
+// bend and a transmission lobe would be a delta) both answer a rough dielectric lobe
+// (materials/dielectric_lobe.h, GGX or Beckmann, alpha = roughness^2) instead of specular branches; below it
+// the specular answer, which the lobe converges to (materials_test).
+//
 // No 1 / eta^2 radiance scaling is applied on refraction: Cycles applies none, and a closed
 // object scales by eta^2 entering and 1 / eta^2 leaving anyway.
 #pragma once
 
 #include "core/math.h"
 #include "core/params.h"
+#include "materials/dielectric_albedo.h"
 #include "materials/scatter.h"
 
 #include <cstdint>
 
 namespace toyrt {
 
+// Below this alpha a dielectric is specular: the lobe is within 0.06 degrees of the mirror and
+// refraction directions, and its D's peak (1 / (pi alpha^2) ~ 3e5) stays well inside float.
+inline constexpr float kDielectricMinAlpha = 1e-3f;
+
+// The rough lobe's settings, shared by both: roughness (0, clamped to [0, 1]; finite), shadowing
+// ('separable' 3.x, 'correlated' 4.0+), distribution ('ggx', 'beckmann': Cycles' names, lower case).
+struct DielectricRoughness {
+  float roughness = 0.0f;
+  GgxShadowing shadowing = GgxShadowing::Separable;
+  MicrofacetDistribution distribution = MicrofacetDistribution::Ggx;
+};
+
 // Parameters of both (add_material('refraction' or 'glass', ...)): ior (1.45, Blender's
-// default), positive and finite.
+// default), positive and finite; roughness and shadowing (DielectricRoughness); glass also
+// fresnel ('microfacet': Cycles 4.0+, the Fresnel term of each microfacet; 'macro': 3.x, the
+// shading normal's Fresnel term weighting a reflection and a refraction lobe).
 struct PerfectRefraction {
   static constexpr const char* kType = "refraction";
-  static constexpr const char* kParams = "ior (1.45): perfect refraction, Blender's Refraction BSDF";
+  static constexpr const char* kParams =
+      "ior (1.45), roughness (0; alpha = roughness^2), distribution ('ggx', 'beckmann'), shadowing\n"
+      "('separable' 3.x, 'correlated' 4.0+): refraction without reflection, Blender's Refraction BSDF";
   float ior = 1.45f;  // Blender's default; must be positive and finite
-  static PerfectRefraction make(float ior);
+  DielectricRoughness rough;
+  static PerfectRefraction make(float ior, DielectricRoughness rough = {});
   static PerfectRefraction from_params(const Params& params);
 };
 
 struct FresnelDielectric {
   static constexpr const char* kType = "glass";
-  static constexpr const char* kParams = "ior (1.45): Fresnel reflection and refraction, Blender's Glass BSDF";
+  static constexpr const char* kParams =
+      "ior (1.45), roughness (0; alpha = roughness^2), distribution ('ggx', 'beckmann'), shadowing\n"
+      "('separable' 3.x, 'correlated' 4.0+), fresnel ('microfacet' 4.0+, 'macro' 3.x), multiscatter (False;\n"
+      "4.0+'s Multiscatter GGX: GGX with fresnel 'microfacet' only): Fresnel reflection and refraction, Blender's\n"
+      "Glass BSDF";
   float ior = 1.45f;
-  static FresnelDielectric make(float ior);
+  DielectricRoughness rough;
+  bool macro_fresnel = false;
+  // Multiscatter GGX (materials/dielectric_albedo.h): the id of the lobe's albedo table over
+  // cos_o, made by make() (shared_dielectric_albedo); -1: single scattering (or a sharp material).
+  int32_t albedo = -1;
+  // Throws std::invalid_argument for multiscatter with Beckmann or the macro Fresnel (Cycles has none).
+  static FresnelDielectric make(float ior, DielectricRoughness rough = {}, bool macro_fresnel = false,
+                                bool multiscatter = false);
   static FresnelDielectric from_params(const Params& params);
 };
+
+// The rough lobe at a hit (frame and sides as refraction's: wo's side of the geometric normal
+// decides eta), or false when the material is specular there (kDielectricMinAlpha, ior ~ 1).
+bool rough_dielectric(const ShadingPoint& s, float ior, const DielectricRoughness& rough, DielectricKind kind,
+                      DielectricLobe* lobe);
 
 // Mirror of wo about n: 2 (wo . n) n - wo.
 inline Vec3 reflect(const Vec3& wo, const Vec3& n) { return 2.0f * glm::dot(wo, n) * n - wo; }

@@ -9,6 +9,7 @@
 #pragma once
 
 #include "core/math.h"
+#include "materials/dielectric_lobe.h"
 #include "materials/glossy_lobe.h"
 #include "materials/texture.h"
 #include "sampling/sobol_owen.h"
@@ -56,17 +57,20 @@ struct SpecularSample {
 
 struct Scatter {
   enum class Kind : uint8_t {
-    Diffuse,   // direct lighting with BRDF value f, then the path ends
-    Specular,  // the path continues along branches[0] with weight 1 (f / pdf = 1)
-    Split,     // each of the `count` branches is traced on its own, weighted by its probability
-    Glossy,    // lights sampled with MIS against `glossy`, then the path continues along its sample;
-               // a diffuse part f, if not 0, gets its direct light as a Diffuse answer does
+    Diffuse,     // direct lighting with BRDF value f, then the path ends
+    Specular,    // the path continues along branches[0] with weight 1 (f / pdf = 1)
+    Split,       // each of the `count` branches is traced on its own, weighted by its probability
+    Glossy,      // lights sampled with MIS against `glossy`, then the path continues along its sample;
+                 // a diffuse part f, if not 0, gets its direct light as a Diffuse answer does
+    Dielectric,  // a rough dielectric: lights sampled on both sides with MIS against `dielectric`,
+                 // then the path continues along its sample (reflected or transmitted)
   };
   Kind kind = Kind::Diffuse;
   Vec3 f{0.0f};  // Diffuse, and Glossy's diffuse part (0: none): for directions on wo's side
   int count = 0;
   SpecularSample branches[2];
   GlossyLobe glossy;
+  DielectricLobe dielectric;
 
   static Scatter diffuse(const Vec3& f) {
     Scatter s;
@@ -77,6 +81,12 @@ struct Scatter {
     Scatter s;
     s.kind = Kind::Glossy;
     s.glossy = lobe;
+    return s;
+  }
+  static Scatter dielectric_lobe(const DielectricLobe& lobe) {
+    Scatter s;
+    s.kind = Kind::Dielectric;
+    s.dielectric = lobe;
     return s;
   }
   static Scatter specular(const SpecularSample& branch) {

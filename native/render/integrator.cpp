@@ -2,6 +2,7 @@
 
 #include "geometry/offset_ray.h"
 #include "lights/light_selector.h"
+#include "render/dielectric_lighting.h"
 #include "render/glossy_lighting.h"
 #include "sampling/frame.h"
 #include "sampling/sobol_owen.h"
@@ -317,6 +318,20 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             bsdf_pdf = g.pdf;
             light_only = depth >= settings.max_specular_depth;
             ray = Ray{origin, 0.0f, g.wi, kInfinity};
+            return true;
+          }
+          if (sc.kind == Scatter::Kind::Dielectric) {
+            // Lamps on both sides, then a reflection or a transmission: as a glossy vertex, with
+            // the side chosen on the lobe-choice dimension.
+            const DielectricStep g = dielectric_vertex(
+                scene, s.p, ng, sc.dielectric, pixel, sample, vertex_dimension(depth, 1),
+                vertex_dimension(depth, kDimsPerVertex - 5), vertex_dimension(depth, kDimsPerVertex - 6), settings);
+            radiance += throughput * g.radiance;
+            if (!(g.pdf > 0.0f)) return false;
+            throughput *= g.weight;
+            bsdf_pdf = g.pdf;
+            light_only = depth >= settings.max_specular_depth;
+            ray = Ray{g.origin, 0.0f, g.wi, kInfinity};
             return true;
           }
           bsdf_pdf = 0.0f;  // a delta branch: no lamp was sampled here

@@ -245,6 +245,34 @@ def test_glossy_and_metal():
     check(px is not None and np.isfinite(px).all() and px[..., :3].mean() > 0, "and the image is lit and finite")
 
 
+def test_bad_glass():
+    clear_scene()
+    # A rough Beckmann Glass whose roughness is NaN and IOR 0, and a rough Refraction of IOR 1: both
+    # render, finite, with one note naming the NaN (roughness 0: sharp), the IOR below Cycles'
+    # floor (1e-5: a mirror) and the IOR 1 (nothing bends).
+    glass = kit.glass("bad_glass", 0.0)
+    node = next(n for n in glass.node_tree.nodes if n.type == "BSDF_GLASS")
+    node.distribution = "BECKMANN"
+    node.inputs["Roughness"].default_value = float("nan")
+    refraction, rnode = kit.surface("odd_refraction", "ShaderNodeBsdfRefraction")
+    rnode.distribution = "GGX"
+    rnode.inputs["Roughness"].default_value = 0.4
+    rnode.inputs["IOR"].default_value = 1.0
+    kit.plane("floor", 20.0, kit.diffuse("grey"))
+    kit.box("box", 1.5, (0.5, 0.3, 0.75), material=glass)
+    kit.box("box2", 1.0, (-2.0, -1.0, 1.0), material=refraction)
+    kit.point_light("lamp", (0, 0, 4), 300.0, radius=0.3)
+    kit.world((0.2, 0.2, 0.2))
+    camera()
+    result, px, log = render("glass")
+    warned = warnings_in(log)
+    w = warned[0] if warned else ""
+    check(result == {"FINISHED"} and len(warned) == 1 and "bad_glass" in w and "NaN" in w and "IOR 0" in w
+          and "odd_refraction" in w and "IOR 1" in w,
+          f"a NaN-rough glass of IOR 0 and a refraction of IOR 1: one note naming them: {warned[:1]}")
+    check(px is not None and np.isfinite(px).all() and px[..., :3].mean() > 0, "and the image is lit and finite")
+
+
 def test_library_linked():
     # A library file holding a cube object with its mesh and material, written by this Blender.
     basic_scene()
@@ -316,6 +344,7 @@ def test_100k_objects():
 
 
 PARTS = [test_empty_scene, test_no_camera, test_edges_and_points_only, test_zero_scale, test_nan_vertices,
-         test_far_from_origin, test_missing_image, test_unsupported_nodes, test_glossy_and_metal, test_library_linked,
+         test_far_from_origin, test_missing_image, test_unsupported_nodes, test_glossy_and_metal, test_bad_glass,
+         test_library_linked,
          test_100k_objects]
 run_script(PARTS, "bad scenes", TMP)

@@ -461,6 +461,47 @@ def test_principled_specular_layer():
           f"Metallic 0.4 is modelled (a mix of metal and dielectric): {h}")
 
 
+def test_rough_glass_and_refraction():
+    """Glass and Refraction BSDFs with roughness > 0 become rough dielectrics as the version's Cycles
+    shades them: the roughness and distribution kept (GGX, Beckmann), 3.x's Fresnel-weighted lobe
+    pair and separable masking, 4.0+'s Fresnel per microfacet and height-correlated masking;
+    Multiscatter GGX glass is 4.0+'s energy compensation, 3.x's single-scatter GGX with a note;
+    roughness 0 stays sharp."""
+    _, _ = addon()
+    from render_toyrt import materials
+
+    new = bpy.app.version >= (4, 0, 0)
+
+    def dielectric(name, shader, distribution, roughness):
+        mat, node = kit.surface(name, shader)
+        node.distribution = distribution
+        node.inputs["Roughness"].default_value = roughness
+        node.inputs["IOR"].default_value = 1.5
+        return materials.material_spec(mat)
+
+    ggx = dielectric("rough_ggx", "ShaderNodeBsdfGlass", "GGX", 0.3)
+    beck = dielectric("rough_beckmann", "ShaderNodeBsdfRefraction", "BECKMANN", 0.2)
+    multi = dielectric("rough_multi", "ShaderNodeBsdfGlass", "MULTI_GGX", 0.5)
+    sharp = dielectric("smooth", "ShaderNodeBsdfGlass", "GGX", 0.0)
+    g = ggx.spec
+    check(g.kind == "glass" and abs(g.roughness - 0.3) < 1e-6 and g.distribution == "ggx" and g.ior == 1.5
+          and g.fresnel == ("microfacet" if new else "macro") and g.shadowing == ("correlated" if new else "separable")
+          and not ggx.notes, f"a rough GGX Glass: {ggx}")
+    b = beck.spec
+    check(b.kind == "refraction" and abs(b.roughness - 0.2) < 1e-6 and b.distribution == "beckmann" and not beck.notes,
+          f"a rough Beckmann Refraction: {beck}")
+    if new:
+        check(multi.spec.kind == "glass" and multi.spec.distribution == "ggx" and multi.spec.multiscatter
+              and not multi.notes, f"Multiscatter GGX glass: 4.0+'s energy compensation: {multi}")
+    else:
+        check(multi.spec.kind == "glass" and not multi.spec.multiscatter and len(multi.notes) == 1
+              and "Multiscatter GGX" in multi.notes[0], f"3.x's Multiscatter GGX glass: single-scatter, noted: {multi}")
+    check(sharp.spec.kind == "glass" and sharp.spec.roughness == 0.0 and not sharp.notes, f"roughness 0: {sharp}")
+    args = ggx.spec.arguments()
+    check(args["roughness"] == g.roughness and args["distribution"] == "ggx" and "fresnel" in args,
+          f"and the core gets them: {args}")
+
+
 # ---- 5. cancel and threads ------------------------------------------------------------------------
 
 def os_threads():
@@ -592,6 +633,6 @@ def test_command_line_range():
 
 
 PARTS = [test_counts_and_transforms, test_instancing_memory, test_missing_texture, test_unsupported_node,
-         test_principled_specular_layer, test_cancel,
+         test_principled_specular_layer, test_rough_glass_and_refraction, test_cancel,
          test_animation, test_command_line_range]
 run_script(PARTS, "export", TMP)

@@ -44,8 +44,8 @@ def test_unknown_light_type_lists_the_known_ones():
 def test_unknown_keyword_is_named():
     with pytest.raises(TypeError, match="unknown argument 'powr' for a POINT light"):
         toyrt.Scene().add_light("POINT", position=(0, 0, 1), powr=10.0)
-    with pytest.raises(TypeError, match="unknown argument 'roughness' for a glass material"):
-        toyrt.Scene().add_material("glass", roughness=0.1)
+    with pytest.raises(TypeError, match="unknown argument 'metallic' for a glass material"):
+        toyrt.Scene().add_material("glass", roughness=0.1, metallic=1.0)
 
 
 def test_unknown_material_kind_lists_the_known_ones():
