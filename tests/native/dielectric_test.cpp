@@ -25,6 +25,8 @@ using namespace toyrt;
 using toyrt::testing::chi_square_quantile;
 using toyrt::testing::direction;
 using toyrt::testing::hemisphere_integral;
+using toyrt::testing::pooled_chi_square;
+using toyrt::testing::PooledChiSquare;
 
 namespace {
 
@@ -163,22 +165,8 @@ TEST(Dielectric, PdfIntegratesToTheSamplersMassAndItsHistogramMatches) {
           const double sampled_mass = 1.0 - counts.back() / kSamples;
           EXPECT_NEAR(mass, sampled_mass, 5e-3) << "kind " << int(kind) << " alpha " << alpha << " eta " << eta;
           expected.back() = std::max(0.0, 1.0 - mass) * kSamples;
-          double chi2 = 0.0, pooled_count = 0.0, pooled_expected = 0.0;
-          int bins = 0;
-          for (size_t c = 0; c < counts.size(); ++c) {
-            if (expected[c] < 5.0) {
-              pooled_count += counts[c];
-              pooled_expected += expected[c];
-              continue;
-            }
-            chi2 += (counts[c] - expected[c]) * (counts[c] - expected[c]) / expected[c];
-            ++bins;
-          }
-          if (pooled_expected >= 5.0) {
-            chi2 += (pooled_count - pooled_expected) * (pooled_count - pooled_expected) / pooled_expected;
-            ++bins;
-          }
-          EXPECT_LT(chi2, chi_square_quantile(bins - 1, 1e-4))
+          const PooledChiSquare t = pooled_chi_square(counts, expected);
+          EXPECT_LT(t.chi2, chi_square_quantile(t.bins - 1, 1e-4))
               << "distribution " << int(dist) << " kind " << int(kind) << " alpha " << alpha << " eta " << eta;
         }
       }

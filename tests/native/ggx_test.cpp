@@ -22,6 +22,8 @@ using namespace toyrt;
 using toyrt::testing::chi_square_quantile;
 using toyrt::testing::direction;
 using toyrt::testing::hemisphere_integral;
+using toyrt::testing::pooled_chi_square;
+using toyrt::testing::PooledChiSquare;
 
 namespace {
 
@@ -83,24 +85,9 @@ TEST(Ggx, SamplerMatchesItsPdfChiSquare) {
         const int j = std::min(kPhi - 1, int(phi / (2.0 * M_PI) * kPhi));
         counts[size_t(i * kPhi + j)] += 1.0;
       }
-      double chi2 = 0.0, pooled_count = 0.0, pooled_expected = 0.0;
-      int bins = 0;
-      for (size_t c = 0; c < counts.size(); ++c) {
-        if (expected[c] < 5.0) {
-          pooled_count += counts[c];
-          pooled_expected += expected[c];
-          continue;
-        }
-        chi2 += (counts[c] - expected[c]) * (counts[c] - expected[c]) / expected[c];
-        ++bins;
-      }
-      if (pooled_expected >= 5.0) {
-        chi2 += (pooled_count - pooled_expected) * (pooled_count - pooled_expected) / pooled_expected;
-        ++bins;
-      } else {
-        EXPECT_LT(pooled_count, 20.0) << "samples where the pdf says there are none";
-      }
-      EXPECT_LT(chi2, chi_square_quantile(bins - 1, 1e-4)) << "alpha " << alpha << " theta_o " << theta_o;
+      const PooledChiSquare t = pooled_chi_square(counts, expected);
+      if (t.pooled_expected < 5.0) EXPECT_LT(t.pooled_count, 20.0) << "samples where the pdf says there are none";
+      EXPECT_LT(t.chi2, chi_square_quantile(t.bins - 1, 1e-4)) << "alpha " << alpha << " theta_o " << theta_o;
     }
   }
 }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cmath>
+#include <vector>
 
 namespace toyrt::testing {
 
@@ -23,6 +24,34 @@ inline double chi_square_quantile(int k, double alpha) {
   const double v = 2.0 / (9.0 * k);
   const double c = 1.0 - v + normal_upper_quantile(alpha) * std::sqrt(v);
   return k * c * c * c;
+}
+
+// Pearson's statistic of observed `counts` against `expected` counts per bin, with the bins
+// expecting fewer than 5 pooled into one (the test's usual validity rule): the statistic, the
+// number of bins it sums (degrees of freedom + 1) and what the pooled bins saw and expected
+// (the pool joins the sum only when it expects 5 or more).
+struct PooledChiSquare {
+  double chi2 = 0.0;
+  int bins = 0;
+  double pooled_count = 0.0, pooled_expected = 0.0;
+};
+
+inline PooledChiSquare pooled_chi_square(const std::vector<double>& counts, const std::vector<double>& expected) {
+  PooledChiSquare r;
+  for (size_t c = 0; c < counts.size(); ++c) {
+    if (expected[c] < 5.0) {
+      r.pooled_count += counts[c];
+      r.pooled_expected += expected[c];
+      continue;
+    }
+    r.chi2 += (counts[c] - expected[c]) * (counts[c] - expected[c]) / expected[c];
+    ++r.bins;
+  }
+  if (r.pooled_expected >= 5.0) {
+    r.chi2 += (r.pooled_count - r.pooled_expected) * (r.pooled_count - r.pooled_expected) / r.pooled_expected;
+    ++r.bins;
+  }
+  return r;
 }
 
 }  // namespace toyrt::testing
