@@ -6,6 +6,7 @@ it in vendor/ beside this file (scripts/vendor-pyoidn.py); the extension install
 wheels. pyoidn is optional: without it the render is returned as it is and the caller notes it."""
 from __future__ import annotations
 
+import functools
 import os
 import sys
 
@@ -17,8 +18,10 @@ VENDOR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "vendor")
 AUXILIARIES = ("diffuse_color", "normal")
 
 
+@functools.cache
 def available() -> str | None:
-    """None when the denoiser loads, else why it does not (for the one note)."""
+    """None when the denoiser loads, else why it does not (for the one note). Asked once per
+    session: the viewport asks at every draw, and a failed import would search the path each time."""
     # First on the path: the vendored cffi must meet its own compiled half, not a system's
     # (Debian has python3-cffi-backend 1.15 without the cffi package).
     if os.path.isdir(VENDOR) and VENDOR not in sys.path:

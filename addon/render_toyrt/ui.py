@@ -63,17 +63,24 @@ class RENDER_PT_toyrt_sampling_viewport(ToyrtRenderPanel, bpy.types.Panel):
         layout.prop(settings, "viewport_samples", text="Max Samples")
 
 
-class RENDER_PT_toyrt_sampling_viewport_denoise(ToyrtRenderPanel, bpy.types.Panel):
+class ToyrtDenoisePanel(ToyrtRenderPanel):
+    """A Denoise sub-panel, its switch in the header as Cycles' are: `setting` names the switch,
+    `what` says what it denoises."""
     bl_label = "Denoise"
-    bl_parent_id = "RENDER_PT_toyrt_sampling_viewport"
-    bl_options = {"DEFAULT_CLOSED"}
+    setting = what = ""
 
     def draw_header(self, context):
-        self.layout.prop(context.scene.toyrt, "use_preview_denoising", text="")
+        self.layout.prop(context.scene.toyrt, self.setting, text="")
 
     def draw_settings(self, layout, settings):
-        layout.active = settings.use_preview_denoising
-        layout.label(text="Open Image Denoise, after each pass")
+        layout.active = getattr(settings, self.setting)
+        layout.label(text=self.what)
+
+
+class RENDER_PT_toyrt_sampling_viewport_denoise(ToyrtDenoisePanel, bpy.types.Panel):
+    bl_parent_id = "RENDER_PT_toyrt_sampling_viewport"
+    bl_options = {"DEFAULT_CLOSED"}
+    setting, what = "use_preview_denoising", "Open Image Denoise, after each pass"
 
 
 class RENDER_PT_toyrt_sampling_render(ToyrtRenderPanel, bpy.types.Panel):
@@ -93,16 +100,9 @@ class RENDER_PT_toyrt_sampling_render(ToyrtRenderPanel, bpy.types.Panel):
         layout.prop(settings, "time_limit", text="Time Limit")
 
 
-class RENDER_PT_toyrt_sampling_render_denoise(ToyrtRenderPanel, bpy.types.Panel):
-    bl_label = "Denoise"
+class RENDER_PT_toyrt_sampling_render_denoise(ToyrtDenoisePanel, bpy.types.Panel):
     bl_parent_id = "RENDER_PT_toyrt_sampling_render"
-
-    def draw_header(self, context):
-        self.layout.prop(context.scene.toyrt, "use_denoising", text="")
-
-    def draw_settings(self, layout, settings):
-        layout.active = settings.use_denoising
-        layout.label(text="Open Image Denoise, albedo and normal")
+    setting, what = "use_denoising", "Open Image Denoise, albedo and normal"
 
 
 class RENDER_PT_toyrt_sampling_lights(ToyrtRenderPanel, bpy.types.Panel):
