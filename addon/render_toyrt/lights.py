@@ -59,10 +59,12 @@ class AreaLightSpec:
     power: float                            # watts, in Blender 3.x's units (light_power)
     color: Vec3
     visibility: Visibility = Visibility()
+    spread: float = np.pi                   # radians; pi: no slats (Blender's default)
 
     def arguments(self) -> dict:
         return dict(matrix=np.array(self.matrix, np.float64), shape=self.shape, size=self.size,
-                    size_y=self.size_y, power=self.power, color=self.color, **self.visibility.arguments())
+                    size_y=self.size_y, power=self.power, color=self.color, spread=self.spread,
+                    **self.visibility.arguments())
 
 
 @dataclass(frozen=True)
@@ -146,10 +148,8 @@ def light_spec(obj, matrix: np.ndarray) -> tuple[LightSpec | None, tuple[str, ..
             return None, tuple(notes)  # a portal only guides Cycles' world sampling; it emits nothing
         shape = light.shape
         size_y = float(light.size_y) if shape in ("RECTANGLE", "ELLIPSE") else None
-        if float(getattr(light, "spread", np.pi)) < np.pi - 1e-6:
-            notes.append(f"area light '{obj.name}': spread (rendered as 180 degrees)")
-        return (AreaLightSpec(_rows(matrix), shape, float(light.size), size_y, power, color, visibility),
-                tuple(notes))
+        return (AreaLightSpec(_rows(matrix), shape, float(light.size), size_y, power, color, visibility,
+                              _spread(obj.name, light, cycles4, notes)), tuple(notes))
     if light.type == "SPOT":
         return (SpotLightSpec(_rows(matrix), power, color, float(light.shadow_soft_size), soft,
                               float(light.spot_size), float(light.spot_blend),
@@ -175,6 +175,25 @@ def light_color(light) -> Vec3:
     if getattr(light, "use_temperature", False):
         color = tuple(a * b for a, b in zip(color, rgb(light.temperature_color)))
     return color
+
+
+# Cycles 3.x renders a spread of at least 1 degree; 4.0+ takes any, 0 being a parallel beam.
+_MIN_SPREAD = np.radians(1.0)
+
+
+def _spread(name: str, light, cycles4: bool, notes: list) -> float:
+    """The area light's spread for the core (lights/area_spread.h: the beam of a soft box's slats,
+    the same function in Cycles 3.x and 4.x+), at least 1 degree: Cycles 3.x's own floor, and on
+    4.0+, where a smaller one is allowed, a note."""
+    spread = float(getattr(light, "spread", np.pi))
+    if not np.isfinite(spread):
+        notes.append(f"area light '{name}': spread is not a number (180 degrees)")
+        return float(np.pi)
+    if spread < _MIN_SPREAD:
+        if cycles4:
+            notes.append(f"area light '{name}': spread below 1 degree (rendered as 1 degree)")
+        return float(_MIN_SPREAD)
+    return min(spread, float(np.pi))
 
 
 def light_power(light, matrix: np.ndarray) -> float:

@@ -18,19 +18,44 @@ bool use_solid_angle(const AreaLight& light, AreaSampling sampling) {
   return sampling == AreaSampling::SolidAngle && light.is_rectangle();
 }
 
-// Density of area sampling, converted to solid angle.
-float area_pdf(const AreaLight& light, float distance, float cos_light) {
-  return distance * distance / (light.area * cos_light);
+// Density of area sampling over `area`, converted to solid angle.
+float area_pdf(float area, float distance, float cos_light) { return distance * distance / (area * cos_light); }
+
+// The part of the light that sample() draws from for shading point p at `height` over its plane:
+// the whole light, or for a rectangle with a spread the part within spread.reach(height) of p's
+// foot on the plane (f = 0 beyond it). evaluate() rebuilds the same region for its density.
+struct Region {
+  Vec3 center, edge_x, edge_y;
+  float area;
+  Vec3 corner() const { return center - 0.5f * edge_x - 0.5f * edge_y; }
+};
+
+// False when a spread leaves nothing of the light that reaches p.
+bool sampled_region(const AreaLight& light, const Vec3& p, float height, Region& r) {
+  r = {light.center, light.edge_x, light.edge_y, light.area};
+  if (!light.spread.active || !light.is_rectangle()) return true;
+  const float lx = glm::length(light.edge_x), ly = glm::length(light.edge_y);
+  const Vec3 ux = light.edge_x / lx, uy = light.edge_y / ly;
+  const Vec3 foot = p - height * light.normal - light.center;
+  const float reach = light.spread.reach(height), cu = glm::dot(foot, ux), cv = glm::dot(foot, uy);
+  const float u0 = std::max(cu - reach, -0.5f * lx), u1 = std::min(cu + reach, 0.5f * lx);
+  const float v0 = std::max(cv - reach, -0.5f * ly), v1 = std::min(cv + reach, 0.5f * ly);
+  if (!(u0 < u1 && v0 < v1)) return false;
+  r = {light.center + 0.5f * (u0 + u1) * ux + 0.5f * (v0 + v1) * uy, (u1 - u0) * ux, (v1 - v0) * uy,
+       (u1 - u0) * (v1 - v0)};
+  return true;
 }
 
 }  // namespace
 
-AreaLight AreaLight::make(AreaShape shape, float size, float size_y, const Mat4& m, float power, const Vec3& color) {
+AreaLight AreaLight::make(AreaShape shape, float size, float size_y, const Mat4& m, float power, const Vec3& color,
+                          float spread) {
   const bool square = shape == AreaShape::Square || shape == AreaShape::Disk;
   const float sx = size, sy = square ? size : size_y;
   require(std::isfinite(sx) && std::isfinite(sy) && sx > 0.0f && sy > 0.0f, "size must be positive and finite");
   require(std::isfinite(power) && power >= 0.0f, "power must be finite and >= 0 W");
   require(is_finite(color) && !glm::any(glm::lessThan(color, Vec3(0.0f))), "colour must be finite and >= 0");
+  require(std::isfinite(spread) && spread > 0.0f, "spread must be a positive angle in radians (pi: no slats)");
   check_light_matrix(m, "area light");
   const Vec3 ax(m[0]), ay(m[1]), az(m[2]);
   const float lx = glm::length(ax), ly = glm::length(ay), lz = glm::length(az);
@@ -49,6 +74,7 @@ AreaLight AreaLight::make(AreaShape shape, float size, float size_y, const Mat4&
   const float rect_area = (sx * lx) * (sy * ly);
   light.area = light.is_rectangle() ? rect_area : 0.25f * kPi * rect_area;
   light.radiance = power * color / (4.0f * light.area);
+  light.spread = AreaSpread::make(spread);
   return light;
 }
 
@@ -62,17 +88,21 @@ AreaLight AreaLight::from_params(const Params& params) {
   const float size_y = float(params.number("size_y", size));
   const float power = float(params.non_negative("power", d.power));
   const Vec3 color = params.color("color", d.color);
-  return make(shape, size, size_y, matrix, power, color);
+  const float spread = float(params.positive("spread", d.spread));
+  return make(shape, size, size_y, matrix, power, color, spread);
 }
 
 LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u, const LightContext& ctx) {
   LightSample s;
-  if (!(glm::dot(p - light.center, light.normal) > 0.0f)) return s;  // one-sided
+  const float height = glm::dot(p - light.center, light.normal);
+  if (!(height > 0.0f)) return s;  // one-sided
+  Region region;
+  if (!sampled_region(light, p, height, region)) return s;
   float pdf = 0.0f;
   Vec3 q;
   bool by_area = true;
   if (use_solid_angle(light, ctx.area_sampling)) {
-    const SphericalRectangle rect = SphericalRectangle::make(p, light.corner(), light.edge_x, light.edge_y);
+    const SphericalRectangle rect = SphericalRectangle::make(p, region.corner(), region.edge_x, region.edge_y);
     if (rect.solid_angle >= SphericalRectangle::kMinSolidAngle) {
       q = rect.sample(u);
       pdf = float(1.0 / rect.solid_angle);
@@ -81,7 +111,7 @@ LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u, const L
   }
   if (by_area) {
     const Vec2 local = light.is_rectangle() ? u - Vec2(0.5f) : 0.5f * sample_uniform_disk_concentric(u);
-    q = light.center + local.x * light.edge_x + local.y * light.edge_y;
+    q = region.center + local.x * region.edge_x + local.y * region.edge_y;
   }
   const Vec3 to_light = q - p;
   const float distance = glm::length(to_light);
@@ -89,11 +119,13 @@ LightSample sample(const AreaLight& light, const Vec3& p, const Vec2& u, const L
   const Vec3 wi = to_light / distance;
   const float cos_light = -glm::dot(wi, light.normal);
   if (!(cos_light > 0.0f)) return s;
+  const float slats = light.spread.factor(wi, light.normal);
+  if (!(slats > 0.0f)) return s;  // beyond the spread: no shadow ray for nothing
   s.point = q;
   s.wi = wi;
   s.distance = distance;
-  s.radiance = light.radiance;
-  s.pdf = by_area ? area_pdf(light, distance, cos_light) : pdf;
+  s.radiance = light.radiance * slats;
+  s.pdf = by_area ? area_pdf(region.area, distance, cos_light) : pdf;
   return s;
 }
 
@@ -108,11 +140,14 @@ LightEval evaluate(const AreaLight& light, const Vec3& p, const Vec3& wi, const 
   const float b = glm::dot(offset, light.edge_y) / glm::dot(light.edge_y, light.edge_y);
   const bool inside = light.is_rectangle() ? std::fabs(a) <= 0.5f && std::fabs(b) <= 0.5f : a * a + b * b <= 0.25f;
   if (!inside) return e;
-  e.radiance = light.radiance;
+  const float slats = light.spread.factor(wi, light.normal);
+  Region region;
+  if (!(slats > 0.0f) || !sampled_region(light, p, height, region)) return e;
+  e.radiance = light.radiance * slats;
   e.distance = t;
-  e.pdf = area_pdf(light, t, cos_light);
+  e.pdf = area_pdf(region.area, t, cos_light);
   if (use_solid_angle(light, ctx.area_sampling)) {
-    const double omega = SphericalRectangle::make(p, light.corner(), light.edge_x, light.edge_y).solid_angle;
+    const double omega = SphericalRectangle::make(p, region.corner(), region.edge_x, region.edge_y).solid_angle;
     if (omega >= SphericalRectangle::kMinSolidAngle) e.pdf = float(1.0 / omega);
   }
   return e;
@@ -143,7 +178,8 @@ float importance(const AreaLight& light, const Vec3& p, const Vec3& n) {
     if (cos_receive <= 0.0f) return 0.0f;
   }
   const float mean_intensity = (light.radiance.x + light.radiance.y + light.radiance.z) / 3.0f * light.area;
-  return mean_intensity * cos_emit * cos_receive / std::max(d2, r2);
+  // The slats' f is largest at the smallest angle, whose cosine cos_emit bounds.
+  return mean_intensity * light.spread.at_cos(cos_emit) * cos_emit * cos_receive / std::max(d2, r2);
 }
 
 LightBounds bounds(const AreaLight& light) {
@@ -152,7 +188,8 @@ LightBounds bounds(const AreaLight& light) {
   for (const Vec3& q : {c, c + light.edge_x, c + light.edge_y, c + light.edge_x + light.edge_y}) b.box.extend(q);
   b.axis = light.normal;
   b.theta_o = 0.0f;
-  b.power = (light.radiance.x + light.radiance.y + light.radiance.z) / 3.0f * light.area;
+  b.theta_e = light.spread.half_angle();
+  b.power = (light.radiance.x + light.radiance.y + light.radiance.z) / 3.0f * light.area * light.spread.peak();
   return b;
 }
 

@@ -13,10 +13,12 @@
 //
 // Parameters (add_light('AREA', ...), Blender's names): matrix (the object's (4, 4) world
 // matrix, identity), shape ('SQUARE'), size (1 m), size_y (size; RECTANGLE and ELLIPSE only,
-// accepted and ignored otherwise), power (10 W), color ((1, 1, 1)): AreaLight::Settings.
+// accepted and ignored otherwise), power (10 W), color ((1, 1, 1)), spread (radians, pi: no slats;
+// lights/area_spread.h): AreaLight::Settings.
 #pragma once
 
 #include "core/params.h"
+#include "lights/area_spread.h"
 #include "lights/light_bounds.h"
 #include "lights/light_context.h"
 #include "lights/light_sample.h"
@@ -33,7 +35,7 @@ struct AreaLight {
   static constexpr const char* kParams =
       "matrix ((4, 4) world matrix, identity; emits along local -Z), shape ('RECTANGLE', 'SQUARE', 'DISK',\n"
       "    'ELLIPSE'; 'SQUARE'), size (m, 1), size_y (m, size; RECTANGLE and ELLIPSE), power (W, 10),\n"
-      "    color (linear RGB, (1, 1, 1))";
+      "    color (linear RGB, (1, 1, 1)), spread (radians > 0; pi: no slats)";
 
   // Blender's settings, with the defaults of a new area light: a 1 m square of 10 W, white.
   struct Settings {
@@ -43,6 +45,7 @@ struct AreaLight {
     float size_y = 1.0f;  // m, RECTANGLE and ELLIPSE only; from_params defaults it to size
     float power = 10.0f;  // W
     Vec3 color{1.0f};
+    float spread = kPi;  // radians; pi: a plain light
   };
 
   AreaShape shape = AreaShape::Rectangle;
@@ -51,13 +54,15 @@ struct AreaLight {
   Vec3 normal{0.0f, 0.0f, -1.0f};                           // unit, the emitting side
   float area = 1.0f;                                        // m^2 (pi/4 |edge_x| |edge_y| for disks and ellipses)
   Vec3 radiance{0.0f};                                      // L = P colour / (4 area), W / (m^2 sr)
+  AreaSpread spread;                                        // radiance x spread.factor(cos) in each direction
 
   // Blender's settings: shape; size (and size_y for RECTANGLE and ELLIPSE; SQUARE and DISK use
   // size for both, a disk's size being its diameter); the object's world matrix; power (W);
-  // colour. Throws std::invalid_argument for non-positive sizes, negative power or colour, a
-  // non-finite or non-affine matrix, a zero or sheared scale (the light must stay a rectangle).
+  // colour; spread (at or above pi: no slats). Throws std::invalid_argument for non-positive sizes,
+  // negative power or colour, a spread that is not a positive number, a non-finite or non-affine matrix, a zero or
+  // sheared scale (the light must stay a rectangle).
   static AreaLight make(AreaShape shape, float size, float size_y, const Mat4& matrix_world, float power,
-                        const Vec3& color);
+                        const Vec3& color, float spread = kPi);
   // From Params named as Settings' members (shape as Blender's name); size_y defaults to size.
   static AreaLight from_params(const Params& params);
 

@@ -225,21 +225,22 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       .def(
           "add_area_light",
           [](PyScene& self, py::handle matrix, const std::string& shape, float size, py::handle size_y, float power,
-             py::handle color, bool visible_camera, bool visible_specular) {
+             py::handle color, float spread, bool visible_camera, bool visible_specular) {
             Params p;
             p.set("matrix", to_matrix(matrix, "matrix")).set("shape", shape).set("size", double(size));
             if (!size_y.is_none()) p.set("size_y", double(size_y.cast<float>()));
-            p.set("power", double(power)).set("color", to_vec3(color, "color"));
+            p.set("power", double(power)).set("color", to_vec3(color, "color")).set("spread", double(spread));
             return self.add_light(AreaLight::kType, p, {visible_camera, visible_specular});
           },
           py::arg("matrix"), py::arg("shape") = area_shape_name(AreaLight::Settings{}.shape),
           py::arg("size") = AreaLight::Settings{}.size, py::arg("size_y") = py::none(),
           py::arg("power") = AreaLight::Settings{}.power, py::arg("color") = as_tuple(AreaLight::Settings{}.color),
-          py::arg("visible_camera") = LightVisibility{}.camera,
+          py::arg("spread") = AreaLight::Settings{}.spread, py::arg("visible_camera") = LightVisibility{}.camera,
           py::arg("visible_specular") = LightVisibility{}.specular,
           "Adds an area light in Blender's units: the light object's (4, 4) world matrix (it emits along its\n"
           "local -Z, one-sided), shape 'RECTANGLE', 'SQUARE', 'DISK' or 'ELLIPSE', size (and size_y) in metres,\n"
-          "power in watts (radiance = power / (4 area), as Cycles). visible_camera / visible_specular: whether\n"
+          "power in watts (radiance = power / (4 area), as Cycles), spread in radians (pi: none; the beam of a\n"
+          "soft box's slats, as Cycles). visible_camera / visible_specular: whether\n"
           "camera rays / rays through glass see the light's surface (Cycles' defaults: both).\n"
           "The same as add_light('AREA', ...).")
       .def_property("background", &PyScene::background, &PyScene::set_background,

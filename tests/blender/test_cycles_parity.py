@@ -390,6 +390,19 @@ SCENES_SPEC.append(("sky_preetham", scene_sky_preetham, dict(sun=(0.5, -0.4, 0.7
                                                              camera=(0.0, -6.0, 1.2), mean_limit=0.005,
                                                              sample_factor=2), 0))
 
+
+# An area light's spread (issue 13): a soft box whose slats narrow its beam to 30 degrees, so it
+# lights a pool on the floor with a soft rim and the box beside it from one side only. Cycles 3.x
+# and 4.0+ write the same function of the angle (lights/area_spread.h), asserted on each.
+def scene_area_spread(p):
+    scene_area(p)
+    bpy.data.objects["panel"].data.spread = p["spread"]
+
+
+SCENES_SPEC.append(("area_spread", scene_area_spread,
+                    dict(light=(-0.5, 0.5, 2.2), light_target=(0.3, 0.0, 0.0), power=150.0, size=2.0, size_y=1.2,
+                         spread=0.5236, camera=(0.0, -6.0, 4.5), mean_limit=0.005, sample_factor=8), 0))
+
 # ---- Cycles ------------------------------------------------------------------------------------
 
 def render_cycles(scene, path):

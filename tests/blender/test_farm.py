@@ -4,7 +4,7 @@
 # and by Cycles. Every regular expression of those managers' parsers that Cycles' output matches
 # on this Blender must match TOYRT's too; the last Sample line of a frame says N/N; nothing trips
 # Deadline Cloud's strict mode although the scene has what TOYRT approximates (a Principled BSDF,
-# an area light's spread) and the SAH builder stands in for a missing OpenCL; the exit codes with and without
+# a Diffuse BSDF's roughness) and the SAH builder stands in for a missing OpenCL; the exit codes with and without
 # -E TOYRT where the add-on is missing; the longest silence while a large mesh is exported and
 # its BVH built. The command lines run against a copy of the installed add-on in an empty user
 # folder, as on a fresh farm worker; under the bpy module (no blender executable,
@@ -44,15 +44,15 @@ MEASURED = {}  # what the docs quote, printed at the end
 
 
 def build_scene(engine, path, builder="sah"):
-    """A 32 x 32 view of a Principled BSDF plane (TOYRT: its Lambert base) under a point light, with
-    an area light of 60 degree spread (TOYRT: 180 degrees), three frames, PNG output; saved to
-    `path` for `engine`."""
+    """A 32 x 32 view of a rough Diffuse BSDF plane (TOYRT: Lambert, noted) under a point light and
+    an area light, three frames, PNG output; saved to `path` for `engine`."""
     s = kit.clear_scene()
     # The material's name carries one of the strict-mode words into TOYRT's note on purpose.
-    kit.plane("floor", 10.0, kit.principled("WarningStripes", (0.8, 0.6, 0.2)))
+    floor = kit.diffuse("WarningStripes", (0.8, 0.6, 0.2))
+    kit.input_of(floor.node_tree.nodes["Diffuse BSDF"], "Roughness").default_value = 0.5
+    kit.plane("floor", 10.0, floor)
     kit.point_light("lamp", (0, 0, 1), 100.0)
-    panel = kit.area_light("panel", (0, 0, 2), 50.0, 0.5)
-    panel.data.spread = 1.047
+    kit.area_light("panel", (0, 0, 2), 50.0, 0.5)
     kit.camera((0, 0, 5), ortho_scale=2.0)
     kit.output(s, 32, 32)
     if engine == "CYCLES":
@@ -89,7 +89,7 @@ def compare(label, toyrt_lines, cycles_lines, frames):
         check(mine and not odd, f"{label}: TOYRT's Sample lines have Cycles' layout: {(odd or mine)[-1:]}")
     strict = [line for line in toyrt_lines if STRICT.match(line)]
     notes = [line for line in toyrt_lines if line.startswith("TOYRT note: approximated")]
-    check(not strict and len(notes) == len(frames) and "spread" in notes[0],
+    check(not strict and len(notes) == len(frames) and "roughness" in notes[0],
           f"{label}: one 'TOYRT note:' per frame, no line trips strict mode: {strict[:2] or notes[:1]}")
 
 

@@ -323,6 +323,12 @@ def test_zero_size_area_light_is_refused(size, size_y):
             "size must be positive and finite")
 
 
+@pytest.mark.parametrize("spread", [0.0, -0.5, float("nan"), float("inf")])
+def test_area_light_spread_that_is_not_a_positive_angle_is_refused(spread):
+    refused(lambda: toyrt.Scene().add_area_light(np.eye(4), spread=spread), ValueError, "spread must be positive")
+    refused(lambda: toyrt.Scene().add_light("AREA", matrix=np.eye(4), spread=spread), ValueError, "spread")
+
+
 def test_zero_power_light_is_accepted_and_lights_nothing():
     s = toyrt.Scene()
     s.add_mesh(np.float32([[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]]), [[0, 1, 2], [0, 2, 3]])
