@@ -146,13 +146,17 @@ def write_ply(path, positions, normals, uvs):
 
 
 def material_description(mat, out_dir):
-    """The subset of node materials the bench scenes use: Diffuse BSDF (colour or image), Glass."""
+    """The subset of node materials the bench scenes use: Diffuse BSDF (colour or image), Glass,
+    Emission (colour x strength)."""
     if mat is None or not mat.use_nodes:
         return dict(type="diffuse", color=[0.8, 0.8, 0.8])
     out = next(n for n in mat.node_tree.nodes if n.type == "OUTPUT_MATERIAL")
     bsdf = out.inputs["Surface"].links[0].from_node
     if bsdf.type == "BSDF_GLASS":
         return dict(type="glass", ior=bsdf.inputs["IOR"].default_value)
+    if bsdf.type == "EMISSION":
+        return dict(type="emission", color=list(bsdf.inputs["Color"].default_value)[:3],
+                    strength=bsdf.inputs["Strength"].default_value)
     color = bsdf.inputs["Color"]
     if color.is_linked and color.links[0].from_node.type == "TEX_IMAGE":
         image = color.links[0].from_node.image
@@ -168,6 +172,30 @@ def material_description(mat, out_dir):
     return dict(type="diffuse", color=list(color.default_value)[:3])
 
 
+def world_description(scene, out_dir):
+    """A plain world's colour, or an Environment Texture's image (rows from the top, as Mitsuba's
+    bitmaps) with the matrix taking world directions to the map's frame (the add-on's own reading of
+    a Mapping node) and the Background's strength; None without a world."""
+    if scene.world is None or not scene.world.use_nodes:
+        return None
+    background = scene.world.node_tree.nodes["Background"]
+    color = background.inputs["Color"]
+    if not color.is_linked:
+        return list(color.default_value)[:3]
+    node = color.links[0].from_node
+    if node.type != "TEX_ENVIRONMENT":
+        raise ValueError(f"world colour from {node.bl_idname} is not converted for Mitsuba")
+    from render_toyrt.world import mapping_matrix
+
+    w, h = node.image.size[:]
+    px = np.empty(w * h * 4, np.float32)
+    node.image.pixels.foreach_get(px)
+    np.save(out_dir / "envmap.npy", px.reshape(h, w, 4)[::-1, :, :3].copy())
+    matrix = mapping_matrix(scene.world.name, node.inputs["Vector"], [])
+    return dict(type="envmap", image="envmap.npy", matrix=np.asarray(matrix).tolist(),
+                strength=background.inputs["Strength"].default_value)
+
+
 def dump_for_mitsuba(mesh, out_dir):
     """Meshes (one PLY per mesh and material, in object space), their instances' world matrices,
     lights in Blender's units, the camera and the world colour: bench/mitsuba_bench.py converts."""
@@ -181,7 +209,9 @@ def dump_for_mitsuba(mesh, out_dir):
             light = obj.data
             lights.append(dict(type=light.type, power=light.energy, color=list(light.color), matrix=matrix,
                                shape=getattr(light, "shape", None), size=getattr(light, "size", 0.0),
-                               size_y=getattr(light, "size_y", 0.0),
+                               size_y=getattr(light, "size_y", 0.0), angle=getattr(light, "angle", 0.0),
+                               spot_size=getattr(light, "spot_size", 0.0), spot_blend=getattr(light, "spot_blend", 0.0),
+                               radius=getattr(light, "shadow_soft_size", 0.0),
                                visible_camera=bool(getattr(obj, "visible_camera", True))))
             continue
         if obj.type != "MESH" or not (inst.is_instance or inst.show_self):
@@ -203,16 +233,25 @@ def dump_for_mitsuba(mesh, out_dir):
                 ply = out_dir / f"mesh{len(shapes)}-{int(m)}.ply"
                 write_ply(ply, verts[tris[sel]].reshape(-1, 3), normals[sel].reshape(-1, 3),
                           None if uvs is None else uvs[sel].reshape(-1, 2))
-                parts.append(dict(ply=ply.name, material=material_description(mat, out_dir)))
+                part = dict(ply=ply.name, material=material_description(mat, out_dir))
+                if part["material"]["type"] == "emission":
+                    # Cycles' mesh lights emit from both sides, Mitsuba's area emitters from the
+                    # front: a turned-over copy, moved behind the surface by 1e-5 of the mesh's size
+                    # so that each side's rays meet their own copy first.
+                    corners = tris[sel][:, [0, 2, 1]]
+                    n = normals[sel][:, [0, 2, 1]].reshape(-1, 3)
+                    eps = 1e-5 * float(np.linalg.norm(verts.max(0) - verts.min(0)))
+                    back = out_dir / f"mesh{len(shapes)}-{int(m)}-back.ply"
+                    write_ply(back, verts[corners].reshape(-1, 3) - eps * n, -n,
+                              None if uvs is None else uvs[sel][:, [0, 2, 1]].reshape(-1, 2))
+                    part["ply_back"] = back.name
+                parts.append(part)
             shapes[key] = dict(parts=parts, instances=[])
         shapes[key]["instances"].append(matrix)
     scene = depsgraph.scene
     cam = scene.camera
     r = scene.render
-    world = None
-    if scene.world is not None and scene.world.use_nodes:
-        world = list(scene.world.node_tree.nodes["Background"].inputs["Color"].default_value)[:3]
-    desc = dict(shapes=list(shapes.values()), lights=lights, world=world,
+    desc = dict(shapes=list(shapes.values()), lights=lights, world=world_description(scene, out_dir),
                 camera=dict(matrix=[list(row) for row in cam.matrix_world], lens=cam.data.lens,
                             sensor_width=cam.data.sensor_width, sensor_fit=cam.data.sensor_fit,
                             clip_start=cam.data.clip_start, clip_end=cam.data.clip_end),

@@ -10,6 +10,15 @@
 # both. Blender's area lights emit along their local -Z; Mitsuba's rectangle along +Z, so the
 # rectangle is turned over.
 #
+# Also converted: a sun (Mitsuba's `directional`, irradiance = strength), a spot (`spot`, intensity
+# P / (4 pi)), Emission materials (an `area` emitter of radiance colour x strength on the mesh, on
+# both sides as Cycles' mesh lights: blender_bench.py writes a turned-over copy just behind the
+# surface; no BSDF), and an
+# Environment Texture world (`envmap`, its frame turned to Blender's equirectangular convention and
+# the Mapping node's rotation). What Mitsuba cannot express is rendered its nearest way and listed in
+# the output's "approximations": a sun's disc (Mitsuba's directional light is a delta), a spot's
+# smoothstep edge and radius (Mitsuba's spot is a point with a falloff linear in angle).
+#
 # Time: wall-clock seconds from the scene description to an image, as for the others: mi.load_dict
 # (which builds Mitsuba's BVH) plus mi.render.
 import argparse
@@ -46,7 +55,14 @@ def to_transform(mi, m):
     return mi.ScalarTransform4f(np.asarray(m, np.float64).tolist())
 
 
-def build_dict(mi, scene_dir, desc):
+# Blender's equirectangular map in Mitsuba's envmap frame: Blender looks up u = 1/2 - atan2(y, x) / 2 pi,
+# v = asin(z) / pi + 1/2 (rows from the bottom); Mitsuba u = atan2(x', -z') / 2 pi, v = acos(y') / pi
+# (rows from the top, which the dump wrote). Both agree when (x', y', z') = (y, z, x).
+BLENDER_TO_ENVMAP = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+
+
+def build_dict(mi, scene_dir, desc, approximations=None):
+    approximations = [] if approximations is None else approximations
     d = {"type": "scene"}
     bsdfs = {}
 
@@ -72,7 +88,19 @@ def build_dict(mi, scene_dir, desc):
     for s, shape in enumerate(desc["shapes"]):
         instanced = len(shape["instances"]) > 1
         for p, part in enumerate(shape["parts"]):
-            ply = {"type": "ply", "filename": str(scene_dir / part["ply"]), "bsdf": bsdf_for(part["material"])}
+            mat = part["material"]
+            if mat["type"] == "emission":
+                if instanced:
+                    raise ValueError("instanced emitters are not converted for Mitsuba")
+                radiance = (np.array(mat["color"], np.float64) * mat["strength"]).tolist()
+                for side, ply in (("front", part["ply"]), ("back", part["ply_back"])):
+                    d[f"shape{s}_{p}_{side}"] = {
+                        "type": "ply", "filename": str(scene_dir / ply),
+                        "to_world": to_transform(mi, shape["instances"][0]),
+                        "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}},
+                        "emitter": {"type": "area", "radiance": {"type": "rgb", "value": radiance}}}
+                continue
+            ply = {"type": "ply", "filename": str(scene_dir / part["ply"]), "bsdf": bsdf_for(mat)}
             if not instanced:
                 ply["to_world"] = to_transform(mi, shape["instances"][0])
                 d[f"shape{s}_{p}"] = ply
@@ -97,10 +125,35 @@ def build_dict(mi, scene_dir, desc):
             d[f"light{k}"] = {"type": "rectangle", "to_world": to_transform(mi, m @ local),
                               "emitter": {"type": "area", "radiance": {"type": "rgb",
                                                                        "value": (color / (4 * area)).tolist()}}}
+        elif light["type"] == "SUN":
+            direction = -m[:3, 2] / np.linalg.norm(m[:3, 2])  # Blender's sun shines along its local -Z
+            d[f"light{k}"] = {"type": "directional", "direction": direction.tolist(),
+                              "irradiance": {"type": "rgb", "value": color.tolist()}}
+            if light.get("angle", 0.0) > 0.0:
+                approximations.append(f"sun of {math.degrees(light['angle']):.1f} degree disc: a delta direction")
+        elif light["type"] == "SPOT":
+            half = 0.5 * light["spot_size"]
+            # Blender's edge: smoothstep from cos(half) to cos(half) + (1 - cos(half)) blend; Mitsuba's
+            # falls linearly in angle from beam_width to cutoff_angle.
+            inner = math.acos(min(1.0, math.cos(half) + (1.0 - math.cos(half)) * light["spot_blend"]))
+            rotation = m[:3, :3] / np.linalg.norm(m[:3, :3], axis=0)
+            frame = np.eye(4)
+            frame[:3, :3], frame[:3, 3] = rotation @ np.diag([1.0, -1.0, -1.0]), m[:3, 3]  # +Z: Blender's -Z
+            d[f"light{k}"] = {"type": "spot", "to_world": to_transform(mi, frame),
+                              "intensity": {"type": "rgb", "value": (color / (4 * math.pi)).tolist()},
+                              "cutoff_angle": math.degrees(half), "beam_width": math.degrees(inner)}
+            approximations.append("spot: a point with Mitsuba's linear edge (Blender: smoothstep"
+                                  + (f", radius {light['radius']:g} m" if light.get("radius", 0.0) > 0 else "") + ")")
         else:
             raise ValueError(f"light {light['type']}/{light.get('shape')} is not converted for Mitsuba")
-    if desc["world"] is not None:
-        d["world"] = {"type": "constant", "radiance": {"type": "rgb", "value": desc["world"]}}
+    world = desc["world"]
+    if isinstance(world, dict):  # an Environment Texture: Mitsuba's local frame -> Blender's world
+        to_world = np.eye(4)
+        to_world[:3, :3] = np.linalg.inv(BLENDER_TO_ENVMAP @ np.array(world["matrix"], np.float64))
+        d["world"] = {"type": "envmap", "bitmap": mi.Bitmap(np.load(scene_dir / world["image"])),
+                      "scale": float(world["strength"]), "to_world": to_transform(mi, to_world)}
+    elif world is not None:
+        d["world"] = {"type": "constant", "radiance": {"type": "rgb", "value": world}}
     cam = desc["camera"]
     m = blender_matrix(cam["matrix"])
     origin, forward, up = m[:3, 3], -m[:3, 2], m[:3, 1]
@@ -142,7 +195,8 @@ def main():
     ref = np.load(args.reference).astype(np.float64)
     # The pixels blender_bench.py counted (lights seen directly and their edges left out).
     mask = np.load(str(args.reference).replace(".ref.npy", ".mask.npy"))
-    runs = []
+    runs, approximations = [], []
+    build_dict(mi, args.scene_dir, desc, approximations)  # once, for the list of what it approximates
     for spp in args.spp:
         best = None
         for _ in range(args.repeats):
@@ -157,8 +211,8 @@ def main():
                          relmse=relmse))
         print(f"bench: mitsuba {args.scene_dir.name} {spp} spp {best[1]:.3f} s rmse {rmse:.4g}", flush=True)
     np.save(args.out.with_suffix(".mitsuba.npy"), best[0].astype(np.float32))
-    args.out.write_text(json.dumps(dict(variant=variant, variant_note=note, version=mi.__version__, runs=runs),
-                                   indent=1))
+    args.out.write_text(json.dumps(dict(variant=variant, variant_note=note, version=mi.__version__, runs=runs,
+                                        approximations=approximations), indent=1))
 
 
 if __name__ == "__main__":
