@@ -82,8 +82,9 @@ TEST(AreaSpread, UnderASoftBoxWiderThanItsBeamIrradianceIsPiL) {
         const float h = 0.8f;
         const Light light = soft_box(shape, 3.0f, 3.0f, h, degrees * kDegree);  // reach at 90 deg: 0.8 m
         const double pi_l = kPiD * std::get<AreaLight>(light).radiance.x;
-        const Estimate e = monte_carlo(
-            200000, [&](uint32_t i) { return irradiance_sample(light, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 9), sampling); });
+        const Estimate e = monte_carlo(200000, [&](uint32_t i) {
+          return irradiance_sample(light, Vec3(0.0f), Vec3(0, 0, 1), rand2(i, 9), sampling);
+        });
         expect_converges(e, pi_l, degrees < 10.0 ? "1 degree" : shape == AreaShape::Disk ? "disk" : "square");
       }
 }
@@ -137,7 +138,8 @@ TEST(AreaSpread, ImportanceIsPositiveWhereverTheBeamArrives) {
   for (uint32_t i = 0; i < 2000; ++i) {
     const Vec3 p(3.0f * rand2(i, 4).x - 1.5f, 3.0f * rand2(i, 4).y - 1.5f, 0.0f);
     bool arrives = false;
-    for (uint32_t k = 0; k < 64 && !arrives; ++k) arrives = sample_light(light, p, rand2(k, 6), AreaSampling::SolidAngle).valid();
+    for (uint32_t k = 0; k < 64 && !arrives; ++k)
+      arrives = sample_light(light, p, rand2(k, 6), AreaSampling::SolidAngle).valid();
     if (!arrives) continue;
     ++lit;
     EXPECT_GT(importance(std::get<AreaLight>(light), p, Vec3(0, 0, 1)), 0.0f);
