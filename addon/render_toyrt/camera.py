@@ -53,9 +53,10 @@ def depth_of_field(depsgraph, cam, dof) -> dict:
 
 
 def focus_distance(depsgraph, cam, dof) -> float:
-    """The focus object's depth along the camera's view axis, as Cycles computes it (|view axis .
-    (camera - object)| between the world positions), else dof.focus_distance. A bone named by
-    4.x's dof.focus_subtarget is not looked up: the armature object's own position is used."""
+    """The focus point's depth along the camera's view axis, as Cycles computes it (|view axis .
+    (camera - point)| between world positions), else dof.focus_distance. The point is the focus
+    object's origin, or, when dof.focus_subtarget names a bone of that armature, the posed bone's
+    head (the object's matrix times the pose bone's, as Cycles 3.4 and 5.x both do)."""
     target = dof.focus_object
     if target is None:
         return float(dof.focus_distance)
@@ -63,5 +64,9 @@ def focus_distance(depsgraph, cam, dof) -> float:
     target = target.evaluated_get(depsgraph) if hasattr(target, "evaluated_get") else target
     m = np.array(cam.matrix_world, np.float64)
     t = np.array(target.matrix_world, np.float64)
+    bone_name = getattr(dof, "focus_subtarget", "")
+    pose = getattr(target, "pose", None)
+    if bone_name and pose is not None and bone_name in pose.bones:
+        t = t @ np.array(pose.bones[bone_name].matrix, np.float64)
     axis = m[:3, 2] / np.linalg.norm(m[:3, 2])
     return float(abs(axis @ (m[:3, 3] - t[:3, 3])))

@@ -7,7 +7,10 @@
 # aperture's projection, whose variance the thin lens fixes (tests/python/test_depth_of_field.py
 # derives it):
 #   1. a focus object on the plane but far off the view axis: the edge is sharp (the focus distance
-#      is the object's depth along the view axis, as Cycles takes it, not its distance);
+#      is the object's depth along the view axis, as Cycles takes it, not its distance); the same
+#      with an armature whose origin is 1 m deep and whose bone, named by dof.focus_subtarget, has
+#      its head on the plane (Cycles 3.4 and 5.0 focus on the bone: checked by rendering with them),
+#      while the armature without the subtarget blurs the edge;
 #   2. a focus distance of 2 m, round aperture: the spread's variance is r^2 / 4 with the blur
 #      radius r = A |d - f| / (d f) * lens * width / sensor pixels, A = lens / (2 f-stop);
 #   3. six blades: the hexagon's (1 + 2 cos^2(pi / 6)) r^2 / 12;
@@ -75,6 +78,21 @@ def main():
     dof.focus_object = target
     err = sharp(render("focus_object"))
     check(err < 1e-5, f"focus object on the plane, off axis: the edge is sharp (max deviation {err:.1e})")
+
+    rig = kit.link(bpy.data.objects.new("rig", bpy.data.armatures.new("rig")))
+    rig.location = (6.0, 2.0, -1.0)  # 1 m deep
+    bpy.context.view_layer.objects.active = rig
+    bpy.ops.object.mode_set(mode="EDIT")
+    bone = rig.data.edit_bones.new("aim")
+    bone.head, bone.tail = (0.0, 0.0, -(DEPTH - 1.0)), (0.0, 0.5, -(DEPTH - 1.0))  # its head on the plane
+    bpy.ops.object.mode_set(mode="OBJECT")
+    dof.focus_object, dof.focus_subtarget = rig, "aim"
+    err = sharp(render("focus_bone"))
+    check(err < 1e-5,
+          f"focus_subtarget: a bone's head on the plane, its armature 1 m deep: sharp (max deviation {err:.1e})")
+    dof.focus_subtarget = ""
+    err = sharp(render("focus_armature"))
+    check(err > 0.1, f"the same armature without focus_subtarget focuses 1 m deep: blurred (max deviation {err:.2f})")
 
     dof.focus_object = None
     dof.focus_distance = 2.0
