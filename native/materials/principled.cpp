@@ -18,6 +18,7 @@ Principled Principled::from_params(const Params& params) {
   m.roughness = std::clamp(roughness, 0.0f, 1.0f);
   m.multiscatter = params.flag("multiscatter", m.multiscatter);
   m.layered = params.flag("layered", m.layered);
+  m.burley = params.flag("burley", m.burley);
   m.shadowing = params.has("shadowing") ? shadowing_from_params(params) : m.shadowing;
   const double metallic = params.number("metallic", m.metallic);
   m.metallic = float(std::clamp(metallic, 0.0, 1.0));
@@ -99,6 +100,16 @@ Scatter lobe_over(const GlossyLobe& lobe, const Vec3& f) {
   return sc;
 }
 
+// 3.x: the base is Burley's diffuse about the shading normal on wo's side (as the integrator turns
+// it), with the Principled Roughness.
+Scatter burley_base(const Principled& m, const ShadingPoint& s, Scatter sc) {
+  if (!m.burley) return sc;
+  const Vec3 ng = glm::dot(s.ng, s.wo) > 0.0f ? s.ng : -s.ng;
+  sc.burley = true;
+  sc.retro = BurleyDiffuse{glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns, s.wo, m.roughness};
+  return sc;
+}
+
 }  // namespace
 
 Scatter scatter(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx) {
@@ -108,9 +119,9 @@ Scatter scatter(const Principled& m, const ShadingPoint& s, const MaterialContex
   if (!m.layered) {
     // 3.x: one lobe whose F0 goes from the dielectric's to the base colour with Metallic, over
     // the base weighted 1 - Metallic.
-    if (m.eta == 1.0f && m.metallic == 0.0f) return Scatter::diffuse(lambert_f(albedo));
+    if (m.eta == 1.0f && m.metallic == 0.0f) return burley_base(m, s, Scatter::diffuse(lambert_f(albedo)));
     const Vec3 f0 = glm::mix(m.f0, glm::clamp(albedo, Vec3(0.0f), Vec3(1.0f)), m.metallic);
-    return lobe_over(dielectric_layer(m, s, f0).lobe, dielectric * lambert_f(albedo));
+    return burley_base(m, s, lobe_over(dielectric_layer(m, s, f0).lobe, dielectric * lambert_f(albedo)));
   }
   // 4.0+: Metallic mixes a metal with the dielectric layer over its base. The base is always
   // there; of the two lobes one is drawn with probability its weight (its value then counts

@@ -341,15 +341,15 @@ SCENES_SPEC = [
     ("mix_diffuse_glossy", scene_diffuse_and_glossy, dict(balls=[(0.2, 0.3), (0.5, 0.3), (0.8, 0.3), (None, 0.1)],
                                                           mean_limit=0.005, sample_factor=4), 8),
     # Principled dielectrics: a roughness sweep under a point lamp, and Specular levels and tints
-    # under an area lamp (3.x: a Lambert base for its Burley diffuse, so reported there only).
+    # under an area lamp (3.x: a Burley diffuse base, 4.0+: a Lambert base layered under the layer).
     ("principled_sweep_point", scene_principled, dict(balls=[(r, 0.5, None) for r in (0.05, 0.2, 0.4, 0.7, 1.0)],
                                                       color=(0.7, 0.25, 0.15), lamp="point", mean_limit=0.005,
-                                                      asserted_from=(4, 0, 0), sample_factor=2), 8),
+                                                      sample_factor=2), 8),
     ("principled_specular_area", scene_principled, dict(balls=[(0.3, 0.0, None), (0.3, 1.0, None),
                                                                (0.3, 0.5, (1.0, (1.0, 0.5, 0.2))),
                                                                (0.15, 2.0, None), (0.6, 0.25, None)],
                                                         color=(0.2, 0.45, 0.7), lamp="area", mean_limit=0.005,
-                                                        asserted_from=(4, 0, 0), sample_factor=4), 8),
+                                                        sample_factor=4), 8),
     # Principled metals (Metallic 1): 3.x's Fresnel blend from the base colour, 4.0+'s F82-tint
     # with Multiscatter GGX.
     ("metal_sweep", scene_metal_sweep, dict(roughness=[0.05, 0.2, 0.4, 0.7, 1.0], color=(0.9, 0.75, 0.5),
@@ -588,11 +588,11 @@ def write_doc(results):
         "GGX (4.x/5.x default to Multiscatter GGX, which TOYRT renders as Cycles compensates it; 3.x's is a "
         "random walk, rendered as single-scatter GGX and noted).",
         "- Principled BSDF (docs/render.md, 'Principled BSDF and Multiscatter GGX'): principled_sweep_point and "
-        "principled_specular_area (Metallic 0: a Lambert base under a GGX layer) are asserted from 4.0, where "
-        "TOYRT renders Cycles' model (energy layering, Multiscatter GGX); on 3.x they are reported: Cycles 3.x's "
-        "Burley diffuse (darker towards grazing, with a roughness-dependent retro-reflection) is Lambert in "
-        "TOYRT. metal_sweep (Metallic 1, Blender's defaults otherwise: 3.x GGX with its Fresnel blend from the "
-        "base colour, 4.0+ Multiscatter GGX with F82-tint) is asserted on both.",
+        "principled_specular_area (Metallic 0) are asserted on both: 4.0+'s Lambert base energy-layered under "
+        "a GGX layer (Multiscatter GGX), 3.x's Burley diffuse (darker towards grazing, with a "
+        "roughness-dependent retro-reflection) with the layer added. metal_sweep (Metallic 1, Blender's "
+        "defaults otherwise: 3.x GGX with its Fresnel blend from the base colour, 4.0+ Multiscatter GGX with "
+        "F82-tint) is asserted on both.",
         "",
     ]
     DOC.write_text("\n".join(lines))

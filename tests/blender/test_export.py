@@ -425,8 +425,9 @@ def test_principled_specular_layer():
     """A Principled BSDF with Metallic 0 becomes the 'principled' kind on each Blender as its Cycles
     shades it: 4.0+ keeps its IOR, Specular IOR Level and tint colour, layered over the base,
     Multiscatter GGX by default; 3.x's F0 = 0.08 x Specular becomes the layer's IOR, tinted towards
-    the base colour's hue, added to a whole base, with a note for its Burley diffuse; Specular 0
-    leaves the plain Lambert base with no note."""
+    the base colour's hue (its luminance by Cycles 3.x's weights 0.3, 0.6, 0.1), added to a whole
+    Burley diffuse base. Specular 0 leaves the plain base with no note: Lambert on 4.0+, Burley's
+    (the 'principled' kind at IOR 1) on 3.x."""
     _, _ = addon()
     from render_toyrt import materials
 
@@ -437,19 +438,21 @@ def test_principled_specular_layer():
     tinted = materials.material_spec(kit.principled_dielectric("tinted", base, 0.3, specular=1.0,
                                                                tint=(1.0, 0.5, 0.2) if new else 1.0))
     check(default.spec.kind == "principled" and default.spec.multiscatter == new
-          and default.spec.layered == new and default.spec.shadowing == ("correlated" if new else "separable"),
+          and default.spec.layered == new and default.spec.shadowing == ("correlated" if new else "separable")
+          and default.spec.burley == (not new),
           f"the default Principled material has a specular layer: {default.spec}")
-    check(none.spec.kind == "diffuse" and np.allclose(none.spec.color, base) and not none.notes,
-          f"Specular 0: the Lambert base, no note: {none}")
+    check((none.spec.kind == "diffuse" if new else none.spec.kind == "principled" and none.spec.ior == 1.0
+           and none.spec.burley) and np.allclose(none.spec.color, base) and not none.notes,
+          f"Specular 0: the base alone, no note: {none}")
     t = tinted.spec
     if new:
         want = dict(ior=1.5, specular_ior_level=1.0, specular_tint=(1.0, 0.5, 0.2))
         ok = not tinted.notes
     else:
-        lum = 0.2126 * base[0] + 0.7152 * base[1] + 0.0722 * base[2]
+        lum = 0.3 * base[0] + 0.6 * base[1] + 0.1 * base[2]
         want = dict(ior=(1 + 0.08 ** 0.5) / (1 - 0.08 ** 0.5), specular_ior_level=0.5,
                     specular_tint=tuple(c / lum for c in base))
-        ok = len(tinted.notes) == 1 and "Burley" in tinted.notes[0]
+        ok = not tinted.notes and t.burley
     got = dict(ior=t.ior, specular_ior_level=t.specular_ior_level, specular_tint=t.specular_tint)
     check(ok and abs(t.roughness - 0.3) < 1e-6 and all(np.allclose(got[k], want[k], rtol=1e-5) for k in want),
           f"Specular 1 with a tint: {got} ({want}); notes {tinted.notes}")

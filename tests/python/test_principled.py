@@ -33,6 +33,36 @@ def test_unlayered_rough_principled_is_lambert_plus_f0_over_4_pi():
     np.testing.assert_allclose(got, (color / math.pi + 0.04 / (4 * math.pi)) * IRRADIANCE, rtol=1e-4)
 
 
+def lit_from(x, **material):
+    """The floor's pixel straight below the camera, lit by a 100 W point lamp at (x, 0, 2)."""
+    s = toyrt.Scene()
+    s.add_material("principled", **material)
+    s.add_mesh(np.float32([[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]]), [[0, 1, 2], [0, 2, 3]], material_ids=0)
+    s.background = (0.0, 0.0, 0.0)
+    s.add_point_light((x, 0.0, 2.0), 100.0)
+    s.commit()
+    m = np.eye(4)
+    m[2, 3] = 5.0
+    return s.render(dict(type="ORTHO", ortho_scale=1e-3, resolution_x=1, resolution_y=1, matrix_world=m),
+                    samples=16)[0, 0, :3]
+
+
+@pytest.mark.parametrize("roughness", [0.0, 0.5, 1.0])
+def test_burley_base_has_its_closed_form_under_an_oblique_lamp(roughness):
+    # Blender 3.x's Burley diffuse seen head-on (FV = 0) and lit at cos_i: albedo / pi times
+    # (1 - FL / 2) + R FL, FL = (1 - cos_i)^5, R = roughness (1 + cos_i); no layer at IOR 1.
+    color = np.array([0.6, 0.3, 0.1])
+    x = 3.0
+    d2 = x * x + 4.0
+    cos_i = 2.0 / math.sqrt(d2)
+    fl = (1.0 - cos_i) ** 5
+    factor = 1.0 - 0.5 * fl + roughness * (1.0 + cos_i) * fl
+    got = lit_from(x, color=tuple(color), roughness=roughness, ior=1.0, layered=False, burley=True)
+    lambert = lit_from(x, color=tuple(color), roughness=roughness, ior=1.0, layered=False)
+    np.testing.assert_allclose(got, color / math.pi * factor * 100.0 / (4 * math.pi * d2) * cos_i, rtol=1e-4)
+    np.testing.assert_allclose(got, lambert * factor, rtol=1e-5)
+
+
 def test_specular_tint_and_level_scale_f0():
     got = floor(color=(0.0, 0.0, 0.0), roughness=1.0, ior=1.5, specular_ior_level=1.0,
                 specular_tint=(1.0, 0.5, 0.0), layered=False, multiscatter=False)
