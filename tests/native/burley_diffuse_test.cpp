@@ -81,8 +81,8 @@ TEST(BurleyDiffuse, PrincipledHandsItToTheIntegratorOn3xOnly) {
   const ShadingPoint below{-wo, Vec3(0, 0, 1), Vec3(0, 0, 1), Vec2(0.0f)};
   using Args = std::vector<std::pair<std::string, Params::Value>>;
   for (const double ior : {1.0, 1.5}) {
-    const Principled x3 = Principled::from_params(Params(Args{{"burley", true}, {"layered", false},
-                                                              {"roughness", 0.4}, {"ior", ior}}));
+    const Principled x3 =
+        Principled::from_params(Params(Args{{"burley", true}, {"layered", false}, {"roughness", 0.4}, {"ior", ior}}));
     const Scatter sc = scatter(x3, below, ctx);
     EXPECT_TRUE(sc.burley) << "ior " << ior;
     EXPECT_EQ(sc.retro.n, Vec3(0, 0, -1));
