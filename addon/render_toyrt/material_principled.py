@@ -9,7 +9,6 @@ from dataclasses import replace
 
 from .material_dielectric import ior_value
 from .materials import (
-    MaterialSpec,
     _blender_version,
     _color_material,
     _constant,
@@ -20,21 +19,15 @@ from .materials import (
 
 
 def principled_spec(name, node, notes):
-    """A Principled BSDF as (MaterialSpec, image): glass at Transmission 1, a metal at Metallic 1,
-    else the 'principled' kind (or the plain base) as the Blender version's Cycles shades it."""
-    trans = input_socket(node, "Transmission Weight", "Transmission")  # 4.0+ / 3.x
-    if trans is not None and not trans.is_linked and trans.default_value >= 0.999:
-        rough = input_socket(node, "Roughness")
-        if rough is not None and (rough.is_linked or rough.default_value > 0.0):
-            notes.append(f"material '{name}': rough Principled transmission (sharp glass)")
-        return MaterialSpec("glass", ior=ior_value(name, node, notes), roughness=0.0), None
+    """A Principled BSDF as (MaterialSpec, image): a metal at Metallic 1, else the 'principled'
+    kind (or the plain base) as the Blender version's Cycles shades it, its Transmission a glass
+    beside the opaque parts."""
     metal = input_socket(node, "Metallic")
     if metal is not None and not metal.is_linked and metal.default_value >= 0.999:
         return _metal(name, node, notes)
     extras = []
     metallic = _constant(name, metal, "Metallic", 0.0, notes, 0.0, 1.0)
-    if trans is not None and (trans.is_linked or trans.default_value > 0.0):
-        extras.append("partial transmission")
+    glass = _transmission(name, node, notes)
     for label, names in (("coat", ("Coat Weight", "Clearcoat")), ("sheen", ("Sheen Weight", "Sheen")),
                          ("subsurface", ("Subsurface Weight", "Subsurface")), ("anisotropy", ("Anisotropic",)),
                          ("diffuse roughness", ("Diffuse Roughness",)), ("thin film", ("Thin Film Thickness",))):
@@ -52,13 +45,30 @@ def principled_spec(name, node, notes):
     layer = _specular_layer(name, node, base, extras, notes)
     if extras:
         notes.append(f"material '{name}': Principled {', '.join(extras)} (not modelled)")
-    if layer is None and metallic > 0.0:   # no dielectric layer, but a metal beside the base
+    if glass and (base.texture is not None or any(c != 1.0 for c in base.color)):
+        notes.append(f"material '{name}': Principled transmission colour (white)")
+    if layer is None and (metallic > 0.0 or glass):   # no dielectric layer, but a metal or glass beside the base
         new = _blender_version() >= (4, 0, 0)
         layer = dict(roughness=_constant(name, input_socket(node, "Roughness"), "roughness", 0.5, notes, 0.0, 1.0),
                      ior=1.0, multiscatter=new and getattr(node, "distribution", "GGX") == "MULTI_GGX",
                      shadowing="correlated" if new else "separable", layered=new)
-    spec = base if layer is None else replace(base, kind="principled", metallic=metallic, **layer)
+    spec = base if layer is None else replace(base, kind="principled", metallic=metallic, **layer, **glass)
     return replace(spec, emission=emission), image
+
+
+def _transmission(name, node, notes) -> dict:
+    """Transmission (3.x) / Transmission Weight (4.0+) as the 'principled' kind's transmission
+    arguments ({} for none): the weight and the IOR socket's value (3.x's Specular sets the layer's
+    IOR, not the glass's). 3.x's Transmission Roughness, which roughens the refraction alone, is
+    the Roughness (noted)."""
+    trans = input_socket(node, "Transmission Weight", "Transmission")
+    weight = _constant(name, trans, "Transmission", 0.0, notes, 0.0, 1.0)
+    if weight <= 0.0:
+        return {}
+    extra = input_socket(node, "Transmission Roughness")   # 3.x only
+    if extra is not None and (extra.is_linked or extra.default_value > 0.0):
+        notes.append(f"material '{name}': Principled Transmission Roughness (the Roughness)")
+    return dict(transmission=weight, transmission_ior=ior_value(name, node, notes))
 
 
 # The luminance Cycles 3.x's Principled specular divides the base colour by for its Specular Tint:

@@ -57,6 +57,8 @@ class MaterialSpec:
     specular_tint: tuple[float, float, float] = (1.0, 1.0, 1.0)  # 'principled': the layer's F0 tint
     layered: bool = True                                     # 'principled': 4.0+ (False: 3.x's sum)
     burley: bool = False                                     # 'principled': 3.x's Burley diffuse base
+    transmission: float = 0.0                                # 'principled': the glass's weight
+    transmission_ior: float = 1.45                           # 'principled': the glass's IOR
     metallic: float = 0.0                                    # 'principled': Metallic (1: a metal of the base colour)
     emission: tuple[float, float, float] = (0.0, 0.0, 0.0)   # colour x strength, linear radiance
     emission_sampling: str = "AUTO"                           # Blender 4.x's names (3.x: AUTO or NONE)
@@ -77,7 +79,8 @@ class MaterialSpec:
             args.update(fresnel=self.fresnel, multiscatter=self.multiscatter)
         if self.kind == "principled":
             args.update(specular_ior_level=self.specular_ior_level, specular_tint=self.specular_tint,
-                        layered=self.layered, metallic=self.metallic, burley=self.burley)
+                        layered=self.layered, metallic=self.metallic, burley=self.burley,
+                        transmission=self.transmission, transmission_ior=self.transmission_ior)
         if self.kind == "diffuse_glossy":
             args.update(diffuse_weight=self.diffuse_weight, glossy_color=self.glossy_color)
         return args

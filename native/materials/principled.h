@@ -24,12 +24,22 @@
 // colour), roughness (0.5, clamped to [0, 1]), ior (1.45, every kind's; > 0), specular_ior_level (0.5, >= 0),
 // specular_tint ((1, 1, 1), >= 0), multiscatter (True), layered (True; False: 3.x), shadowing
 // ('correlated', 4.0+; 'separable', 3.x), metallic (0, clamped to [0, 1]), burley (False; True:
-// 3.x's Burley diffuse base instead of Lambert).
+// 3.x's Burley diffuse base instead of Lambert), transmission (0, clamped to [0, 1]) and
+// transmission_ior (the ior): the share of a glass beside the opaque parts, below.
+//
+// Transmission (Cycles' order: the metal takes Metallic, the glass (1 - Metallic) Transmission,
+// the dielectric layer and base what is left): the glass is the Glass BSDF's rough dielectric of
+// the same roughness and masking (materials/refraction.h; 3.x's Fresnel-weighted lobe pair, 4.0+'s
+// Fresnel per microfacet with Multiscatter GGX as chosen), drawn with probability its share on the
+// lobe-choice number; otherwise the opaque parts answer as above with the base scaled so that its
+// expectation keeps its weight. Its colour is white (Cycles tints the transmission: the add-on's
+// note).
 #pragma once
 
 #include "core/params.h"
 #include "materials/glossy.h"
 #include "materials/lambert.h"
+#include "materials/refraction.h"
 #include "materials/scatter.h"
 
 #include <cstdint>
@@ -41,8 +51,8 @@ struct Principled {
   static constexpr const char* kParams =
       "color, texture (the base colour), roughness (0.5), ior (1.45), specular_ior_level (0.5),\n"
       "specular_tint ((1, 1, 1)), multiscatter (True), layered (True; False: Blender 3.x's sum),\n"
-      "shadowing ('correlated'; 'separable': 3.x), metallic (0), burley (False; True: 3.x's diffuse):\n"
-      "the Principled BSDF";
+      "shadowing ('correlated'; 'separable': 3.x), metallic (0), burley (False; True: 3.x's diffuse),\n"
+      "transmission (0), transmission_ior (the ior): the Principled BSDF";
   Lambert base;
   float roughness = 0.5f;  // in [0, 1]
   bool multiscatter = true;
@@ -51,6 +61,8 @@ struct Principled {
   GgxShadowing shadowing = GgxShadowing::HeightCorrelated;
   float metallic = 0.0f;  // in [0, 1]; 1: a metal of the base colour, no base
   Vec3 specular_tint{1.0f};
+  float transmission = 0.0f;  // in [0, 1]; > 0: `glass` takes (1 - metallic) transmission
+  FresnelDielectric glass;
   // Derived once from ior, specular_ior_level and specular_tint:
   float eta = 1.5f;      // the IOR whose curve shapes the Fresnel term; 1: no layer
   Vec3 f0{0.04f};        // the layer's reflectance at normal incidence, tint included, <= 1

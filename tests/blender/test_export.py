@@ -464,6 +464,37 @@ def test_principled_specular_layer():
           f"Metallic 0.4 is modelled (a mix of metal and dielectric): {h}")
 
 
+def test_principled_transmission():
+    """A Principled BSDF's Transmission (3.x) / Transmission Weight (4.0+) becomes the 'principled'
+    kind's glass share, with the IOR socket's value as the glass's IOR (3.x's layer keeps its
+    Specular IOR) and the roughness kept, at 0.5 and at 1; the base colour's tint of the
+    transmission is noted (white); Metallic 1 stays the metal."""
+    _, _ = addon()
+    from render_toyrt import materials
+
+    new = bpy.app.version >= (4, 0, 0)
+    for weight in (0.5, 1.0):
+        mat = kit.principled_dielectric(f"glassy{weight}", (0.9, 0.8, 0.7), 0.3)
+        node = mat.node_tree.nodes["Principled BSDF"]
+        kit.input_of(node, "Transmission Weight", "Transmission").default_value = weight
+        node.inputs["IOR"].default_value = 1.33
+        c = materials.material_spec(mat)
+        check(c.spec.kind == "principled" and abs(c.spec.transmission - weight) < 1e-6
+              and abs(c.spec.transmission_ior - 1.33) < 1e-6 and abs(c.spec.roughness - 0.3) < 1e-6
+              and c.spec.burley == (not new) and c.spec.arguments()["transmission"] == c.spec.transmission
+              and any("transmission colour (white)" in n for n in c.notes)
+              and not any("not modelled" in n for n in c.notes),
+              f"Transmission {weight}: a glass share beside the opaque parts: {c}")
+    white = kit.principled_dielectric("white_glass", (1.0, 1.0, 1.0), 0.0)
+    kit.input_of(white.node_tree.nodes["Principled BSDF"], "Transmission Weight", "Transmission").default_value = 1.0
+    w = materials.material_spec(white)
+    check(w.spec.transmission == 1.0 and not w.notes, f"white glass: nothing to note: {w}")
+    metal = kit.metal("glassy_metal", (0.9, 0.8, 0.7), 0.3)
+    kit.input_of(metal.node_tree.nodes["Principled BSDF"], "Transmission Weight", "Transmission").default_value = 1.0
+    m = materials.material_spec(metal)
+    check(m.spec.metallic == 1.0 and m.spec.transmission == 0.0, f"Metallic 1 is the metal (no glass): {m}")
+
+
 def test_rough_glass_and_refraction():
     """Glass and Refraction BSDFs with roughness > 0 become rough dielectrics as the version's Cycles
     shades them: the roughness and distribution kept (GGX, Beckmann), 3.x's Fresnel-weighted lobe
@@ -636,6 +667,6 @@ def test_command_line_range():
 
 
 PARTS = [test_counts_and_transforms, test_instancing_memory, test_missing_texture, test_unsupported_node,
-         test_principled_specular_layer, test_rough_glass_and_refraction, test_cancel,
+         test_principled_specular_layer, test_principled_transmission, test_rough_glass_and_refraction, test_cancel,
          test_animation, test_command_line_range]
 run_script(PARTS, "export", TMP)
