@@ -390,6 +390,29 @@ SCENES_SPEC.append(("sky_preetham", scene_sky_preetham, dict(sun=(0.5, -0.4, 0.7
                                                              camera=(0.0, -6.0, 1.2), mean_limit=0.005,
                                                              sample_factor=2), 0))
 
+
+# Principled Transmission (white base, so that neither version's transmission tint shows): a ball
+# of Transmission 1 (the Glass BSDF's lobe) beside one of 0.5 (the glass drawn beside the opaque
+# parts: 3.x's Burley base and layer, 4.0+'s layered base), roughness 0.3, IOR 1.45, the rough
+# glass scene's lamp and floor. 16x the samples: the partial ball draws glass or opaque parts per
+# hit in TOYRT (one of them, unweighted), a noisier estimator than Cycles' (NEE over all closures).
+def scene_principled_glass(p):
+    floor = checker("checker", 8, 0.15, 0.85)
+    kit.plane("floor", 6.0, floor, uv_repeat=4.0)
+    for i, (weight, x) in enumerate(((1.0, -0.8), (0.5, 0.8))):
+        mat = kit.principled_dielectric(f"principled_glass{i}", (1.0, 1.0, 1.0), p["roughness"])
+        bsdf = mat.node_tree.nodes["Principled BSDF"]
+        kit.input_of(bsdf, "Transmission Weight", "Transmission").default_value = weight
+        bsdf.inputs["IOR"].default_value = 1.45
+        kit.uv_sphere(f"ball{i}", 0.6, (x, 0.0, 0.65), mat)
+    kit.area_light("panel", (1.0, -1.0, 3.0), 200.0, 4.0, 3.0, target=(0, 0, 0))
+    camera((0.0, -5.0, 2.5), (0, 0, 0.4))
+    kit.world((0.05, 0.05, 0.05))
+
+
+SCENES_SPEC.append(("principled_glass", scene_principled_glass, dict(roughness=0.3, mean_limit=0.005,
+                                                                     sample_factor=16), 8))
+
 # ---- Cycles ------------------------------------------------------------------------------------
 
 def render_cycles(scene, path):

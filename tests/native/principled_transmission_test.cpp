@@ -65,7 +65,8 @@ TEST(PrincipledTransmission, TransmissionOneIsTheGlassBsdf) {
 TEST(PrincipledTransmission, TransmissionZeroLeavesTheOpaqueMaterial) {
   const ShadingPoint s = hit_from(glm::normalize(Vec3(0.4f, 0.1f, 1.0f)));
   for (const double metallic : {0.0, 0.3}) {
-    const Principled with = principled({{"transmission", 0.0}, {"metallic", metallic}, {"color", Vec3(0.5f, 0.4f, 0.3f)}});
+    const Principled with =
+        principled({{"transmission", 0.0}, {"metallic", metallic}, {"color", Vec3(0.5f, 0.4f, 0.3f)}});
     const Principled without = principled({{"metallic", metallic}, {"color", Vec3(0.5f, 0.4f, 0.3f)}});
     for (uint32_t i = 0; i < 64; ++i) {
       const MaterialContext ctx{&kNoTextures, false, 0, i, 1, 0, 7};
@@ -99,9 +100,7 @@ TEST(PrincipledTransmission, PartialTransmissionDrawsEachPartWithItsWeight) {
           const Scatter sc = scatter(m, s, ctx);
           glass += sc.kind == Scatter::Kind::Dielectric;
           // The metal lobe's Fresnel is the base colour's (3.x: a blend towards it; 4.0+: F82).
-          const bool is_metal = new_model ? sc.kind == Scatter::Kind::Glossy && sc.glossy.fresnel == LobeFresnel::F82Tint
-                                          : false;
-          metal += is_metal;
+          metal += new_model && sc.kind == Scatter::Kind::Glossy && sc.glossy.fresnel == LobeFresnel::F82Tint;
           f_sum += sc.f;
           f_opaque += scatter(opaque, s, ctx).f;
         }
