@@ -14,7 +14,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .material_dielectric import dielectric_spec, ior_value
+from .material_dielectric import dielectric_spec
 from .material_mix import mix_of_diffuse_and_glossy
 
 DEFAULT_GREY = (0.8, 0.8, 0.8)   # Blender's default surface colour
@@ -56,6 +56,9 @@ class MaterialSpec:
     specular_ior_level: float = 0.5                          # 'principled' (4.0+'s socket)
     specular_tint: tuple[float, float, float] = (1.0, 1.0, 1.0)  # 'principled': the layer's F0 tint
     layered: bool = True                                     # 'principled': 4.0+ (False: 3.x's sum)
+    burley: bool = False                                     # 'principled': 3.x's Burley diffuse base
+    transmission: float = 0.0                                # 'principled': the glass's weight
+    transmission_ior: float = 1.45                           # 'principled': the glass's IOR
     metallic: float = 0.0                                    # 'principled': Metallic (1: a metal of the base colour)
     emission: tuple[float, float, float] = (0.0, 0.0, 0.0)   # colour x strength, linear radiance
     emission_sampling: str = "AUTO"                           # Blender 4.x's names (3.x: AUTO or NONE)
@@ -76,7 +79,8 @@ class MaterialSpec:
             args.update(fresnel=self.fresnel, multiscatter=self.multiscatter)
         if self.kind == "principled":
             args.update(specular_ior_level=self.specular_ior_level, specular_tint=self.specular_tint,
-                        layered=self.layered, metallic=self.metallic)
+                        layered=self.layered, metallic=self.metallic, burley=self.burley,
+                        transmission=self.transmission, transmission_ior=self.transmission_ior)
         if self.kind == "diffuse_glossy":
             args.update(diffuse_weight=self.diffuse_weight, glossy_color=self.glossy_color)
         return args
@@ -265,7 +269,8 @@ def _convert_node(name, node, notes):
             notes.append(f"material '{name}': Diffuse roughness (Lambert)")
         return _color_material(name, input_socket(node, "Color"), notes)
     if t == "BSDF_PRINCIPLED":
-        return _principled(name, node, notes)
+        from .material_principled import principled_spec  # it reads this module's socket helpers
+        return principled_spec(name, node, notes)
     if t in ("BSDF_GLOSSY", "BSDF_ANISOTROPIC"):   # 4.0+: the Glossy node is ShaderNodeBsdfAnisotropic
         return _glossy(name, node, notes)
     if t in ("MIX_SHADER", "ADD_SHADER"):
@@ -357,140 +362,6 @@ def _glossy(name, node, notes):
     if distribution == "MULTI_GGX" and _blender_version() >= (4, 0, 0):
         spec = replace(spec, multiscatter=True)
     return (replace(spec, roughness=0.0) if rough is None else spec), None
-
-
-def _principled(name, node, notes):
-    trans = input_socket(node, "Transmission Weight", "Transmission")  # 4.0+ / 3.x
-    if trans is not None and not trans.is_linked and trans.default_value >= 0.999:
-        rough = input_socket(node, "Roughness")
-        if rough is not None and (rough.is_linked or rough.default_value > 0.0):
-            notes.append(f"material '{name}': rough Principled transmission (sharp glass)")
-        return MaterialSpec("glass", ior=ior_value(name, node, notes), roughness=0.0), None
-    metal = input_socket(node, "Metallic")
-    if metal is not None and not metal.is_linked and metal.default_value >= 0.999:
-        return _metal(name, node, notes)
-    extras = []
-    metallic = _constant(name, metal, "Metallic", 0.0, notes, 0.0, 1.0)
-    if trans is not None and (trans.is_linked or trans.default_value > 0.0):
-        extras.append("partial transmission")
-    for label, names in (("coat", ("Coat Weight", "Clearcoat")), ("sheen", ("Sheen Weight", "Sheen")),
-                         ("subsurface", ("Subsurface Weight", "Subsurface")), ("anisotropy", ("Anisotropic",)),
-                         ("diffuse roughness", ("Diffuse Roughness",)), ("thin film", ("Thin Film Thickness",))):
-        sock = input_socket(node, *names)
-        if sock is not None and (sock.is_linked or sock.default_value > 0.0):
-            extras.append(label)
-    normal = input_socket(node, "Normal")
-    if normal is not None and normal.is_linked:
-        extras.append("normal input")
-    emission = _emission(name, input_socket(node, "Emission Color", "Emission"),  # 4.0+ / 3.x
-                         input_socket(node, "Emission Strength"), notes)
-    base, image = _color_material(name, input_socket(node, "Base Color"), notes)
-    if base.texture is None:
-        base = replace(base, color=_finite_color(name, base.color, "base colour", notes))
-    layer = _specular_layer(name, node, base, extras, notes)
-    if extras:
-        notes.append(f"material '{name}': Principled {', '.join(extras)} (not modelled)")
-    if layer is None and metallic > 0.0:   # no dielectric layer, but a metal beside the base
-        new = _blender_version() >= (4, 0, 0)
-        layer = dict(roughness=_constant(name, input_socket(node, "Roughness"), "roughness", 0.5, notes, 0.0, 1.0),
-                     ior=1.0, multiscatter=new and getattr(node, "distribution", "GGX") == "MULTI_GGX",
-                     shadowing="correlated" if new else "separable", layered=new)
-    spec = base if layer is None else replace(base, kind="principled", metallic=metallic, **layer)
-    return replace(spec, emission=emission), image
-
-
-# Blender's luminance weights for linear Rec.709 RGB (3.x's Specular Tint divides the base colour
-# by its luminance).
-_LUMINANCE = (0.2126, 0.7152, 0.0722)
-
-
-def _specular_layer(name, node, base, extras, notes):
-    """The Principled BSDF's dielectric specular layer as the 'principled' kind's arguments, per
-    Blender version; None where there is none (Specular 0, IOR 1)."""
-    rough = _constant(name, input_socket(node, "Roughness"), "roughness", 0.5, notes, 0.0, 1.0)
-    distribution = getattr(node, "distribution", "GGX")
-    if _blender_version() >= (4, 0, 0):
-        # A Lambert base energy-layered under the layer; F0 from the IOR times 2 x Specular IOR
-        # Level, tinted by the Specular Tint colour; Multiscatter GGX by default.
-        ior = _constant(name, input_socket(node, "IOR"), "IOR", 1.5, notes, 1e-5, 1e30)
-        level = _constant(name, input_socket(node, "Specular IOR Level"), "Specular IOR Level", 0.5, notes, 0.0, 1e30)
-        tint_sock = input_socket(node, "Specular Tint")
-        tint = (1.0, 1.0, 1.0)
-        if tint_sock is not None:
-            if tint_sock.is_linked:
-                notes.append(f"material '{name}': linked Specular Tint (its constant colour)")
-            tint = _finite_color(name, tint_sock.default_value, "Specular Tint", notes)
-        if ior == 1.0 or level == 0.0:
-            return None
-        if distribution not in ("GGX", "MULTI_GGX"):
-            notes.append(f"material '{name}': Principled {distribution.title()} distribution (GGX)")
-        return dict(roughness=rough, ior=ior, specular_ior_level=level, specular_tint=tint,
-                    multiscatter=distribution == "MULTI_GGX", shadowing="correlated", layered=True)
-    # 3.x: the layer added to a whole base (no layering); F0 = 0.08 x Specular, tinted towards the
-    # base colour's hue by Specular Tint; the IOR socket is for transmission only.
-    specular = _constant(name, input_socket(node, "Specular"), "Specular", 0.5, notes, 0.0, 1e30)
-    if specular == 0.0:
-        return None
-    notes.append(f"material '{name}': Principled Burley diffuse of Blender 3.x (Lambert)")
-    if distribution == "MULTI_GGX":
-        notes.append(f"material '{name}': Multiscatter GGX of Blender 3.x (single-scatter GGX)")
-    amount = _constant(name, input_socket(node, "Specular Tint"), "Specular Tint", 0.0, notes, 0.0, 1.0)
-    tint = (1.0, 1.0, 1.0)
-    if amount > 0.0:
-        if base.texture is not None:
-            notes.append(f"material '{name}': Specular Tint of a textured base colour (untinted)")
-        else:
-            lum = sum(w * c for w, c in zip(_LUMINANCE, base.color))
-            hue = tuple(c / lum for c in base.color) if lum > 0.0 else (1.0, 1.0, 1.0)
-            tint = tuple(1.0 + amount * (h - 1.0) for h in hue)
-    f0 = min(0.08 * specular, 0.99)
-    root = f0 ** 0.5
-    return dict(roughness=rough, ior=(1.0 + root) / (1.0 - root), specular_ior_level=0.5, specular_tint=tint,
-                multiscatter=False, shadowing="separable", layered=False)
-
-
-def _metal(name, node, notes):
-    """Principled BSDF with Metallic 1: a metal layer whose reflectance at normal incidence is the
-    base colour (or its texture), no base under it, emission kept. 4.0+: F82-tint Fresnel with
-    Specular Tint, Multiscatter GGX by default; 3.x: the dielectric curve of the Specular's IOR
-    blended from the base colour to white. The coat, anisotropy and other distributions go in the
-    one note."""
-    extras = []
-    coat = input_socket(node, "Coat Weight", "Clearcoat")
-    if coat is not None and (coat.is_linked or coat.default_value > 0.0):
-        extras.append("coat")
-    aniso = input_socket(node, "Anisotropic")
-    if aniso is not None and (aniso.is_linked or aniso.default_value > 0.0):
-        extras.append("anisotropy")
-    distribution = getattr(node, "distribution", "GGX")
-    new = _blender_version() >= (4, 0, 0)
-    if distribution not in ("GGX", "MULTI_GGX"):
-        extras.append(f"{distribution.title()} distribution (GGX)")
-    elif distribution == "MULTI_GGX" and not new:
-        extras.append("Multiscatter GGX of Blender 3.x (single-scatter GGX)")
-    if extras:
-        notes.append(f"material '{name}': Principled metal without {', '.join(extras)}")
-    base, image = _color_material(name, input_socket(node, "Base Color"), notes)
-    if base.texture is None:
-        base = replace(base, color=_finite_color(name, base.color, "base colour", notes))
-    rough = _constant(name, input_socket(node, "Roughness"), "roughness", 0.5, notes, 0.0, 1.0)
-    if new:
-        tint_sock = input_socket(node, "Specular Tint")
-        tint = (1.0, 1.0, 1.0)
-        if tint_sock is not None and hasattr(tint_sock.default_value, "__len__"):
-            if tint_sock.is_linked:
-                notes.append(f"material '{name}': linked Specular Tint (its constant colour)")
-            tint = _finite_color(name, tint_sock.default_value, "Specular Tint", notes)
-        layer = dict(ior=1.5, specular_tint=tint, multiscatter=distribution == "MULTI_GGX", shadowing="correlated",
-                     layered=True)
-    else:
-        specular = _constant(name, input_socket(node, "Specular"), "Specular", 0.5, notes, 0.0, 1e30)
-        root = min(0.08 * specular, 0.99) ** 0.5
-        layer = dict(ior=(1.0 + root) / (1.0 - root), multiscatter=False, shadowing="separable", layered=False)
-    spec = replace(base, kind="principled", roughness=rough, metallic=1.0, **layer)
-    emission = _emission(name, input_socket(node, "Emission Color", "Emission"),
-                         input_socket(node, "Emission Strength"), notes)
-    return replace(spec, emission=emission), image
 
 
 def _color_material(name, sock, notes):

@@ -18,11 +18,22 @@ Principled Principled::from_params(const Params& params) {
   m.roughness = std::clamp(roughness, 0.0f, 1.0f);
   m.multiscatter = params.flag("multiscatter", m.multiscatter);
   m.layered = params.flag("layered", m.layered);
+  m.burley = params.flag("burley", m.burley);
   m.shadowing = params.has("shadowing") ? shadowing_from_params(params) : m.shadowing;
   const double metallic = params.number("metallic", m.metallic);
   m.metallic = float(std::clamp(metallic, 0.0, 1.0));
   const float ior = float(params.number("ior", 1.45));  // every kind's default (the binding's)
   if (!(ior > 0.0f) || !std::isfinite(ior)) throw std::invalid_argument("principled: ior must be finite and > 0");
+  const double transmission = params.number("transmission", 0.0);
+  if (!std::isfinite(transmission)) throw std::invalid_argument("principled: transmission must be finite");
+  m.transmission = float(std::clamp(transmission, 0.0, 1.0));
+  const float glass_ior = float(params.positive("transmission_ior", ior));
+  if (m.transmission > 0.0f) {
+    // 3.x: the macro Fresnel pair, single scattering; 4.0+: Fresnel per microfacet, Multiscatter
+    // GGX as the layer's.
+    const DielectricRoughness rough{m.roughness, m.shadowing, MicrofacetDistribution::Ggx};
+    m.glass = FresnelDielectric::make(glass_ior, rough, !m.layered, m.multiscatter && m.layered);
+  }
   const float level = float(params.non_negative("specular_ior_level", 0.5));
   const Vec3 tint = params.color("specular_tint", Vec3(1.0f));
   // Specular IOR Level scales F0 (0.5: as the IOR gives it); the IOR with that F0 then shapes the
@@ -99,31 +110,66 @@ Scatter lobe_over(const GlossyLobe& lobe, const Vec3& f) {
   return sc;
 }
 
+// 3.x: the base is Burley's diffuse about the shading normal on wo's side (as the integrator turns
+// it), with the Principled Roughness.
+Scatter burley_base(const Principled& m, const ShadingPoint& s, Scatter sc) {
+  if (!m.burley) return sc;
+  const Vec3 ng = glm::dot(s.ng, s.wo) > 0.0f ? s.ng : -s.ng;
+  sc.burley = true;
+  sc.retro = BurleyDiffuse{glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns, s.wo, m.roughness};
+  return sc;
+}
+
+// The opaque parts (no glass). scale: on the base's weight (what the glass's draw leaves it);
+// u: the lobe-choice number left for the metal's draw, or < 0: draw it here when needed.
+Scatter opaque_scatter(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx, const Vec3& albedo,
+                       float scale, float u);
+
 }  // namespace
 
 Scatter scatter(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx) {
   const Vec3 albedo = lambert_albedo(m.base, *ctx.textures, s.uv);
   if (m.metallic >= 1.0f) return Scatter::glossy_lobe(metal_lobe(m, s, albedo));
+  const float glass = (1.0f - m.metallic) * m.transmission;
+  if (glass <= 0.0f) return opaque_scatter(m, s, ctx, albedo, 1.0f, -1.0f);
+  // One of glass and opaque parts, each with probability its weight and then counted unweighted;
+  // the base, always there in the opaque answer, carries (1 - transmission) of its weight over
+  // the opaque draw's probability. The rest of the number, rescaled to [0, 1), is the metal's.
+  const float u = ctx.lobe_uniform();
+  if (u < glass) return scatter(m.glass, s, ctx);
+  return opaque_scatter(m, s, ctx, albedo, (1.0f - m.transmission) / (1.0f - glass),
+                        std::min((u - glass) / (1.0f - glass), 0x1.fffffep-1f));
+}
+
+namespace {
+
+Scatter opaque_scatter(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx, const Vec3& albedo,
+                       float scale, float u) {
   const float dielectric = 1.0f - m.metallic;
+  // Given no glass (probability 1 - glass), the metal's probability is metallic / (1 - glass).
+  const float metal_share = m.metallic / (1.0f - (1.0f - m.metallic) * m.transmission);
+  const auto metal_drawn = [&] { return (u < 0.0f ? ctx.lobe_uniform() : u) < metal_share; };
   if (!m.layered) {
     // 3.x: one lobe whose F0 goes from the dielectric's to the base colour with Metallic, over
     // the base weighted 1 - Metallic.
-    if (m.eta == 1.0f && m.metallic == 0.0f) return Scatter::diffuse(lambert_f(albedo));
+    if (m.eta == 1.0f && m.metallic == 0.0f) return burley_base(m, s, Scatter::diffuse(scale * lambert_f(albedo)));
     const Vec3 f0 = glm::mix(m.f0, glm::clamp(albedo, Vec3(0.0f), Vec3(1.0f)), m.metallic);
-    return lobe_over(dielectric_layer(m, s, f0).lobe, dielectric * lambert_f(albedo));
+    return burley_base(m, s, lobe_over(dielectric_layer(m, s, f0).lobe, scale * dielectric * lambert_f(albedo)));
   }
   // 4.0+: Metallic mixes a metal with the dielectric layer over its base. The base is always
   // there; of the two lobes one is drawn with probability its weight (its value then counts
   // once, unweighted), which is what Cycles does when it picks a closure to continue with.
   if (m.eta == 1.0f) {
-    if (m.metallic == 0.0f) return Scatter::diffuse(lambert_f(albedo));
-    if (ctx.lobe_uniform() < m.metallic) return lobe_over(metal_lobe(m, s, albedo), dielectric * lambert_f(albedo));
-    return Scatter::diffuse(dielectric * lambert_f(albedo));
+    if (m.metallic == 0.0f) return Scatter::diffuse(scale * lambert_f(albedo));
+    if (metal_drawn()) return lobe_over(metal_lobe(m, s, albedo), scale * dielectric * lambert_f(albedo));
+    return Scatter::diffuse(scale * dielectric * lambert_f(albedo));
   }
   const Layer layer = dielectric_layer(m, s, m.f0);
-  const Vec3 f = dielectric * layer.base * lambert_f(albedo);
-  if (m.metallic > 0.0f && ctx.lobe_uniform() < m.metallic) return lobe_over(metal_lobe(m, s, albedo), f);
+  const Vec3 f = scale * dielectric * layer.base * lambert_f(albedo);
+  if (m.metallic > 0.0f && metal_drawn()) return lobe_over(metal_lobe(m, s, albedo), f);
   return lobe_over(layer.lobe, f);
 }
+
+}  // namespace
 
 }  // namespace toyrt

@@ -15,19 +15,31 @@
 // lobe's F0 from the dielectric's to the base colour and weights the base 1 - metallic.
 // Blender 3.x's Principled (layered False, shadowing 'separable') adds the same kind of layer to
 // a base it leaves whole: F0 = 0.08 Specular times its tint colour, the curve of the IOR with
-// that F0 (the add-on converts); its Burley diffuse is taken as Lambert (the add-on's note).
+// that F0 (the add-on converts), over Burley's diffuse (burley True: materials/burley_diffuse.h),
+// whose value the integrator takes per light direction.
 // The integrator sees what a Mix of Diffuse and Glossy gives it (scatter.h's Glossy answer with a
 // diffuse part), so the base's direct light is a Lambert hit's and the layer's is MIS'd.
 //
 // Parameters (add_material('principled', ...)): color ((0.8, 0.8, 0.8)), texture (the base
 // colour), roughness (0.5, clamped to [0, 1]), ior (1.45, every kind's; > 0), specular_ior_level (0.5, >= 0),
 // specular_tint ((1, 1, 1), >= 0), multiscatter (True), layered (True; False: 3.x), shadowing
-// ('correlated', 4.0+; 'separable', 3.x), metallic (0, clamped to [0, 1]).
+// ('correlated', 4.0+; 'separable', 3.x), metallic (0, clamped to [0, 1]), burley (False; True:
+// 3.x's Burley diffuse base instead of Lambert), transmission (0, clamped to [0, 1]) and
+// transmission_ior (the ior): the share of a glass beside the opaque parts, below.
+//
+// Transmission (Cycles' order: the metal takes Metallic, the glass (1 - Metallic) Transmission,
+// the dielectric layer and base what is left): the glass is the Glass BSDF's rough dielectric of
+// the same roughness and masking (materials/refraction.h; 3.x's Fresnel-weighted lobe pair, 4.0+'s
+// Fresnel per microfacet with Multiscatter GGX as chosen), drawn with probability its share on the
+// lobe-choice number; otherwise the opaque parts answer as above with the base scaled so that its
+// expectation keeps its weight. Its colour is white (Cycles tints the transmission: the add-on's
+// note).
 #pragma once
 
 #include "core/params.h"
 #include "materials/glossy.h"
 #include "materials/lambert.h"
+#include "materials/refraction.h"
 #include "materials/scatter.h"
 
 #include <cstdint>
@@ -39,14 +51,18 @@ struct Principled {
   static constexpr const char* kParams =
       "color, texture (the base colour), roughness (0.5), ior (1.45), specular_ior_level (0.5),\n"
       "specular_tint ((1, 1, 1)), multiscatter (True), layered (True; False: Blender 3.x's sum),\n"
-      "shadowing ('correlated'; 'separable': 3.x), metallic (0): the Principled BSDF";
+      "shadowing ('correlated'; 'separable': 3.x), metallic (0), burley (False; True: 3.x's diffuse),\n"
+      "transmission (0), transmission_ior (the ior): the Principled BSDF";
   Lambert base;
   float roughness = 0.5f;  // in [0, 1]
   bool multiscatter = true;
   bool layered = true;  // the base scaled by what the layer leaves (4.0+), or whole (3.x)
+  bool burley = false;  // the base is Burley's diffuse (3.x), not Lambert
   GgxShadowing shadowing = GgxShadowing::HeightCorrelated;
   float metallic = 0.0f;  // in [0, 1]; 1: a metal of the base colour, no base
   Vec3 specular_tint{1.0f};
+  float transmission = 0.0f;  // in [0, 1]; > 0: `glass` takes (1 - metallic) transmission
+  FresnelDielectric glass;
   // Derived once from ior, specular_ior_level and specular_tint:
   float eta = 1.5f;      // the IOR whose curve shapes the Fresnel term; 1: no layer
   Vec3 f0{0.04f};        // the layer's reflectance at normal incidence, tint included, <= 1

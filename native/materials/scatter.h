@@ -9,6 +9,7 @@
 #pragma once
 
 #include "core/math.h"
+#include "materials/burley_diffuse.h"
 #include "materials/dielectric_lobe.h"
 #include "materials/glossy_lobe.h"
 #include "materials/texture.h"
@@ -67,6 +68,10 @@ struct Scatter {
   };
   Kind kind = Kind::Diffuse;
   Vec3 f{0.0f};  // Diffuse, and Glossy's diffuse part (0: none): for directions on wo's side
+  // Diffuse and Glossy's diffuse part: f times burley_factor(retro, wi) per light direction
+  // (Blender 3.x's Principled diffuse, materials/burley_diffuse.h) instead of f alone.
+  bool burley = false;
+  BurleyDiffuse retro;
   int count = 0;
   SpecularSample branches[2];
   GlossyLobe glossy;

@@ -68,6 +68,17 @@ struct DiffusePoint {
   int depth;
 };
 
+// The diffuse BRDF value towards wi: the point's f (Lambert), or f times Burley's factor (Blender
+// 3.x's Principled diffuse, materials/burley_diffuse.h). A template argument, not a run-time
+// test, so a Lambert hit runs the code it ran before Burley's existed.
+template <bool kBurley>
+[[gnu::always_inline]] inline Vec3 diffuse_f(const DiffusePoint& at, const BurleyDiffuse* retro, const Vec3& wi) {
+  if constexpr (kBurley)
+    return at.f * burley_factor(*retro, wi);
+  else
+    return at.f;
+}
+
 // A cosine-distributed direction around the shading normal, from sample dimension `dim` of the
 // point's path vertex; cos is its cosine to ns (the density is cos / pi).
 struct CosineDirection {
@@ -90,8 +101,9 @@ float mis_cos_over_pdf(float cos, float pdf, float other) { return cos * pdf / (
 // The environment map as a light: one sample from the map's distribution and one
 // cosine-distributed, combined by the power heuristic, so a bright sun in the map and a uniform
 // sky are both found with little noise.
-[[gnu::noinline]] Vec3 environment_lighting(const Scene& scene, const DiffusePoint& at, uint32_t pixel, uint32_t sample,
-                                            const IntegratorSettings& settings) {
+template <bool kBurley>
+[[gnu::noinline]] Vec3 environment_lighting(const Scene& scene, const DiffusePoint& at, const BurleyDiffuse* retro,
+                                            uint32_t pixel, uint32_t sample, const IntegratorSettings& settings) {
   const Environment& env = scene.world().environment;
   const Texture& image = scene.textures()[size_t(env.texture)];
   Vec3 sum(0.0f);
@@ -100,14 +112,14 @@ float mis_cos_over_pdf(float cos, float pdf, float other) { return cos * pdf / (
   if (es.pdf > 0.0f) {
     const float cos_s = glm::dot(at.ns, es.wi);
     if (cos_s > 0.0f && glm::dot(at.ng, es.wi) > 0.0f && !scene.shadowed(Ray{at.origin, 0.0f, es.wi, kInfinity})) {
-      sum += at.f * es.radiance * mis_cos_over_pdf(cos_s, es.pdf, cos_s * kInvPi);
+      sum += diffuse_f<kBurley>(at, retro, es.wi) * es.radiance * mis_cos_over_pdf(cos_s, es.pdf, cos_s * kInvPi);
     }
   }
   // A BSDF-sampled direction is a path ray, not a shadow ray: an object with visible_shadow off
   // still stops it, as Cycles' does (docs/lights.md).
   const CosineDirection c = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings);
   if (glm::dot(at.ng, c.wi) > 0.0f && c.cos > 0.0f && !scene.occluded(Ray{at.origin, 0.0f, c.wi, kInfinity}))
-    sum += at.f * environment_radiance(env, image, c.wi) *
+    sum += diffuse_f<kBurley>(at, retro, c.wi) * environment_radiance(env, image, c.wi) *
            mis_cos_over_pdf(c.cos, c.cos * kInvPi, environment_pdf(env, c.wi));
   return sum;
 }
@@ -136,8 +148,10 @@ EmissiveTriangle emissive_triangle_at(const Scene& scene, const Hit& hit, const 
 // hits. The cosine ray wins beside a large emitter (a floor under a glowing ball, which the
 // power-chosen triangle rarely finds well) and is the only strategy for emitters, or sides of
 // them, that shadow rays do not sample (emission sampling None, Front, Back).
-[[gnu::noinline]] Vec3 emission_lighting(const Scene& scene, const DiffusePoint& at, const Vec3& p, uint32_t pixel,
-                                         uint32_t sample, const IntegratorSettings& settings) {
+template <bool kBurley>
+[[gnu::noinline]] Vec3 emission_lighting(const Scene& scene, const DiffusePoint& at, const BurleyDiffuse* retro,
+                                         const Vec3& p, uint32_t pixel, uint32_t sample,
+                                         const IntegratorSettings& settings) {
   const MeshEmitters& emitters = scene.emitters();
   Vec3 sum(0.0f);
   if (!emitters.empty()) {
@@ -147,7 +161,7 @@ EmissiveTriangle emissive_triangle_at(const Scene& scene, const Hit& hit, const 
       const float cos_s = glm::dot(at.ns, ls.wi);
       if (cos_s > 0.0f && glm::dot(at.ng, ls.wi) > 0.0f &&
           !scene.shadowed(Ray{at.origin, 0.0f, ls.point - at.origin, 1.0f})) {
-        sum += at.f * ls.radiance * mis_cos_over_pdf(cos_s, ls.pdf, cos_s * kInvPi);
+        sum += diffuse_f<kBurley>(at, retro, ls.wi) * ls.radiance * mis_cos_over_pdf(cos_s, ls.pdf, cos_s * kInvPi);
       }
     }
   }
@@ -160,12 +174,15 @@ EmissiveTriangle emissive_triangle_at(const Scene& scene, const Hit& hit, const 
   const MaterialEmission& e = scene.emission()[size_t(m)];
   const EmissiveTriangle t = emissive_triangle_at(scene, hit, e);
   const float pl = emitter_pdf(emitters, p, t, wi, glm::dot(t.p0 + hit.u * t.e1 + hit.v * t.e2 - p, wi));
-  return sum + at.f * e.radiance * mis_cos_over_pdf(c.cos, c.cos * kInvPi, pl);
+  return sum + diffuse_f<kBurley>(at, retro, wi) * e.radiance * mis_cos_over_pdf(c.cos, c.cos * kInvPi, pl);
 }
 
 // Light arriving at a diffuse point: one sample per light, or one light chosen by contribution.
-Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f, int depth,
-                     uint32_t pixel, uint32_t sample, const IntegratorSettings& settings) {
+// kBurley: the BRDF is f times Burley's factor of *retro (else f; retro unread).
+template <bool kBurley>
+Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f,
+                     const BurleyDiffuse* retro, int depth, uint32_t pixel, uint32_t sample,
+                     const IntegratorSettings& settings) {
   const World& world = scene.world();
   const Vec3 origin = offset_ray_origin(s.p, ng);
   const DiffusePoint at{origin, ng, ns, f, depth};
@@ -186,20 +203,20 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
           std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
       if (scene.shadowed(shadow)) return;
     }
-    sum += f * ls.radiance * (cos_s / (ls.pdf * select_probability));
+    sum += diffuse_f<kBurley>(at, retro, ls.wi) * ls.radiance * (cos_s / (ls.pdf * select_probability));
   };
   // The world, emissive meshes: each in a function of its own, out of line, so a scene of lamps
   // and a constant world runs the same small loop as before they existed.
   if (world.background_lights_surfaces && world.environment.active())
-    sum += environment_lighting(scene, at, pixel, sample, settings);
+    sum += environment_lighting<kBurley>(scene, at, retro, pixel, sample, settings);
   else if (world.background_lights_surfaces && world.background != Vec3(0.0f)) {
     // A constant background: a cosine-distributed direction makes the estimate f L cos / pdf =
     // albedo L when nothing blocks it, exactly. A BSDF-sampled ray: every object stops it.
     const Vec3 wi = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings).wi;
     if (glm::dot(ng, wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, wi, kInfinity}))
-      sum += f * world.background * kPi;  // f = albedo / pi
+      sum += diffuse_f<kBurley>(at, retro, wi) * world.background * kPi;  // f = albedo / pi
   }
-  if (scene.any_emission()) sum += emission_lighting(scene, at, s.p, pixel, sample, settings);
+  if (scene.any_emission()) sum += emission_lighting<kBurley>(scene, at, retro, s.p, pixel, sample, settings);
   const std::vector<Light>& lights = world.lights;
   if (settings.light_sampling != LightSampling::One || lights.size() == 1) {
     for (size_t j = 0; j < lights.size(); ++j) add(j, 1.0f, 1 + uint32_t(j));
@@ -210,6 +227,13 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     if (pick.found()) add(size_t(pick.index), pick.probability, 1);
   }
   return sum;
+}
+
+// A Burley diffuse point's direct light: out of line, so the Lambert path's loop does not grow.
+[[gnu::noinline]] Vec3 burley_direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns,
+                                              const Vec3& f, const BurleyDiffuse& retro, int depth, uint32_t pixel,
+                                              uint32_t sample, const IntegratorSettings& settings) {
+  return direct_lighting<true>(scene, s, ng, ns, f, &retro, depth, pixel, sample, settings);
 }
 
 // The radiance of the lights a camera (depth 0) or specular ray passes before distance `limit`
@@ -301,13 +325,21 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             // f by value: a reference into sc would make the whole answer (its glossy lobe and
             // specular branches, dead here) live in memory across the call.
             const Vec3 f = sc.f;
-            radiance += throughput * direct_lighting(scene, s, ng, ns, f, depth, pixel, sample, settings);
+            if (sc.burley)  // a constant false for Lambert's inline scatter(): folded away
+              radiance +=
+                  throughput * burley_direct_lighting(scene, s, ng, ns, f, sc.retro, depth, pixel, sample, settings);
+            else
+              radiance +=
+                  throughput * direct_lighting<false>(scene, s, ng, ns, f, nullptr, depth, pixel, sample, settings);
             return false;
           }
           if (sc.kind == Scatter::Kind::Glossy) {
             if (first) first->diffuse = sc.f * kPi;  // the diffuse part beside the lobe (Mix, Add)
             if (sc.f != Vec3(0.0f))
-              radiance += throughput * direct_lighting(scene, s, ng, ns, sc.f, depth, pixel, sample, settings);
+              radiance +=
+                  throughput *
+                  (sc.burley ? burley_direct_lighting(scene, s, ng, ns, sc.f, sc.retro, depth, pixel, sample, settings)
+                             : direct_lighting<false>(scene, s, ng, ns, sc.f, nullptr, depth, pixel, sample, settings));
             const Vec3 origin = offset_ray_origin(s.p, ng);
             const GlossyStep g =
                 glossy_vertex(scene, s.p, origin, ng, sc.glossy, pixel, sample, vertex_dimension(depth, 1),

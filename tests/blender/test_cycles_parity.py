@@ -341,15 +341,15 @@ SCENES_SPEC = [
     ("mix_diffuse_glossy", scene_diffuse_and_glossy, dict(balls=[(0.2, 0.3), (0.5, 0.3), (0.8, 0.3), (None, 0.1)],
                                                           mean_limit=0.005, sample_factor=4), 8),
     # Principled dielectrics: a roughness sweep under a point lamp, and Specular levels and tints
-    # under an area lamp (3.x: a Lambert base for its Burley diffuse, so reported there only).
+    # under an area lamp (3.x: a Burley diffuse base, 4.0+: a Lambert base layered under the layer).
     ("principled_sweep_point", scene_principled, dict(balls=[(r, 0.5, None) for r in (0.05, 0.2, 0.4, 0.7, 1.0)],
                                                       color=(0.7, 0.25, 0.15), lamp="point", mean_limit=0.005,
-                                                      asserted_from=(4, 0, 0), sample_factor=2), 8),
+                                                      sample_factor=2), 8),
     ("principled_specular_area", scene_principled, dict(balls=[(0.3, 0.0, None), (0.3, 1.0, None),
                                                                (0.3, 0.5, (1.0, (1.0, 0.5, 0.2))),
                                                                (0.15, 2.0, None), (0.6, 0.25, None)],
                                                         color=(0.2, 0.45, 0.7), lamp="area", mean_limit=0.005,
-                                                        asserted_from=(4, 0, 0), sample_factor=4), 8),
+                                                        sample_factor=4), 8),
     # Principled metals (Metallic 1): 3.x's Fresnel blend from the base colour, 4.0+'s F82-tint
     # with Multiscatter GGX.
     ("metal_sweep", scene_metal_sweep, dict(roughness=[0.05, 0.2, 0.4, 0.7, 1.0], color=(0.9, 0.75, 0.5),
@@ -402,6 +402,29 @@ def scene_area_spread(p):
 SCENES_SPEC.append(("area_spread", scene_area_spread,
                     dict(light=(-0.5, 0.5, 2.2), light_target=(0.3, 0.0, 0.0), power=150.0, size=2.0, size_y=1.2,
                          spread=0.5236, camera=(0.0, -6.0, 4.5), mean_limit=0.005, sample_factor=8), 0))
+
+
+# Principled Transmission (white base, so that neither version's transmission tint shows): a ball
+# of Transmission 1 (the Glass BSDF's lobe) beside one of 0.5 (the glass drawn beside the opaque
+# parts: 3.x's Burley base and layer, 4.0+'s layered base), roughness 0.3, IOR 1.45, the rough
+# glass scene's lamp and floor. 16x the samples: the partial ball draws glass or opaque parts per
+# hit in TOYRT (one of them, unweighted), a noisier estimator than Cycles' (NEE over all closures).
+def scene_principled_glass(p):
+    floor = checker("checker", 8, 0.15, 0.85)
+    kit.plane("floor", 6.0, floor, uv_repeat=4.0)
+    for i, (weight, x) in enumerate(((1.0, -0.8), (0.5, 0.8))):
+        mat = kit.principled_dielectric(f"principled_glass{i}", (1.0, 1.0, 1.0), p["roughness"])
+        bsdf = mat.node_tree.nodes["Principled BSDF"]
+        kit.input_of(bsdf, "Transmission Weight", "Transmission").default_value = weight
+        bsdf.inputs["IOR"].default_value = 1.45
+        kit.uv_sphere(f"ball{i}", 0.6, (x, 0.0, 0.65), mat)
+    kit.area_light("panel", (1.0, -1.0, 3.0), 200.0, 4.0, 3.0, target=(0, 0, 0))
+    camera((0.0, -5.0, 2.5), (0, 0, 0.4))
+    kit.world((0.05, 0.05, 0.05))
+
+
+SCENES_SPEC.append(("principled_glass", scene_principled_glass, dict(roughness=0.3, mean_limit=0.005,
+                                                                     sample_factor=16), 8))
 
 # ---- Cycles ------------------------------------------------------------------------------------
 
@@ -601,11 +624,11 @@ def write_doc(results):
         "GGX (4.x/5.x default to Multiscatter GGX, which TOYRT renders as Cycles compensates it; 3.x's is a "
         "random walk, rendered as single-scatter GGX and noted).",
         "- Principled BSDF (docs/render.md, 'Principled BSDF and Multiscatter GGX'): principled_sweep_point and "
-        "principled_specular_area (Metallic 0: a Lambert base under a GGX layer) are asserted from 4.0, where "
-        "TOYRT renders Cycles' model (energy layering, Multiscatter GGX); on 3.x they are reported: Cycles 3.x's "
-        "Burley diffuse (darker towards grazing, with a roughness-dependent retro-reflection) is Lambert in "
-        "TOYRT. metal_sweep (Metallic 1, Blender's defaults otherwise: 3.x GGX with its Fresnel blend from the "
-        "base colour, 4.0+ Multiscatter GGX with F82-tint) is asserted on both.",
+        "principled_specular_area (Metallic 0) are asserted on both: 4.0+'s Lambert base energy-layered under "
+        "a GGX layer (Multiscatter GGX), 3.x's Burley diffuse (darker towards grazing, with a "
+        "roughness-dependent retro-reflection) with the layer added. metal_sweep (Metallic 1, Blender's "
+        "defaults otherwise: 3.x GGX with its Fresnel blend from the base colour, 4.0+ Multiscatter GGX with "
+        "F82-tint) is asserted on both.",
         "",
     ]
     DOC.write_text("\n".join(lines))

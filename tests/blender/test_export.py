@@ -425,8 +425,9 @@ def test_principled_specular_layer():
     """A Principled BSDF with Metallic 0 becomes the 'principled' kind on each Blender as its Cycles
     shades it: 4.0+ keeps its IOR, Specular IOR Level and tint colour, layered over the base,
     Multiscatter GGX by default; 3.x's F0 = 0.08 x Specular becomes the layer's IOR, tinted towards
-    the base colour's hue, added to a whole base, with a note for its Burley diffuse; Specular 0
-    leaves the plain Lambert base with no note."""
+    the base colour's hue (its luminance by Cycles 3.x's weights 0.3, 0.6, 0.1), added to a whole
+    Burley diffuse base. Specular 0 leaves the plain base with no note: Lambert on 4.0+, Burley's
+    (the 'principled' kind at IOR 1) on 3.x."""
     _, _ = addon()
     from render_toyrt import materials
 
@@ -437,19 +438,21 @@ def test_principled_specular_layer():
     tinted = materials.material_spec(kit.principled_dielectric("tinted", base, 0.3, specular=1.0,
                                                                tint=(1.0, 0.5, 0.2) if new else 1.0))
     check(default.spec.kind == "principled" and default.spec.multiscatter == new
-          and default.spec.layered == new and default.spec.shadowing == ("correlated" if new else "separable"),
+          and default.spec.layered == new and default.spec.shadowing == ("correlated" if new else "separable")
+          and default.spec.burley == (not new),
           f"the default Principled material has a specular layer: {default.spec}")
-    check(none.spec.kind == "diffuse" and np.allclose(none.spec.color, base) and not none.notes,
-          f"Specular 0: the Lambert base, no note: {none}")
+    check((none.spec.kind == "diffuse" if new else none.spec.kind == "principled" and none.spec.ior == 1.0
+           and none.spec.burley) and np.allclose(none.spec.color, base) and not none.notes,
+          f"Specular 0: the base alone, no note: {none}")
     t = tinted.spec
     if new:
         want = dict(ior=1.5, specular_ior_level=1.0, specular_tint=(1.0, 0.5, 0.2))
         ok = not tinted.notes
     else:
-        lum = 0.2126 * base[0] + 0.7152 * base[1] + 0.0722 * base[2]
+        lum = 0.3 * base[0] + 0.6 * base[1] + 0.1 * base[2]
         want = dict(ior=(1 + 0.08 ** 0.5) / (1 - 0.08 ** 0.5), specular_ior_level=0.5,
                     specular_tint=tuple(c / lum for c in base))
-        ok = len(tinted.notes) == 1 and "Burley" in tinted.notes[0]
+        ok = not tinted.notes and t.burley
     got = dict(ior=t.ior, specular_ior_level=t.specular_ior_level, specular_tint=t.specular_tint)
     check(ok and abs(t.roughness - 0.3) < 1e-6 and all(np.allclose(got[k], want[k], rtol=1e-5) for k in want),
           f"Specular 1 with a tint: {got} ({want}); notes {tinted.notes}")
@@ -459,6 +462,37 @@ def test_principled_specular_layer():
     check(h.spec.kind == "principled" and abs(h.spec.metallic - 0.4) < 1e-6
           and not any("etallic" in n for n in h.notes),
           f"Metallic 0.4 is modelled (a mix of metal and dielectric): {h}")
+
+
+def test_principled_transmission():
+    """A Principled BSDF's Transmission (3.x) / Transmission Weight (4.0+) becomes the 'principled'
+    kind's glass share, with the IOR socket's value as the glass's IOR (3.x's layer keeps its
+    Specular IOR) and the roughness kept, at 0.5 and at 1; the base colour's tint of the
+    transmission is noted (white); Metallic 1 stays the metal."""
+    _, _ = addon()
+    from render_toyrt import materials
+
+    new = bpy.app.version >= (4, 0, 0)
+    for weight in (0.5, 1.0):
+        mat = kit.principled_dielectric(f"glassy{weight}", (0.9, 0.8, 0.7), 0.3)
+        node = mat.node_tree.nodes["Principled BSDF"]
+        kit.input_of(node, "Transmission Weight", "Transmission").default_value = weight
+        node.inputs["IOR"].default_value = 1.33
+        c = materials.material_spec(mat)
+        check(c.spec.kind == "principled" and abs(c.spec.transmission - weight) < 1e-6
+              and abs(c.spec.transmission_ior - 1.33) < 1e-6 and abs(c.spec.roughness - 0.3) < 1e-6
+              and c.spec.burley == (not new) and c.spec.arguments()["transmission"] == c.spec.transmission
+              and any("transmission colour (white)" in n for n in c.notes)
+              and not any("not modelled" in n for n in c.notes),
+              f"Transmission {weight}: a glass share beside the opaque parts: {c}")
+    white = kit.principled_dielectric("white_glass", (1.0, 1.0, 1.0), 0.0)
+    kit.input_of(white.node_tree.nodes["Principled BSDF"], "Transmission Weight", "Transmission").default_value = 1.0
+    w = materials.material_spec(white)
+    check(w.spec.transmission == 1.0 and not w.notes, f"white glass: nothing to note: {w}")
+    metal = kit.metal("glassy_metal", (0.9, 0.8, 0.7), 0.3)
+    kit.input_of(metal.node_tree.nodes["Principled BSDF"], "Transmission Weight", "Transmission").default_value = 1.0
+    m = materials.material_spec(metal)
+    check(m.spec.metallic == 1.0 and m.spec.transmission == 0.0, f"Metallic 1 is the metal (no glass): {m}")
 
 
 def test_rough_glass_and_refraction():
@@ -633,6 +667,6 @@ def test_command_line_range():
 
 
 PARTS = [test_counts_and_transforms, test_instancing_memory, test_missing_texture, test_unsupported_node,
-         test_principled_specular_layer, test_rough_glass_and_refraction, test_cancel,
+         test_principled_specular_layer, test_principled_transmission, test_rough_glass_and_refraction, test_cancel,
          test_animation, test_command_line_range]
 run_script(PARTS, "export", TMP)

@@ -33,6 +33,36 @@ def test_unlayered_rough_principled_is_lambert_plus_f0_over_4_pi():
     np.testing.assert_allclose(got, (color / math.pi + 0.04 / (4 * math.pi)) * IRRADIANCE, rtol=1e-4)
 
 
+def lit_from(x, **material):
+    """The floor's pixel straight below the camera, lit by a 100 W point lamp at (x, 0, 2)."""
+    s = toyrt.Scene()
+    s.add_material("principled", **material)
+    s.add_mesh(np.float32([[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]]), [[0, 1, 2], [0, 2, 3]], material_ids=0)
+    s.background = (0.0, 0.0, 0.0)
+    s.add_point_light((x, 0.0, 2.0), 100.0)
+    s.commit()
+    m = np.eye(4)
+    m[2, 3] = 5.0
+    return s.render(dict(type="ORTHO", ortho_scale=1e-3, resolution_x=1, resolution_y=1, matrix_world=m),
+                    samples=16)[0, 0, :3]
+
+
+@pytest.mark.parametrize("roughness", [0.0, 0.5, 1.0])
+def test_burley_base_has_its_closed_form_under_an_oblique_lamp(roughness):
+    # Blender 3.x's Burley diffuse seen head-on (FV = 0) and lit at cos_i: albedo / pi times
+    # (1 - FL / 2) + R FL, FL = (1 - cos_i)^5, R = roughness (1 + cos_i); no layer at IOR 1.
+    color = np.array([0.6, 0.3, 0.1])
+    x = 3.0
+    d2 = x * x + 4.0
+    cos_i = 2.0 / math.sqrt(d2)
+    fl = (1.0 - cos_i) ** 5
+    factor = 1.0 - 0.5 * fl + roughness * (1.0 + cos_i) * fl
+    got = lit_from(x, color=tuple(color), roughness=roughness, ior=1.0, layered=False, burley=True)
+    lambert = lit_from(x, color=tuple(color), roughness=roughness, ior=1.0, layered=False)
+    np.testing.assert_allclose(got, color / math.pi * factor * 100.0 / (4 * math.pi * d2) * cos_i, rtol=1e-4)
+    np.testing.assert_allclose(got, lambert * factor, rtol=1e-5)
+
+
 def test_specular_tint_and_level_scale_f0():
     got = floor(color=(0.0, 0.0, 0.0), roughness=1.0, ior=1.5, specular_ior_level=1.0,
                 specular_tint=(1.0, 0.5, 0.0), layered=False, multiscatter=False)
@@ -61,3 +91,44 @@ def test_bad_parameters_are_refused_by_name(bad):
     s = toyrt.Scene()
     with pytest.raises(ValueError, match=next(iter(bad))):
         s.add_material("principled", **bad)
+
+
+def sphere_scene(kind, **material):
+    """A sphere of the material over a lit checker-free floor, seen in perspective: the pixels a
+    rough glass's reflection, transmission and the floor through it make."""
+    s = toyrt.Scene()
+    s.add_material(kind, **material)
+    s.add_material("diffuse", color=(0.6, 0.6, 0.6))
+    n_lat, n_lon = 24, 48
+    theta = np.linspace(0, np.pi, n_lat + 1)
+    phi = np.linspace(0, 2 * np.pi, n_lon, endpoint=False)
+    verts = np.float32([[np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), 1.0 + np.cos(t)] for t in theta for p in phi])
+    tris = []
+    for i in range(n_lat):
+        for j in range(n_lon):
+            a, b = i * n_lon + j, i * n_lon + (j + 1) % n_lon
+            c, d = a + n_lon, b + n_lon
+            tris += [[a, c, b], [b, c, d]]
+    s.add_mesh(verts, tris, material_ids=0)
+    s.add_mesh(np.float32([[-9, -9, 0], [9, -9, 0], [9, 9, 0], [-9, 9, 0]]), [[0, 1, 2], [0, 2, 3]], material_ids=1)
+    s.background = (0.2, 0.2, 0.25)
+    s.add_point_light((2.0, -2.0, 4.0), 400.0)
+    s.commit()
+    m = np.eye(4)
+    m[:3, 3] = (0.0, 0.0, 7.0)
+    return s.render(dict(type="PERSP", resolution_x=32, resolution_y=24, matrix_world=m), samples=16, seed=3,
+                    max_specular_depth=8)
+
+
+@pytest.mark.parametrize("version", ["4.0+", "3.x"])
+def test_principled_transmission_one_renders_the_glass_bsdf(version):
+    # Transmission 1, Metallic 0: every hit draws the glass, which is the Glass BSDF's lobe of the
+    # same roughness and conventions: the same image, bit for bit (the same sample numbers).
+    new = version == "4.0+"
+    glass = sphere_scene("glass", ior=1.45, roughness=0.3, shadowing="correlated" if new else "separable",
+                         fresnel="microfacet" if new else "macro", multiscatter=new)
+    principled = sphere_scene("principled", color=(0.7, 0.3, 0.2), ior=1.8 if not new else 1.45, transmission=1.0,
+                              transmission_ior=1.45, roughness=0.3, layered=new, burley=not new, multiscatter=new,
+                              shadowing="correlated" if new else "separable")
+    assert glass.mean() > 0.0
+    np.testing.assert_array_equal(principled, glass)

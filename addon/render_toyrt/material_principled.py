@@ -1,0 +1,165 @@
+"""The Principled BSDF -> MaterialSpec, per Blender version (docs/render.md, 'Principled BSDF and
+Multiscatter GGX'): 4.0+'s Lambert base energy-layered under a dielectric layer (F0 from the IOR
+and Specular IOR Level, a tint colour) or a metal (F82-tint); 3.x's Burley diffuse base with the
+layer added (F0 = 0.08 x Specular, a scalar Specular Tint towards the base colour's hue) or its
+metal (the dielectric curve blended from the base colour). What is not modelled goes in the note."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+from .material_dielectric import ior_value
+from .materials import (
+    _blender_version,
+    _color_material,
+    _constant,
+    _emission,
+    _finite_color,
+    input_socket,
+)
+
+
+def principled_spec(name, node, notes):
+    """A Principled BSDF as (MaterialSpec, image): a metal at Metallic 1, else the 'principled'
+    kind (or the plain base) as the Blender version's Cycles shades it, its Transmission a glass
+    beside the opaque parts."""
+    metal = input_socket(node, "Metallic")
+    if metal is not None and not metal.is_linked and metal.default_value >= 0.999:
+        return _metal(name, node, notes)
+    extras = []
+    metallic = _constant(name, metal, "Metallic", 0.0, notes, 0.0, 1.0)
+    glass = _transmission(name, node, notes)
+    for label, names in (("coat", ("Coat Weight", "Clearcoat")), ("sheen", ("Sheen Weight", "Sheen")),
+                         ("subsurface", ("Subsurface Weight", "Subsurface")), ("anisotropy", ("Anisotropic",)),
+                         ("diffuse roughness", ("Diffuse Roughness",)), ("thin film", ("Thin Film Thickness",))):
+        sock = input_socket(node, *names)
+        if sock is not None and (sock.is_linked or sock.default_value > 0.0):
+            extras.append(label)
+    normal = input_socket(node, "Normal")
+    if normal is not None and normal.is_linked:
+        extras.append("normal input")
+    emission = _emission(name, input_socket(node, "Emission Color", "Emission"),  # 4.0+ / 3.x
+                         input_socket(node, "Emission Strength"), notes)
+    base, image = _color_material(name, input_socket(node, "Base Color"), notes)
+    if base.texture is None:
+        base = replace(base, color=_finite_color(name, base.color, "base colour", notes))
+    layer = _specular_layer(name, node, base, extras, notes)
+    if extras:
+        notes.append(f"material '{name}': Principled {', '.join(extras)} (not modelled)")
+    if glass and (base.texture is not None or any(c != 1.0 for c in base.color)):
+        notes.append(f"material '{name}': Principled transmission colour (white)")
+    if layer is None and (metallic > 0.0 or glass):   # no dielectric layer, but a metal or glass beside the base
+        new = _blender_version() >= (4, 0, 0)
+        layer = dict(roughness=_constant(name, input_socket(node, "Roughness"), "roughness", 0.5, notes, 0.0, 1.0),
+                     ior=1.0, multiscatter=new and getattr(node, "distribution", "GGX") == "MULTI_GGX",
+                     shadowing="correlated" if new else "separable", layered=new)
+    spec = base if layer is None else replace(base, kind="principled", metallic=metallic, **layer, **glass)
+    return replace(spec, emission=emission), image
+
+
+def _transmission(name, node, notes) -> dict:
+    """Transmission (3.x) / Transmission Weight (4.0+) as the 'principled' kind's transmission
+    arguments ({} for none): the weight and the IOR socket's value (3.x's Specular sets the layer's
+    IOR, not the glass's). 3.x's Transmission Roughness, which roughens the refraction alone, is
+    the Roughness (noted)."""
+    trans = input_socket(node, "Transmission Weight", "Transmission")
+    weight = _constant(name, trans, "Transmission", 0.0, notes, 0.0, 1.0)
+    if weight <= 0.0:
+        return {}
+    extra = input_socket(node, "Transmission Roughness")   # 3.x only
+    if extra is not None and (extra.is_linked or extra.default_value > 0.0):
+        notes.append(f"material '{name}': Principled Transmission Roughness (the Roughness)")
+    return dict(transmission=weight, transmission_ior=ior_value(name, node, notes))
+
+
+# The luminance Cycles 3.x's Principled specular divides the base colour by for its Specular Tint:
+# a fixed approximation, not the scene's Rec.709 weights.
+_LUMINANCE = (0.3, 0.6, 0.1)
+
+
+def _specular_layer(name, node, base, extras, notes):
+    """The Principled BSDF's dielectric specular layer as the 'principled' kind's arguments, per
+    Blender version; 4.0+: None where there is none (Specular IOR Level 0, IOR 1); 3.x always (its
+    Burley diffuse base is the 'principled' kind's, with IOR 1 for Specular 0: no layer)."""
+    rough = _constant(name, input_socket(node, "Roughness"), "roughness", 0.5, notes, 0.0, 1.0)
+    distribution = getattr(node, "distribution", "GGX")
+    if _blender_version() >= (4, 0, 0):
+        # A Lambert base energy-layered under the layer; F0 from the IOR times 2 x Specular IOR
+        # Level, tinted by the Specular Tint colour; Multiscatter GGX by default.
+        ior = _constant(name, input_socket(node, "IOR"), "IOR", 1.5, notes, 1e-5, 1e30)
+        level = _constant(name, input_socket(node, "Specular IOR Level"), "Specular IOR Level", 0.5, notes, 0.0, 1e30)
+        tint_sock = input_socket(node, "Specular Tint")
+        tint = (1.0, 1.0, 1.0)
+        if tint_sock is not None:
+            if tint_sock.is_linked:
+                notes.append(f"material '{name}': linked Specular Tint (its constant colour)")
+            tint = _finite_color(name, tint_sock.default_value, "Specular Tint", notes)
+        if ior == 1.0 or level == 0.0:
+            return None
+        if distribution not in ("GGX", "MULTI_GGX"):
+            notes.append(f"material '{name}': Principled {distribution.title()} distribution (GGX)")
+        return dict(roughness=rough, ior=ior, specular_ior_level=level, specular_tint=tint,
+                    multiscatter=distribution == "MULTI_GGX", shadowing="correlated", layered=True)
+    # 3.x: the layer added to a whole Burley diffuse base (no layering); F0 = 0.08 x Specular,
+    # tinted towards the base colour's hue by Specular Tint; the IOR socket is for transmission only.
+    specular = _constant(name, input_socket(node, "Specular"), "Specular", 0.5, notes, 0.0, 1e30)
+    if specular == 0.0:
+        return dict(roughness=rough, ior=1.0, multiscatter=False, shadowing="separable", layered=False, burley=True)
+    if distribution == "MULTI_GGX":
+        notes.append(f"material '{name}': Multiscatter GGX of Blender 3.x (single-scatter GGX)")
+    amount = _constant(name, input_socket(node, "Specular Tint"), "Specular Tint", 0.0, notes, 0.0, 1.0)
+    tint = (1.0, 1.0, 1.0)
+    if amount > 0.0:
+        if base.texture is not None:
+            notes.append(f"material '{name}': Specular Tint of a textured base colour (untinted)")
+        else:
+            lum = sum(w * c for w, c in zip(_LUMINANCE, base.color))
+            hue = tuple(c / lum for c in base.color) if lum > 0.0 else (1.0, 1.0, 1.0)
+            tint = tuple(1.0 + amount * (h - 1.0) for h in hue)
+    f0 = min(0.08 * specular, 0.99)
+    root = f0 ** 0.5
+    return dict(roughness=rough, ior=(1.0 + root) / (1.0 - root), specular_ior_level=0.5, specular_tint=tint,
+                multiscatter=False, shadowing="separable", layered=False, burley=True)
+
+
+def _metal(name, node, notes):
+    """Principled BSDF with Metallic 1: a metal layer whose reflectance at normal incidence is the
+    base colour (or its texture), no base under it, emission kept. 4.0+: F82-tint Fresnel with
+    Specular Tint, Multiscatter GGX by default; 3.x: the dielectric curve of the Specular's IOR
+    blended from the base colour to white. The coat, anisotropy and other distributions go in the
+    one note."""
+    extras = []
+    coat = input_socket(node, "Coat Weight", "Clearcoat")
+    if coat is not None and (coat.is_linked or coat.default_value > 0.0):
+        extras.append("coat")
+    aniso = input_socket(node, "Anisotropic")
+    if aniso is not None and (aniso.is_linked or aniso.default_value > 0.0):
+        extras.append("anisotropy")
+    distribution = getattr(node, "distribution", "GGX")
+    new = _blender_version() >= (4, 0, 0)
+    if distribution not in ("GGX", "MULTI_GGX"):
+        extras.append(f"{distribution.title()} distribution (GGX)")
+    elif distribution == "MULTI_GGX" and not new:
+        extras.append("Multiscatter GGX of Blender 3.x (single-scatter GGX)")
+    if extras:
+        notes.append(f"material '{name}': Principled metal without {', '.join(extras)}")
+    base, image = _color_material(name, input_socket(node, "Base Color"), notes)
+    if base.texture is None:
+        base = replace(base, color=_finite_color(name, base.color, "base colour", notes))
+    rough = _constant(name, input_socket(node, "Roughness"), "roughness", 0.5, notes, 0.0, 1.0)
+    if new:
+        tint_sock = input_socket(node, "Specular Tint")
+        tint = (1.0, 1.0, 1.0)
+        if tint_sock is not None and hasattr(tint_sock.default_value, "__len__"):
+            if tint_sock.is_linked:
+                notes.append(f"material '{name}': linked Specular Tint (its constant colour)")
+            tint = _finite_color(name, tint_sock.default_value, "Specular Tint", notes)
+        layer = dict(ior=1.5, specular_tint=tint, multiscatter=distribution == "MULTI_GGX", shadowing="correlated",
+                     layered=True)
+    else:
+        specular = _constant(name, input_socket(node, "Specular"), "Specular", 0.5, notes, 0.0, 1e30)
+        root = min(0.08 * specular, 0.99) ** 0.5
+        layer = dict(ior=(1.0 + root) / (1.0 - root), multiscatter=False, shadowing="separable", layered=False)
+    spec = replace(base, kind="principled", roughness=rough, metallic=1.0, **layer)
+    emission = _emission(name, input_socket(node, "Emission Color", "Emission"),
+                         input_socket(node, "Emission Strength"), notes)
+    return replace(spec, emission=emission), image
