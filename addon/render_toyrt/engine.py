@@ -57,7 +57,7 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             report.error(f"render failed: {err}", self.report)
 
     def _render(self, depsgraph, toyrt):
-        from . import denoise, passes, report, sync
+        from . import denoise, passes, render_cache, report, sync
         from .camera import export_camera
 
         scene = depsgraph.scene
@@ -70,17 +70,17 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         camera = export_camera(depsgraph)  # fails early without a camera
         # One cache per Blender scene: the frames of an animation reuse the meshes that did not
         # change, and the native scene is edited in place, so memory stays flat.
-        cache = sync.for_render(depsgraph, toyrt)
+        cache = render_cache.for_render(depsgraph, toyrt)
         t_scene = cache.scene
         progress.memory = lambda: t_scene.memory_bytes
         try:
             cache.sync(depsgraph, should_cancel=progress.poll)
         except sync.ExportCancelled:
-            sync.discard_render_cache(depsgraph)  # half updated: the next F12 starts afresh
+            render_cache.discard_render_cache(depsgraph)  # half updated: the next F12 starts afresh
             return
         except Exception:
             # Any other failure mid-walk leaves it half updated too (meshes neither kept nor freed).
-            sync.discard_render_cache(depsgraph)
+            render_cache.discard_render_cache(depsgraph)
             raise
         stats = cache.stats
         if cache.approximated:
@@ -238,10 +238,10 @@ def _set_rect(rect, pixels):
 @persistent
 def _on_load_pre(*_args):
     """A file is about to close: stop every viewport render and drop the final-render cache."""
-    from . import sync, viewport
+    from . import render_cache, viewport
 
     viewport.close_all()
-    sync.free_render_caches()
+    render_cache.free_render_caches()
 
 
 def register() -> None:
@@ -258,10 +258,10 @@ def register() -> None:
 def unregister() -> None:
     import atexit
 
-    from . import sync, viewport
+    from . import render_cache, viewport
 
     viewport.close_all()
-    sync.free_render_caches()
+    render_cache.free_render_caches()
     atexit.unregister(viewport.close_all)
     if _on_load_pre in bpy.app.handlers.load_pre:
         bpy.app.handlers.load_pre.remove(_on_load_pre)

@@ -3,7 +3,7 @@
 The only code of the add-on that walks `depsgraph.object_instances` and the only writer of the
 native scene. The converters (mesh.py, materials.py, lights.py, world.py, camera.py) return plain
 data; SceneSync compares it with what it sent and sends only the difference. F12 and animations
-(one SceneSync per Blender scene: for_render), the 3D viewport (one per view) and the tests and
+(one SceneSync per Blender scene: render_cache.for_render), the 3D viewport (one per view) and the tests and
 benchmarks (export_scene, a one-shot sync) all go through it.
 
     sync = SceneSync(toyrt)
@@ -51,8 +51,7 @@ from .mesh import (
 from .sync_materials import MaterialSync
 from .world import WorldSpec, world_spec
 
-__all__ = ["SceneSync", "ExportCancelled", "export_scene", "for_render", "discard_render_cache",
-           "free_render_caches", "render_caches"]
+__all__ = ["SceneSync", "ExportCancelled", "export_scene"]
 
 # should_cancel is polled every this many object instances, and between the stages of each mesh.
 _POLL_EVERY = 256
@@ -422,41 +421,3 @@ def export_scene(depsgraph, toyrt, *, report: Callable | None = None,
 
         note("approximated: " + "; ".join(sync.approximated), report)
     return sync.scene, camera, stats
-
-
-# ---------------------------------------------------------------------------------------------
-# Final renders: one SceneSync per Blender scene, so the frames of an animation rendered in one
-# Blender process reuse what did not change (Blender makes a new engine object for every F12;
-# an animation's frames share one engine and depsgraph on 3.4, but not their mesh datablocks).
-
-_render_caches: dict[int, SceneSync] = {}
-
-
-def _scene_key(depsgraph) -> int:
-    scene = depsgraph.scene
-    return (getattr(scene, "original", scene) or scene).as_pointer()
-
-
-def for_render(depsgraph, toyrt) -> SceneSync:
-    """The final-render SceneSync of the depsgraph's scene (made on first use)."""
-    key = _scene_key(depsgraph)
-    cache = _render_caches.get(key)
-    if cache is None:
-        _render_caches.clear()  # one scene at a time: another scene's meshes are not kept alive
-        cache = _render_caches[key] = SceneSync(toyrt)
-    return cache
-
-
-def discard_render_cache(depsgraph) -> None:
-    """Drops the scene's SceneSync after a cancelled sync (it may be half updated)."""
-    _render_caches.pop(_scene_key(depsgraph), None)
-
-
-def free_render_caches() -> None:
-    """On file load and unregister: the Blender data the keys point to is gone."""
-    _render_caches.clear()
-
-
-def render_caches() -> list[SceneSync]:
-    """The final-render SceneSyncs alive (at most one), for tests and statistics."""
-    return list(_render_caches.values())

@@ -58,7 +58,7 @@ def build():
 
 
 def main():
-    from render_toyrt import sync
+    from render_toyrt import render_cache
 
     scene, sphere = build()
     samples = {}
@@ -74,7 +74,7 @@ def main():
 
     files = sorted(f for f in os.listdir(TMP) if f.endswith(".png"))
     check(len(files) == FRAMES, f"{FRAMES} frames written ({len(files)})")
-    caches = sync.render_caches()
+    caches = render_cache.render_caches()
     check(len(caches) == 1, "one render cache for the scene")
     cache = caches[0]
     c = cache.counters

@@ -106,7 +106,7 @@ def build_scene():
 
 def main():
     toyrt = install_proxy()
-    from render_toyrt import sync
+    from render_toyrt import render_cache, sync
 
     build_scene()
     py_threads = threading.active_count()
@@ -159,11 +159,11 @@ def main():
         raised = True
     check(raised and cache.counters["meshes_exported"] == 0,
           f"Esc before the export: ExportCancelled, no mesh read ({cache.counters['meshes_exported']} exported)")
-    sync.for_render(depsgraph, toyrt)
-    sync.discard_render_cache(depsgraph)
-    check(sync.for_render(depsgraph, toyrt).counters["syncs"] == 0,
+    render_cache.for_render(depsgraph, toyrt)
+    render_cache.discard_render_cache(depsgraph)
+    check(render_cache.for_render(depsgraph, toyrt).counters["syncs"] == 0,
           "after discard_render_cache the next render gets a fresh cache")
-    sync.free_render_caches()
+    render_cache.free_render_caches()
 
     stopped = [s for done, s in bvh_cancels if not done and s is not None]
     check(len(stopped) == len(bvh_cancels),
