@@ -41,6 +41,8 @@ void expect_same(const AreaLight& a, const AreaLight& b) {
   EXPECT_EQ(a.normal, b.normal);
   EXPECT_EQ(a.area, b.area);
   EXPECT_EQ(a.radiance, b.radiance);
+  EXPECT_EQ(a.spread.active, b.spread.active);
+  EXPECT_EQ(a.spread.tan_half, b.spread.tan_half);
 }
 
 }  // namespace
@@ -100,9 +102,10 @@ TEST(MakeLight, EqualsTheLightBuiltDirectly) {
                                                 {"size", 0.5},
                                                 {"size_y", 0.25},
                                                 {"power", 30.0},
-                                                {"color", Vec3(0.2f, 0.4f, 1.0f)}}));
+                                                {"color", Vec3(0.2f, 0.4f, 1.0f)},
+                                                {"spread", 0.6}}));
   expect_same(std::get<AreaLight>(area),
-              AreaLight::make(AreaShape::Rectangle, 0.5f, 0.25f, m, 30.0f, Vec3(0.2f, 0.4f, 1.0f)));
+              AreaLight::make(AreaShape::Rectangle, 0.5f, 0.25f, m, 30.0f, Vec3(0.2f, 0.4f, 1.0f), 0.6f));
 }
 
 TEST(MakeLight, DefaultsAreTheTypesSettings) {
@@ -110,7 +113,7 @@ TEST(MakeLight, DefaultsAreTheTypesSettings) {
   expect_same(std::get<PointLight>(make_light("POINT", {})), PointLight::make(p.position, p.power, p.color, p.radius));
   const AreaLight::Settings a;
   expect_same(std::get<AreaLight>(make_light("AREA", {})),
-              AreaLight::make(a.shape, a.size, a.size, a.matrix, a.power, a.color));
+              AreaLight::make(a.shape, a.size, a.size, a.matrix, a.power, a.color, a.spread));
 }
 
 TEST(MakeMaterial, EqualsTheMaterialBuiltDirectly) {
