@@ -358,25 +358,33 @@ def camera(location, target=None, rotation=(0, 0, 0), lens=50.0, ortho_scale=Non
     return obj
 
 
-def environment_world(image, strength=1.0, rotation=(0.0, 0.0, 0.0)):
-    """The world as an Environment Texture of `image` (equirectangular) into a Background of
-    `strength`, its directions turned by a Mapping node's `rotation` (Euler XYZ, radians)."""
-    world = bpy.data.worlds.new("environment")
+def _texture_world(name, strength, texture_type):
+    """A new world whose Background (of `strength`) takes its colour from a new node of
+    `texture_type`, made the scene's world: (world, texture node)."""
+    world = bpy.data.worlds.new(name)
     world.use_nodes = True
     nodes, links = world.node_tree.nodes, world.node_tree.links
     background = nodes.get("Background") or nodes.new("ShaderNodeBackground")
     background.inputs["Strength"].default_value = strength
-    texture = nodes.new("ShaderNodeTexEnvironment")
+    texture = nodes.new(texture_type)
+    links.new(texture.outputs["Color"], background.inputs["Color"])
+    output = nodes.get("World Output") or nodes.new("ShaderNodeOutputWorld")
+    links.new(background.outputs["Background"], output.inputs["Surface"])
+    bpy.context.scene.world = world
+    return world, texture
+
+
+def environment_world(image, strength=1.0, rotation=(0.0, 0.0, 0.0)):
+    """The world as an Environment Texture of `image` (equirectangular) into a Background of
+    `strength`, its directions turned by a Mapping node's `rotation` (Euler XYZ, radians)."""
+    world, texture = _texture_world("environment", strength, "ShaderNodeTexEnvironment")
     texture.image = image
+    nodes, links = world.node_tree.nodes, world.node_tree.links
     mapping = nodes.new("ShaderNodeMapping")
     mapping.inputs["Rotation"].default_value = rotation
     coords = nodes.new("ShaderNodeTexCoord")
     links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
     links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
-    links.new(texture.outputs["Color"], background.inputs["Color"])
-    output = nodes.get("World Output") or nodes.new("ShaderNodeOutputWorld")
-    links.new(background.outputs["Background"], output.inputs["Surface"])
-    bpy.context.scene.world = world
     return world
 
 
@@ -384,19 +392,10 @@ def sky_world(sky_type, strength=1.0, **settings):
     """The world as a Sky Texture of `sky_type` (Blender's identifiers: PREETHAM, HOSEK_WILKIE,
     NISHITA; 5.0 SINGLE_SCATTERING, MULTIPLE_SCATTERING) into a Background of `strength`, with
     the node's settings by their property names (sun_direction, turbidity, sun_elevation, ...)."""
-    world = bpy.data.worlds.new("sky")
-    world.use_nodes = True
-    nodes, links = world.node_tree.nodes, world.node_tree.links
-    background = nodes.get("Background") or nodes.new("ShaderNodeBackground")
-    background.inputs["Strength"].default_value = strength
-    texture = nodes.new("ShaderNodeTexSky")
+    world, texture = _texture_world("sky", strength, "ShaderNodeTexSky")
     texture.sky_type = sky_type
     for key, value in settings.items():
         setattr(texture, key, value)
-    links.new(texture.outputs["Color"], background.inputs["Color"])
-    output = nodes.get("World Output") or nodes.new("ShaderNodeOutputWorld")
-    links.new(background.outputs["Background"], output.inputs["Surface"])
-    bpy.context.scene.world = world
     return world
 
 

@@ -209,15 +209,11 @@ def scene_hdri(p):
     camera(p["camera"], (0, 0, 0.3))
 
 
-def scene_glossy_sweep(p):
-    # Material balls: a row of Glossy BSDF (GGX) spheres, roughness 0.05 to 1, over a diffuse floor
-    # (the spheres reflect it and each other: glossy chains ending on the floor's direct light),
-    # under one lamp the sharp balls show as a highlight.
+def ball_row_stage(lamp="point"):
+    """The material-ball scenes' shared stage: the grey floor, a round point lamp or a rectangular
+    area lamp, the camera looking along the row, no world."""
     kit.plane("floor", 8.0, kit.diffuse("floor", (0.6, 0.6, 0.6)))
-    for i, rough in enumerate(p["roughness"]):
-        x = (i - (len(p["roughness"]) - 1) / 2) * 0.9
-        kit.uv_sphere(f"ball{i}", 0.4, (x, 0.0, 0.4), kit.glossy(f"glossy{i}", p["color"], rough))
-    if p["lamp"] == "point":
+    if lamp == "point":
         kit.point_light("lamp", (0.8, -1.5, 2.5), 150.0, radius=0.25)
     else:
         kit.area_light("panel", (-0.8, -1.2, 2.2), 120.0, 1.2, 0.6, target=(0.0, 0.0, 0.3))
@@ -225,47 +221,45 @@ def scene_glossy_sweep(p):
     kit.world((0, 0, 0))
 
 
+def scene_glossy_sweep(p):
+    # Material balls: a row of Glossy BSDF (GGX) spheres, roughness 0.05 to 1, over a diffuse floor
+    # (the spheres reflect it and each other: glossy chains ending on the floor's direct light),
+    # under one lamp the sharp balls show as a highlight.
+    ball_row_stage(p["lamp"])
+    for i, rough in enumerate(p["roughness"]):
+        x = (i - (len(p["roughness"]) - 1) / 2) * 0.9
+        kit.uv_sphere(f"ball{i}", 0.4, (x, 0.0, 0.4), kit.glossy(f"glossy{i}", p["color"], rough))
+
+
 def scene_metal_sweep(p):
     # Principled BSDF, Metallic 1, at the sweep's roughness values (Blender's defaults otherwise: 3.x
     # GGX, 4.0+ Multiscatter GGX and a white Specular Tint).
-    kit.plane("floor", 8.0, kit.diffuse("floor", (0.6, 0.6, 0.6)))
+    ball_row_stage()
     for i, rough in enumerate(p["roughness"]):
         x = (i - (len(p["roughness"]) - 1) / 2) * 0.9
         kit.uv_sphere(f"ball{i}", 0.4, (x, 0.0, 0.4), kit.metal(f"metal{i}", p["color"], rough))
-    kit.point_light("lamp", (0.8, -1.5, 2.5), 150.0, radius=0.25)
-    camera((0.0, -4.5, 1.6), (0, 0, 0.35))
-    kit.world((0, 0, 0))
 
 
 def scene_principled(p):
     # Principled BSDF dielectrics (Metallic 0): a row of balls over a diffuse floor, each its own
     # (roughness, Specular, tint); the version's default distribution (3.x GGX, 4.0+ Multiscatter
     # GGX). A tint is a scalar on 3.x and a colour on 4.0+: each ball gets the version's kind.
-    kit.plane("floor", 8.0, kit.diffuse("floor", (0.6, 0.6, 0.6)))
+    ball_row_stage(p["lamp"])
     new = bpy.app.version >= (4, 0, 0)
     for i, (rough, specular, tint) in enumerate(p["balls"]):
         x = (i - (len(p["balls"]) - 1) / 2) * 0.9
         t = None if tint is None else (tint[1] if new else tint[0])
         kit.uv_sphere(f"ball{i}", 0.4, (x, 0.0, 0.4),
                       kit.principled_dielectric(f"principled{i}", p["color"], rough, specular, t))
-    if p["lamp"] == "point":
-        kit.point_light("lamp", (0.8, -1.5, 2.5), 150.0, radius=0.25)
-    else:
-        kit.area_light("panel", (-0.8, -1.2, 2.2), 120.0, 1.2, 0.6, target=(0.0, 0.0, 0.3))
-    camera((0.0, -4.5, 1.6), (0, 0, 0.35))
-    kit.world((0, 0, 0))
 
 
 def scene_diffuse_and_glossy(p):
     # Mix and Add shaders of a Diffuse and a Glossy BSDF: balls at three mix factors and one sum.
-    kit.plane("floor", 8.0, kit.diffuse("floor", (0.6, 0.6, 0.6)))
+    ball_row_stage()
     for i, (fac, rough) in enumerate(p["balls"]):
         x = (i - (len(p["balls"]) - 1) / 2) * 1.0
         mat = kit.diffuse_and_glossy(f"mixed{i}", (0.7, 0.25, 0.15), (0.9, 0.9, 0.9), rough, fac)
         kit.uv_sphere(f"ball{i}", 0.42, (x, 0.0, 0.42), mat)
-    kit.point_light("lamp", (0.8, -1.5, 2.5), 150.0, radius=0.25)
-    camera((0.0, -4.5, 1.6), (0, 0, 0.35))
-    kit.world((0, 0, 0))
 
 
 # A real file: five 1 m point lights of 100 W a metre above a torus, from Debian's assimp-testmodels
