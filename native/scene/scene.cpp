@@ -411,6 +411,14 @@ size_t Scene::memory_bytes() const {
     bytes += sh.corner_normals.capacity() * sizeof(Vec3) + sh.corner_uvs.capacity() * sizeof(Vec2) +
              sh.material_ids.capacity() * sizeof(int32_t);
   for (const auto& m : meshes_) bytes += m->memory_bytes();
+  // Shading and lighting data the render reads: textures (the environment's image among them),
+  // the environment's sampling grid, the emissive triangles and their CDF, materials and lamps.
+  for (const Texture& t : textures_) bytes += t.texels.capacity() * sizeof(float);
+  const Distribution2D& grid = world_.environment.sampling;
+  bytes += (grid.conditional.capacity() + grid.marginal.capacity() + grid.density.capacity()) * sizeof(float);
+  bytes += emitters_.triangles.capacity() * sizeof(EmissiveTriangle) + emitters_.cdf.capacity() * sizeof(float);
+  bytes += materials_.capacity() * sizeof(Material) + emission_.capacity() * sizeof(MaterialEmission) +
+           world_.lights.capacity() * sizeof(Light);
   return bytes + light_tree_.memory_bytes();
 }
 

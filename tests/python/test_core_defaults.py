@@ -82,3 +82,34 @@ def test_add_mesh_without_an_instance_refuses_a_transform():
     with pytest.raises(ValueError, match="instance=False"):
         s.add_mesh(TRI_V, [[0, 1, 2]], transform=np.eye(4), instance=False)
     assert s.mesh_count == 0
+
+
+
+def _grid_scene(second_emits):
+    """A 100 x 100 quad grid (20,000 triangles) and a copy 2 m above it, emissive or not."""
+    v = np.float32([[x, y, 0.0] for y in range(101) for x in range(101)])
+    i = np.arange(100)
+    q = (i[:, None] * 101 + i[None, :]).ravel()
+    t = np.concatenate([np.stack([q, q + 1, q + 102], 1), np.stack([q, q + 102, q + 101], 1)]).astype(np.uint32)
+    s = toyrt.Scene()
+    s.add_material("diffuse", color=(0.5, 0.5, 0.5))
+    s.add_material("diffuse", color=(0.0, 0.0, 0.0), emission=(1.0, 1.0, 1.0) if second_emits else (0.0, 0.0, 0.0))
+    s.add_mesh(v, t, material_ids=0)
+    s.add_mesh(v + np.float32([0, 0, 2]), t, material_ids=1)
+    s.commit()
+    return s
+
+
+def test_memory_bytes_counts_textures_the_environment_grid_and_emitters():
+    # Each holds at least its own floats: a 64 x 128 RGB float texture 98,304 bytes; the
+    # environment over it a grid of 64 x 128 densities and as many CDF values (65,536 bytes); the
+    # 20,000 emissive triangles 4 Vec3 of geometry and a CDF float each (1,040,000 bytes).
+    s = _grid_scene(second_emits=False)
+    base = s.memory_bytes
+    tid = s.add_texture(np.ones((64, 128, 3), np.float32), srgb=False)
+    with_texture = s.memory_bytes
+    assert with_texture - base >= 64 * 128 * 3 * 4
+    s.set_environment(tid)
+    s.commit()
+    assert s.memory_bytes - with_texture >= 2 * 64 * 128 * 4
+    assert _grid_scene(second_emits=True).memory_bytes - base >= 20000 * (4 * 12 + 4)
