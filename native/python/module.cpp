@@ -376,9 +376,10 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       .def_property_readonly("mesh_count", &PyScene::mesh_count)
       .def_property_readonly("instance_count", &PyScene::instance_count)
       .def_property_readonly("triangle_count", &PyScene::triangle_count, "Triangles stored, each mesh counted once.")
-      .def_property_readonly("memory_bytes", &PyScene::memory_bytes,
-                             "Bytes the scene holds: meshes and their BVHs, the top level, shading arrays, textures,\n"
-                             "the environment's sampling grid, emissive triangles, materials, lamps and the light tree.")
+      .def_property_readonly(
+          "memory_bytes", &PyScene::memory_bytes,
+          "Bytes the scene holds: meshes and their BVHs, the top level, shading arrays, textures,\n"
+          "the environment's sampling grid, emissive triangles, materials, lamps and the light tree.")
       .def_property_readonly("committed", &PyScene::committed)
       .def_property_readonly("build_ms", &PyScene::build_ms, "Wall time of the last commit in milliseconds.");
 
