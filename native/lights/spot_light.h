@@ -56,6 +56,9 @@ struct SpotLight {
   float cos_half = 0.0f;        // cos(spot_size / 2)
   float blend_width = 0.0f;     // (1 - cos_half) spot_blend: the cosine range of the soft edge
   SpotFalloff falloff = SpotFalloff::Smoothstep;
+  // The widest angle from `direction` at which attenuation() can be positive: the half spot
+  // angle, or with 4.x's non-uniform scale the widest of its elliptical cone (for importance()).
+  float outer_angle = kPi;
 
   // Throws std::invalid_argument for a bad matrix (non-finite, non-affine, singular), spot_size
   // outside (0, pi], spot_blend outside [0, 1], or the point light's own errors.

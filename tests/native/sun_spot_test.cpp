@@ -210,6 +210,37 @@ TEST(SpotLight, RoundSpotEvaluateAgreesWithSampleAndImportanceNeverHidesLight) {
   }
 }
 
+TEST(SpotLight, RoundSpotImportanceIsZeroOnlyWhereNoPointOfItsDiskLights) {
+  // Points on a floor around a round spot aimed at it (and one scaled 3x along x in 4.x, whose
+  // cone is elliptical): wherever any of 64 light samples is lit, the importance is positive; and
+  // far outside the cone it is 0 (before, every point beside a spot picked it).
+  for (SpotFalloff falloff : {SpotFalloff::Smoothstep, SpotFalloff::CosineSmoothstep})
+    for (float scale_x : {1.0f, 3.0f}) {
+      SpotLight::Settings s;
+      s.matrix = aimed(Vec3(0, 0, 2), glm::normalize(Vec3(0.3f, 0.0f, -1.0f)), Vec3(scale_x, 1.0f, 1.0f));
+      s.radius = 0.3f;
+      s.spot_size = 0.6f;
+      s.spot_blend = 0.2f;
+      s.falloff = falloff;
+      const Light light = SpotLight::make(s);
+      int lit = 0, dark = 0;
+      for (uint32_t i = 0; i < 3000; ++i) {
+        const Vec3 p(8.0f * rand2(i, 21).x - 4.0f, 8.0f * rand2(i, 21).y - 4.0f, 0.0f);
+        bool arrives = false;
+        for (uint32_t k = 0; k < 64 && !arrives; ++k) arrives = sample_light(light, p, rand2(k, 22), {}).valid();
+        const float importance = light_importance(light, p, Vec3(0, 0, 1));
+        if (arrives) {
+          ++lit;
+          EXPECT_GT(importance, 0.0f) << "lit at " << p.x << ", " << p.y;
+        } else if (importance == 0.0f) {
+          ++dark;
+        }
+      }
+      EXPECT_GT(lit, 50);
+      EXPECT_GT(dark, 1000) << "the cone gates most of the floor";
+    }
+}
+
 TEST(SpotLight, RefusesBadSettings) {
   EXPECT_THROW(make_light("SPOT", Params({{"spot_size", 0.0}})), std::invalid_argument);
   EXPECT_THROW(make_light("SPOT", Params({{"spot_size", 4.0}})), std::invalid_argument);
