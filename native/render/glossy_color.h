@@ -1,0 +1,40 @@
+// The Glossy Color pass at a camera ray's first hit, as Cycles writes it (kernel/film/data_passes.h
+// sums, over the shader's glossy closures, what kernel/closure/bsdf.h's bsdf_albedo answers):
+//   Blender 4.0+: the closure's weight times its Fresnel term's estimated albedo at wo
+//     (bsdf_microfacet_estimate_albedo): 1 without a Fresnel term (the Glossy BSDF: its colour,
+//     Multiscatter GGX's energy scale included, as Cycles puts it in the weight); for a dielectric
+//     layer mix(F0, 1, s) with s the blend over the lobe's reflections of the IOR's curve
+//     (sampling/ggx_albedo.h); for an F82-tint metal mix(F0, 1, s5) with s5 the same blend of
+//     Schlick's (1 - cos)^5, without the F82 dip (Cycles leaves that term out of its estimate).
+//   Blender 3.x: the closure's weight alone (surface_shader_glossy summed sc->weight): the Glossy
+//     BSDF's colour, and 1 for the Principled's specular lobe whatever its Fresnel term.
+// A Principled 4.0+ between metal and dielectric draws one lobe per hit (materials/principled.h)
+// with probability its weight, so the mean over samples is Cycles' weighted sum.
+#pragma once
+
+#include "materials/glossy_lobe.h"
+#include "materials/principled.h"
+
+namespace toyrt {
+
+// The estimated albedo of a lobe's Fresnel term times its tint (Cycles 4.0+'s bsdf_albedo).
+Vec3 lobe_albedo(const GlossyLobe& lobe);
+
+// s5(roughness, cos_o): Cycles' ggx_gen_schlick_s read at its metals' z = 0.5 (near exponent 5;
+// the .cpp says why not exactly), from a 16 x 16 table built once on first use.
+float schlick_blend(float roughness, float cos_o);
+// The mean over the GGX lobe's visible-normal reflections of (1 - cos_h)^exponent, 0 for those
+// leaving below the surface, with n x n stratified samples (Cycles' precomputation). Deterministic.
+double estimate_schlick_blend(float roughness, float cos_o, float exponent, int n);
+
+// What the pass holds for a material's glossy lobe: its albedo; Blender 3.x's Principled (the
+// add-on sends layered False) its closure's weight, 1.
+template <class M>
+Vec3 glossy_pass_color(const M&, const GlossyLobe& lobe) {
+  return lobe_albedo(lobe);
+}
+inline Vec3 glossy_pass_color(const Principled& m, const GlossyLobe& lobe) {
+  return m.layered ? lobe_albedo(lobe) : Vec3(1.0f);
+}
+
+}  // namespace toyrt
