@@ -11,7 +11,7 @@ namespace toyrt {
 
 namespace {
 
-constexpr int kSize = 16;  // Cycles' table size per axis
+constexpr int kSize = 16;    // Cycles' table size per axis
 constexpr int kStrata = 32;  // per table entry: 32 x 32 stratified samples
 
 using SchlickTable = std::array<float, kSize * kSize>;  // roughness fastest, then cos_o
@@ -81,6 +81,11 @@ Vec3 lobe_albedo(const GlossyLobe& lobe) {
       return lobe.tint * glm::mix(lobe.f0, Vec3(1.0f), schlick_blend(roughness, mu));
   }
   return Vec3(0.0f);
+}
+
+Vec3 lobe_weight_albedo(const GlossyLobe& lobe, bool multiscatter) {
+  const Vec3 albedo = lobe_albedo(lobe);
+  return multiscatter ? albedo * ggx_albedo(std::sqrt(lobe.alpha), lobe.wo.z) : albedo;
 }
 
 }  // namespace toyrt

@@ -12,6 +12,8 @@
 // with probability its weight, so the mean over samples is Cycles' weighted sum.
 #pragma once
 
+#include "materials/diffuse_glossy.h"
+#include "materials/glossy.h"
 #include "materials/glossy_lobe.h"
 #include "materials/principled.h"
 
@@ -27,14 +29,26 @@ float schlick_blend(float roughness, float cos_o);
 // leaving below the surface, with n x n stratified samples (Cycles' precomputation). Deterministic.
 double estimate_schlick_blend(float roughness, float cos_o, float exponent, int n);
 
-// What the pass holds for a material's glossy lobe: its albedo; Blender 3.x's Principled (the
-// add-on sends layered False) its closure's weight, 1.
+// Multiscatter GGX (4.0+): TOYRT's tint holds the whole energy scale 1 + F_ms (1 - E) / E
+// (materials/multiscatter.h), where Cycles' weight holds it divided by 1 + (1 - E) / E (the rest
+// is its closure's energy_scale, outside the weight): the pass is the tint times E.
+Vec3 lobe_weight_albedo(const GlossyLobe& lobe, bool multiscatter);
+
+// What the pass holds for a material's glossy lobe (one overload per material with a lobe; the
+// template for any other); Blender 3.x's Principled (the add-on sends layered False) its
+// closure's weight, 1.
 template <class M>
 Vec3 glossy_pass_color(const M&, const GlossyLobe& lobe) {
   return lobe_albedo(lobe);
 }
+inline Vec3 glossy_pass_color(const Glossy& m, const GlossyLobe& lobe) {
+  return lobe_weight_albedo(lobe, m.multiscatter);
+}
+inline Vec3 glossy_pass_color(const DiffuseGlossy& m, const GlossyLobe& lobe) {
+  return lobe_weight_albedo(lobe, m.glossy.multiscatter);
+}
 inline Vec3 glossy_pass_color(const Principled& m, const GlossyLobe& lobe) {
-  return m.layered ? lobe_albedo(lobe) : Vec3(1.0f);
+  return m.layered ? lobe_weight_albedo(lobe, m.multiscatter) : Vec3(1.0f);
 }
 
 }  // namespace toyrt

@@ -4,6 +4,7 @@
 
 #include "materials/fresnel.h"
 #include "materials/glossy.h"
+#include "sampling/ggx_albedo.h"
 
 #include <gtest/gtest.h>
 
@@ -23,6 +24,22 @@ TEST(GlossyColor, AGlossyBsdfGivesItsColourExactly) {
   EXPECT_EQ(lobe_albedo(lobe), Vec3(0.9f, 0.5f, 0.1f));
   Glossy g;
   EXPECT_EQ(glossy_pass_color(g, lobe), lobe.tint);
+}
+
+TEST(GlossyColor, MultiscatterKeepsCyclesShareOfTheEnergyScaleAndAWhiteLobeIsOne) {
+  // Cycles' weight holds (1 + F_ms (1 - E) / E) / (1 + (1 - E) / E) of the scale: 1 for white.
+  Glossy m = Glossy::make(Vec3(1.0f), 0.6f, GgxShadowing::HeightCorrelated, true);
+  const ShadingPoint s{glm::normalize(Vec3(0.5f, 0.0f, 1.0f)), Vec3(0, 0, 1), Vec3(0, 0, 1), Vec2(0.0f)};
+  const Scatter white = scatter(m, s, MaterialContext{});
+  EXPECT_GT(white.glossy.tint.x, 1.05f);  // the energy scale is in TOYRT's tint
+  EXPECT_NEAR(glossy_pass_color(m, white.glossy).x, 1.0f, 1e-5f);
+  m.color = Vec3(0.5f);
+  const Scatter grey = scatter(m, s, MaterialContext{});
+  const float e = ggx_albedo(0.6f, grey.glossy.wo.z), missing = (1.0f - e) / e, e_avg = ggx_average_albedo(0.6f);
+  const float f_ms = 0.5f * e_avg / (1.0f - 0.5f * (1.0f - e_avg));
+  EXPECT_NEAR(glossy_pass_color(m, grey.glossy).x, 0.5f * (1.0f + f_ms * missing) / (1.0f + missing), 1e-5f);
+  m.multiscatter = false;
+  EXPECT_EQ(glossy_pass_color(m, scatter(m, s, MaterialContext{}).glossy), Vec3(0.5f));
 }
 
 TEST(GlossyColor, AMetalAtNormalIncidenceOnASmoothSurfaceIsItsF0) {
