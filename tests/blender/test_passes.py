@@ -201,9 +201,10 @@ SKY = (0.2, 0.3, 0.4)
 
 def glossy_color_environment_and_lamps_equal_cycles():
     """Glossy Color, Environment and Emission on a scene of a Glossy BSDF (GGX and Multiscatter
-    GGX), a Principled metal, a Principled dielectric and a Diffuse BSDF beside a constant world and an area lamp facing the
-    camera, against closed forms (the Glossy BSDF's colour, 0 on the diffuse, the world's colour
-    where nothing is hit, Combined = Environment there) and against Cycles' passes."""
+    GGX), a Principled metal, a Principled dielectric and a Diffuse BSDF beside a constant world
+    and an area lamp facing the camera, against closed forms (the Glossy BSDF's colour, 0 on the
+    diffuse, the world's colour where nothing is hit, Combined = Environment there) and against
+    Cycles' passes."""
     s = kit.clear_scene()
     for k, (name, (make, (x, y))) in enumerate(GLOSSY_SCENE.items()):
         kit.plane(name, 0.8, make(), location=(x, y, 0.0)).pass_index = 1 + k
@@ -230,7 +231,8 @@ def glossy_color_environment_and_lamps_equal_cycles():
         d = np.abs(gt - gc)[mask]
         print(f"  {NAMES['glossy']} on {name} ({mask.sum()} px): TOYRT mean {gt[mask].mean(0).round(4)}, "
               f"Cycles {gc[mask].mean(0).round(4)}, max diff {d.max():.1e}", flush=True)
-        check(mask.sum() > 20 and d.max() < 5e-4, f"{NAMES['glossy']} equals Cycles' on the {name} (max diff {d.max():.1e})")
+        check(mask.sum() > 20 and d.max() < 5e-4,
+              f"{NAMES['glossy']} equals Cycles' on the {name} (max diff {d.max():.1e})")
     check(np.allclose(gt[inner & (obj == 1)], (0.9, 0.6, 0.3), atol=1e-6),
           "the Glossy BSDF's Glossy Color is its colour")
     check(np.all(gt[inner & (obj == 4)] == 0), "the Diffuse BSDF has no Glossy Color")

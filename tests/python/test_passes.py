@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 import toyrt
 
-ALL = ["depth", "mist", "position", "normal", "diffuse_color", "glossy_color", "emission", "environment", "object_index",
-       "material_index"]
+ALL = ["depth", "mist", "position", "normal", "diffuse_color", "glossy_color", "emission", "environment",
+       "object_index", "material_index"]
 
 
 def camera_down(kind="ORTHO", height=5.0, resolution=16):
@@ -143,10 +143,10 @@ def test_a_metal_at_normal_incidence_has_its_colour_as_glossy_color():
 
 
 def test_the_world_seen_directly_is_the_environment_and_lamps_seen_directly_are_emission():
-    # A constant world of colour c behind a floor half the frame wide, and an area lamp facing the
-    # camera: Environment is c where the camera sees the world, Emission is the lamp's radiance
-    # in Cycles' units, P / (4 A) (native/lights/area_light.h), where it sees the lamp; Combined is their sum with the rest of the light, exactly
-    # where nothing else is seen.
+    # A constant world of colour c beside a floor, and an area lamp facing the camera: Environment
+    # is c where the camera sees the world, Emission the lamp's radiance in Cycles' units, P / (4 A)
+    # (native/lights/area_light.h), where it sees the lamp; Combined is their sum with the rest of
+    # the light, exactly, where nothing else is seen.
     s = toyrt.Scene()
     s.add_material("diffuse", color=(0.5, 0.5, 0.5))
     v = np.array([[-5, -5, 0], [0, -5, 0], [0, 5, 0], [-5, 5, 0]], np.float32)  # x < 0 only
