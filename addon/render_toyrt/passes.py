@@ -43,7 +43,7 @@ PASSES = (
     Pass("use_pass_diffuse_color", "DiffCol", "Diffuse Color", "RGB", "COLOR", "diffuse_color"),
     Pass("use_pass_glossy_direct", "GlossDir", "Glossy Direct", "RGB", "COLOR", None),
     Pass("use_pass_glossy_indirect", "GlossInd", "Glossy Indirect", "RGB", "COLOR", None),
-    # The glossy lobes' albedo (native/render/glossy_color.h); glass's reflection is not in it yet.
+    # The glossy lobes' albedo and glass's reflection (native/render/glossy_color.h).
     Pass("use_pass_glossy_color", "GlossCol", "Glossy Color", "RGB", "COLOR", "glossy_color"),
     Pass("use_pass_transmission_direct", "TransDir", "Transmission Direct", "RGB", "COLOR", None),
     Pass("use_pass_transmission_indirect", "TransInd", "Transmission Indirect", "RGB", "COLOR", None),

@@ -1,5 +1,6 @@
 #include "render/glossy_color.h"
 
+#include "materials/fresnel.h"
 #include "sampling/ggx.h"
 #include "sampling/ggx_albedo.h"
 
@@ -81,6 +82,19 @@ Vec3 lobe_albedo(const GlossyLobe& lobe) {
       return lobe.tint * glm::mix(lobe.f0, Vec3(1.0f), schlick_blend(roughness, mu));
   }
   return Vec3(0.0f);
+}
+
+float glass_reflectance(float roughness, float cos_o, float eta) {
+  if (eta > 1.0f) return glm::mix(f0_from_ior(eta), 1.0f, ggx_fresnel_blend(roughness, cos_o, eta));
+  return fresnel_dielectric(cos_o, eta);  // from inside: Cycles takes the curve itself
+}
+
+Vec3 specular_pass_color(const FresnelDielectric& m, const ShadingPoint& s) {
+  const bool entering = glm::dot(s.ng, s.wo) > 0.0f;
+  const Vec3 ng = entering ? s.ng : -s.ng;
+  const Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;
+  const float cos_o = std::clamp(glm::dot(ns, s.wo), 0.0f, 1.0f), eta = entering ? m.ior : 1.0f / m.ior;
+  return Vec3(m.macro_fresnel ? fresnel_dielectric(cos_o, eta) : glass_reflectance(0.0f, cos_o, eta));
 }
 
 Vec3 lobe_weight_albedo(const GlossyLobe& lobe, bool multiscatter) {

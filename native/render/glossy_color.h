@@ -8,14 +8,21 @@
 //     Schlick's (1 - cos)^5, without the F82 dip (Cycles leaves that term out of its estimate).
 //   Blender 3.x: the closure's weight alone (surface_shader_glossy summed sc->weight): the Glossy
 //     BSDF's colour, and 1 for the Principled's specular lobe whatever its Fresnel term.
+// Glass (the Glass BSDF, colourless in TOYRT) counts its reflection: 3.x's closure weight F(cos_o)
+// of the shading normal (Cycles 3.x split its Glass into a reflection closure of that weight and a
+// refraction one); 4.0+ counts the glass closure with its reflection's estimated albedo,
+// mix(F0, 1, s) entering and the Fresnel curve at cos_o leaving. The Refraction BSDF has none.
 // A Principled 4.0+ between metal and dielectric draws one lobe per hit (materials/principled.h)
 // with probability its weight, so the mean over samples is Cycles' weighted sum.
 #pragma once
+
+#include <cmath>
 
 #include "materials/diffuse_glossy.h"
 #include "materials/glossy.h"
 #include "materials/glossy_lobe.h"
 #include "materials/principled.h"
+#include "materials/refraction.h"
 
 namespace toyrt {
 
@@ -50,5 +57,23 @@ inline Vec3 glossy_pass_color(const DiffuseGlossy& m, const GlossyLobe& lobe) {
 inline Vec3 glossy_pass_color(const Principled& m, const GlossyLobe& lobe) {
   return m.layered ? lobe_weight_albedo(lobe, m.multiscatter) : Vec3(1.0f);
 }
+
+// Cycles 4.0+'s estimated reflectance of a dielectric interface at cos_o, eta = n_far / n_near.
+float glass_reflectance(float roughness, float cos_o, float eta);
+
+// A rough dielectric lobe (rough Glass and Refraction) and a specular one (roughness below
+// kDielectricMinAlpha: the integrator follows branches, the pass reads the material).
+template <class M>
+Vec3 glossy_pass_color(const M&, const DielectricLobe&) {
+  return Vec3(0.0f);
+}
+inline Vec3 glossy_pass_color(const FresnelDielectric& m, const DielectricLobe& lobe) {
+  return Vec3(m.macro_fresnel ? lobe.fresnel_macro : glass_reflectance(std::sqrt(lobe.alpha), lobe.wo.z, lobe.eta));
+}
+template <class M>
+Vec3 specular_pass_color(const M&, const ShadingPoint&) {
+  return Vec3(0.0f);
+}
+Vec3 specular_pass_color(const FresnelDielectric& m, const ShadingPoint& s);
 
 }  // namespace toyrt

@@ -195,13 +195,27 @@ GLOSSY_SCENE = {  # name: (material maker, location); pass index = 1 + its place
     # Multiscatter GGX: 4.0+'s energy compensation, whose share Cycles keeps in the weight.
     "glossy_multiscatter": (lambda: kit.glossy("glossy_multiscatter", (0.9, 0.6, 0.3), 0.5, "MULTI_GGX"),
                             (-0.3, -0.4)),
+    # Glass: its reflection (3.x a closure of weight F, 4.0+ the glass closure's reflection).
+    "glass": (lambda: kit.glass("glass", 1.5), (1.4, 0.55)),
+    "rough_glass": (lambda: rough_glass("rough_glass", 0.3), (1.4, -0.4)),
 }
+
+
+def rough_glass(name, roughness):
+    mat = kit.glass(name, 1.5)
+    bsdf = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfGlass")
+    bsdf.distribution = "GGX"
+    bsdf.inputs["Roughness"].default_value = roughness
+    return mat
+
+
 SKY = (0.2, 0.3, 0.4)
 
 
 def glossy_color_environment_and_lamps_equal_cycles():
     """Glossy Color, Environment and Emission on a scene of a Glossy BSDF (GGX and Multiscatter
-    GGX), a Principled metal, a Principled dielectric and a Diffuse BSDF beside a constant world
+    GGX), a Principled metal, a Principled dielectric, a Diffuse BSDF and sharp and rough Glass
+    BSDFs beside a constant world
     and an area lamp facing the camera, against closed forms (the Glossy BSDF's colour, 0 on the
     diffuse, the world's colour where nothing is hit, Combined = Environment there) and against
     Cycles' passes."""
