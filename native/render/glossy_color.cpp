@@ -89,7 +89,14 @@ float glass_reflectance(float roughness, float cos_o, float eta) {
   return fresnel_dielectric(cos_o, eta);  // from inside: Cycles takes the curve itself
 }
 
-Vec3 specular_pass_color(const FresnelDielectric& m, const ShadingPoint& s) {
+[[gnu::noinline]] Vec3 glass_pass_color(const Material& material, const ShadingPoint& s) {
+  const FresnelDielectric* glass = std::get_if<FresnelDielectric>(&material);
+  if (!glass) return Vec3(0.0f);
+  const FresnelDielectric& m = *glass;
+  // The lobe the material's scatter() makes there, or none where it is specular.
+  DielectricLobe lobe;
+  if (rough_dielectric(s, m.ior, m.rough, m.macro_fresnel ? DielectricKind::Glass3x : DielectricKind::Glass, &lobe))
+    return Vec3(m.macro_fresnel ? lobe.fresnel_macro : glass_reflectance(std::sqrt(lobe.alpha), lobe.wo.z, lobe.eta));
   const bool entering = glm::dot(s.ng, s.wo) > 0.0f;
   const Vec3 ng = entering ? s.ng : -s.ng;
   const Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;

@@ -21,6 +21,7 @@
 #include "materials/diffuse_glossy.h"
 #include "materials/glossy.h"
 #include "materials/glossy_lobe.h"
+#include "materials/material.h"
 #include "materials/principled.h"
 #include "materials/refraction.h"
 
@@ -61,19 +62,9 @@ inline Vec3 glossy_pass_color(const Principled& m, const GlossyLobe& lobe) {
 // Cycles 4.0+'s estimated reflectance of a dielectric interface at cos_o, eta = n_far / n_near.
 float glass_reflectance(float roughness, float cos_o, float eta);
 
-// A rough dielectric lobe (rough Glass and Refraction) and a specular one (roughness below
-// kDielectricMinAlpha: the integrator follows branches, the pass reads the material).
-template <class M>
-Vec3 glossy_pass_color(const M&, const DielectricLobe&) {
-  return Vec3(0.0f);
-}
-inline Vec3 glossy_pass_color(const FresnelDielectric& m, const DielectricLobe& lobe) {
-  return Vec3(m.macro_fresnel ? lobe.fresnel_macro : glass_reflectance(std::sqrt(lobe.alpha), lobe.wo.z, lobe.eta));
-}
-template <class M>
-Vec3 specular_pass_color(const M&, const ShadingPoint&) {
-  return Vec3(0.0f);
-}
-Vec3 specular_pass_color(const FresnelDielectric& m, const ShadingPoint& s);
+// The Glossy Color of a Glass BSDF (rough or specular) at a camera ray's first hit, 0 for every
+// other material: out of line and outside the integrator's material dispatch, so that dispatch
+// (and the Lambert path's code) is what it was; called only when passes are asked for.
+Vec3 glass_pass_color(const Material& m, const ShadingPoint& s);
 
 }  // namespace toyrt

@@ -330,7 +330,6 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
           if (sc.kind == Scatter::Kind::Dielectric) {
             // Lamps on both sides, then a reflection or a transmission: as a glossy vertex, with
             // the side chosen on the lobe-choice dimension.
-            if (first) first->glossy = glossy_pass_color(material, sc.dielectric);
             const DielectricStep g = dielectric_vertex(
                 scene, s.p, ng, sc.dielectric, pixel, sample, vertex_dimension(depth, 1),
                 vertex_dimension(depth, kDimsPerVertex - 5), vertex_dimension(depth, kDimsPerVertex - 6), settings);
@@ -343,7 +342,6 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             return true;
           }
           bsdf_pdf = 0.0f;  // a delta branch: no lamp was sampled here
-          if (first) first->glossy = specular_pass_color(material, ShadingPoint{wo, s.ng, s.ns, s.uv});
           if (depth >= settings.max_specular_depth) return false;
           if (sc.kind == Scatter::Kind::Split) {
             for (int b = 0; b < sc.count; ++b) {
@@ -357,6 +355,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
           return true;
         },
         m);
+    if (first) first->glossy += glass_pass_color(m, ShadingPoint{wo, s.ng, s.ns, s.uv});  // 0 but for glass
     first = nullptr;  // passes see the first surface only
     if (!go_on) break;
   }

@@ -89,20 +89,23 @@ TEST(GlossyColor, TheSchlickBlendTableIsCyclesAtItsMetalsZ) {
 
 TEST(GlossyColor, GlassCountsItsReflectionAndRefractionNone) {
   // Head-on, smooth, from outside: F0 of the IOR; from inside past the critical angle: 1 (total
-  // internal reflection); Blender 3.x's macro Fresnel: the curve at cos_o itself.
-  const FresnelDielectric glass = FresnelDielectric::make(1.5f);
+  // internal reflection); Blender 3.x's macro Fresnel: the curve at cos_o itself, rough or not.
+  const Material glass = FresnelDielectric::make(1.5f);
   const ShadingPoint head_on{Vec3(0, 0, 1), Vec3(0, 0, 1), Vec3(0, 0, 1), Vec2(0.0f)};
-  EXPECT_NEAR(specular_pass_color(glass, head_on).x, f0_from_ior(1.5f), 1e-3f);
+  EXPECT_NEAR(glass_pass_color(glass, head_on).x, f0_from_ior(1.5f), 1e-3f);
   const ShadingPoint inside{glm::normalize(Vec3(1.0f, 0.0f, -0.3f)), Vec3(0, 0, 1), Vec3(0, 0, 1), Vec2(0.0f)};
-  EXPECT_EQ(specular_pass_color(glass, inside), Vec3(1.0f));
-  const FresnelDielectric glass3 = FresnelDielectric::make(1.5f, DielectricRoughness{}, true);
+  EXPECT_EQ(glass_pass_color(glass, inside), Vec3(1.0f));
   const ShadingPoint oblique{glm::normalize(Vec3(1.0f, 0.0f, 1.0f)), Vec3(0, 0, 1), Vec3(0, 0, 1), Vec2(0.0f)};
-  EXPECT_FLOAT_EQ(specular_pass_color(glass3, oblique).x, fresnel_dielectric(std::sqrt(0.5f), 1.5f));
-  EXPECT_EQ(specular_pass_color(PerfectRefraction::make(1.5f), oblique), Vec3(0.0f));
-  DielectricLobe lobe;
-  lobe.fresnel_macro = 0.3f;
-  EXPECT_EQ(glossy_pass_color(glass3, lobe), Vec3(0.3f));
-  EXPECT_EQ(glossy_pass_color(PerfectRefraction::make(1.5f), lobe), Vec3(0.0f));
+  for (const float roughness : {0.0f, 0.4f}) {
+    const Material glass3 = FresnelDielectric::make(1.5f, DielectricRoughness{roughness}, true);
+    EXPECT_FLOAT_EQ(glass_pass_color(glass3, oblique).x, fresnel_dielectric(std::sqrt(0.5f), 1.5f)) << roughness;
+  }
+  // 4.0+, rough: the blend grows towards grazing, above the smooth curve's F0 head-on.
+  const Material rough = FresnelDielectric::make(1.5f, DielectricRoughness{0.5f});
+  EXPECT_GT(glass_pass_color(rough, head_on).x, f0_from_ior(1.5f));
+  EXPECT_GT(glass_pass_color(rough, oblique).x, glass_pass_color(rough, head_on).x);
+  EXPECT_EQ(glass_pass_color(Material(PerfectRefraction::make(1.5f)), oblique), Vec3(0.0f));
+  EXPECT_EQ(glass_pass_color(Material(Lambert{}), oblique), Vec3(0.0f));
 }
 
 TEST(GlossyColor, BlenderThreesPrincipledWritesItsClosureWeight) {
