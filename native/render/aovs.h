@@ -14,6 +14,7 @@
 #pragma once
 
 #include "core/math.h"
+#include "materials/scatter.h"
 #include "render/cryptomatte.h"
 
 #include <array>
@@ -75,6 +76,7 @@ struct FirstHit {
   Vec3 glossy{0.0f};           // the glossy lobe's albedo (render/glossy_color.h)
   Vec3 emission{0.0f};         // radiance the surface and the lamps in front of it emit
   Vec3 environment{0.0f};      // the world's radiance, when the ray hits nothing
+  ShadingPoint at;             // the hit as its material saw it (render/glossy_color.h reads it)
   int32_t instance = -1, material = -1;
 };
 

@@ -276,7 +276,11 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     const Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;
     const Material& m =
         s.material >= 0 && size_t(s.material) < materials.size() ? materials[size_t(s.material)] : kDefault;
-    if (first) *first = FirstHit{true, s.p, ns, Vec3(0.0f), Vec3(0.0f), lamps, Vec3(0.0f), hit.instance, s.material};
+    if (first) {
+      *first = FirstHit{true, s.p, ns, Vec3(0.0f), Vec3(0.0f), lamps, Vec3(0.0f), {wo, s.ng, s.ns, s.uv}};
+      first->instance = hit.instance;
+      first->material = s.material;
+    }
     // A camera or specular ray sees an emitting surface's radiance (both sides, as Cycles' mesh
     // lights); its BSDF (black for a pure Emission shader) still scatters below.
     if (scene.any_emission() && s.material >= 0 && size_t(s.material) < materials.size()) {
@@ -355,7 +359,6 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
           return true;
         },
         m);
-    if (first) first->glossy += glass_pass_color(m, ShadingPoint{wo, s.ng, s.ns, s.uv});  // 0 but for glass
     first = nullptr;  // passes see the first surface only
     if (!go_on) break;
   }
@@ -367,6 +370,9 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
 Vec3 trace_path(const Scene& scene, const Ray& camera_ray, uint32_t pixel, uint32_t sample,
                 const IntegratorSettings& settings, FirstHit* first) {
   const Vec3 radiance = trace_from(scene, camera_ray, 0, pixel, sample, settings, first);
+  // Glass's Glossy Color, here rather than in the path loop, whose code stays as it was.
+  if (first && first->found && first->material >= 0 && size_t(first->material) < scene.materials().size())
+    first->glossy += glass_pass_color(scene.materials()[size_t(first->material)], first->at);
   // A numerical failure anywhere (it should not happen) must not poison the pixel.
   if (!is_finite(radiance)) return Vec3(0.0f);
   return glm::max(radiance, Vec3(0.0f));
