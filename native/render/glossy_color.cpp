@@ -104,6 +104,11 @@ float glass_reflectance(float roughness, float cos_o, float eta) {
   return Vec3(m.macro_fresnel ? fresnel_dielectric(cos_o, eta) : glass_reflectance(0.0f, cos_o, eta));
 }
 
+void add_glass_pass_color(const std::vector<Material>& materials, FirstHit& hit) {
+  if (hit.found && hit.material >= 0 && size_t(hit.material) < materials.size())
+    hit.glossy += glass_pass_color(materials[size_t(hit.material)], hit.at);
+}
+
 Vec3 lobe_weight_albedo(const GlossyLobe& lobe, bool multiscatter) {
   const Vec3 albedo = lobe_albedo(lobe);
   return multiscatter ? albedo * ggx_albedo(std::sqrt(lobe.alpha), lobe.wo.z) : albedo;

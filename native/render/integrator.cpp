@@ -370,9 +370,6 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
 Vec3 trace_path(const Scene& scene, const Ray& camera_ray, uint32_t pixel, uint32_t sample,
                 const IntegratorSettings& settings, FirstHit* first) {
   const Vec3 radiance = trace_from(scene, camera_ray, 0, pixel, sample, settings, first);
-  // Glass's Glossy Color, here rather than in the path loop, whose code stays as it was.
-  if (first && first->found && first->material >= 0 && size_t(first->material) < scene.materials().size())
-    first->glossy += glass_pass_color(scene.materials()[size_t(first->material)], first->at);
   // A numerical failure anywhere (it should not happen) must not poison the pixel.
   if (!is_finite(radiance)) return Vec3(0.0f);
   return glm::max(radiance, Vec3(0.0f));
