@@ -43,13 +43,13 @@ PASSES = (
     Pass("use_pass_diffuse_color", "DiffCol", "Diffuse Color", "RGB", "COLOR", "diffuse_color"),
     Pass("use_pass_glossy_direct", "GlossDir", "Glossy Direct", "RGB", "COLOR", None),
     Pass("use_pass_glossy_indirect", "GlossInd", "Glossy Indirect", "RGB", "COLOR", None),
-    # TOYRT's materials have no glossy closure (glass's reflection is not one yet): black, noted.
-    Pass("use_pass_glossy_color", "GlossCol", "Glossy Color", "RGB", "COLOR", None),
+    # The glossy lobes' albedo and glass's reflection (native/render/glossy_color.h).
+    Pass("use_pass_glossy_color", "GlossCol", "Glossy Color", "RGB", "COLOR", "glossy_color"),
     Pass("use_pass_transmission_direct", "TransDir", "Transmission Direct", "RGB", "COLOR", None),
     Pass("use_pass_transmission_indirect", "TransInd", "Transmission Indirect", "RGB", "COLOR", None),
     Pass("use_pass_transmission_color", "TransCol", "Transmission Color", "RGB", "COLOR", None),
     Pass("use_pass_emit", "Emit", "Emission", "RGB", "COLOR", "emission"),
-    Pass("use_pass_environment", "Env", "Environment", "RGB", "COLOR", None),
+    Pass("use_pass_environment", "Env", "Environment", "RGB", "COLOR", "environment"),
     Pass("use_pass_shadow", "Shadow", "Shadow", "RGB", "COLOR", None),  # a 3.x property only
     Pass("use_pass_ambient_occlusion", "AO", "Ambient Occlusion", "RGB", "COLOR", None),
 )

@@ -19,7 +19,9 @@ constexpr std::array<AovInfo, kAovCount> kAovs{{{"depth", 1, true},
                                                 {"position", 3, true},
                                                 {"normal", 3, false},
                                                 {"diffuse_color", 3, false},
+                                                {"glossy_color", 3, false},
                                                 {"emission", 3, false},
+                                                {"environment", 3, false},
                                                 {"object_index", 1, true},
                                                 {"material_index", 1, true}}};
 
@@ -68,7 +70,10 @@ void AovBuffers::allocate(const AovRequest& request, int w, int h) {
 }
 
 void AovPixel::add(const FirstHit& hit, bool first_sample) {
-  if (!hit.found) return;  // a miss adds 0 to the averages and leaves the first-sample values
+  // Lamps and the world a camera ray sees count whether or not it then hits a surface.
+  emission_sum_ += hit.emission;
+  environment_sum_ += hit.environment;
+  if (!hit.found) return;  // a miss adds 0 to the other averages and leaves the first-sample values
   if (first_sample) {
     // Cycles' camera space looks down +z: the planar depth is along the view axis (-axis_z).
     depth_ = glm::dot(hit.p - camera_.position, -camera_.axis_z);
@@ -78,7 +83,7 @@ void AovPixel::add(const FirstHit& hit, bool first_sample) {
   }
   normal_sum_ += hit.normal;
   diffuse_sum_ += hit.diffuse;
-  emission_sum_ += hit.emission;
+  glossy_sum_ += hit.glossy;
   if (request_.has(Aov::Mist)) mist_sum_ += 1.0f - mist_at(request_.mist, camera_, hit.p);
 }
 
@@ -94,7 +99,9 @@ void AovPixel::store(AovBuffers& b, size_t pixel, float inv) const {
   put(Aov::Position, position_);
   put(Aov::Normal, normal_sum_ * inv);
   put(Aov::DiffuseColor, diffuse_sum_ * inv);
+  put(Aov::GlossyColor, glossy_sum_ * inv);
   put(Aov::Emission, emission_sum_ * inv);
+  put(Aov::Environment, environment_sum_ * inv);
   put(Aov::ObjectIndex, Vec3(object_));
   put(Aov::MaterialIndex, Vec3(material_));
 }

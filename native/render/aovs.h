@@ -4,7 +4,9 @@
 //     when the path's sample is 0); depth is the planar camera-space z, 1e10 where nothing is hit;
 //     the others 0 there;
 //   normal (world space, the shading normal turned to the viewer), diffuse_color (the diffuse
-//     albedo), emission: averaged over samples, 0 for samples that hit nothing;
+//     albedo), glossy_color (the glossy lobes' albedo as Cycles estimates it: glossy_color.h),
+//     emission (the surface's and the lamps' the camera sees), environment (the world a camera
+//     ray sees where it hits nothing): averaged over samples, 0 for samples that see none;
 //   mist: 1 - mean over samples of (1 - mist(distance)), so 1 where nothing is hit.
 // Only the first surface a camera ray hits counts, as in Cycles for opaque surfaces. A render that
 // asks for no pass allocates and computes none of this (the integrator gets a null FirstHit).
@@ -12,6 +14,7 @@
 #pragma once
 
 #include "core/math.h"
+#include "materials/scatter.h"
 #include "render/cryptomatte.h"
 
 #include <array>
@@ -23,7 +26,19 @@ namespace toyrt {
 
 struct Camera;
 
-enum class Aov : uint8_t { Depth, Mist, Position, Normal, DiffuseColor, Emission, ObjectIndex, MaterialIndex, Count };
+enum class Aov : uint8_t {
+  Depth,
+  Mist,
+  Position,
+  Normal,
+  DiffuseColor,
+  GlossyColor,
+  Emission,
+  Environment,
+  ObjectIndex,
+  MaterialIndex,
+  Count
+};
 inline constexpr size_t kAovCount = size_t(Aov::Count);
 
 // The name render(passes=...) takes ("depth", "diffuse_color", ...) and the float channels per pixel.
@@ -52,12 +67,16 @@ struct AovRequest {
 };
 
 // What the integrator reports of a camera ray's first surface: filled only when asked (a
-// non-null pointer), at the first hit, so the lighting code is untouched by passes.
+// non-null pointer), at the first hit, so the lighting code is untouched by passes. `emission`
+// and `environment` are filled on a miss too (found false): the lamps and the world it sees.
 struct FirstHit {
   bool found = false;
   Vec3 p{0.0f}, normal{0.0f};  // world position; unit shading normal facing the ray
   Vec3 diffuse{0.0f};          // the diffuse albedo (0 for a specular surface)
-  Vec3 emission{0.0f};         // radiance the surface emits
+  Vec3 glossy{0.0f};           // the glossy lobe's albedo (render/glossy_color.h)
+  Vec3 emission{0.0f};         // radiance the surface and the lamps in front of it emit
+  Vec3 environment{0.0f};      // the world's radiance, when the ray hits nothing
+  ShadingPoint at;             // the hit as its material saw it (render/glossy_color.h reads it)
   int32_t instance = -1, material = -1;
 };
 
@@ -84,7 +103,8 @@ class AovPixel {
   const AovRequest& request_;
   const Camera& camera_;
   float depth_ = 1e10f, object_ = 0.0f, material_ = 0.0f, mist_sum_ = 0.0f;
-  Vec3 position_{0.0f}, normal_sum_{0.0f}, diffuse_sum_{0.0f}, emission_sum_{0.0f};
+  Vec3 position_{0.0f}, normal_sum_{0.0f}, diffuse_sum_{0.0f}, glossy_sum_{0.0f}, emission_sum_{0.0f};
+  Vec3 environment_sum_{0.0f};
 };
 
 }  // namespace toyrt

@@ -3,6 +3,7 @@
 #include "geometry/offset_ray.h"
 #include "lights/light_selector.h"
 #include "render/dielectric_lighting.h"
+#include "render/glossy_color.h"
 #include "render/glossy_lighting.h"
 #include "sampling/frame.h"
 #include "sampling/sobol_owen.h"
@@ -273,19 +274,22 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
   bool light_only = false;
   for (int depth = first_depth;; ++depth) {
     const Hit hit = scene.intersect(ray);
+    Vec3 lamps(0.0f);  // the lamps this ray sees: the Emission pass's at the camera ray
     if (!world.lights.empty()) {
       const float length = glm::length(ray.dir);
-      radiance += throughput * visible_lights(world, ray.org, ray.dir / length, ray.tnear * length,
-                                              std::min(hit.t, ray.tfar) * length, !hit.found(), depth == 0,
-                                              settings.area_sampling, bsdf_pdf);
+      lamps = visible_lights(world, ray.org, ray.dir / length, ray.tnear * length, std::min(hit.t, ray.tfar) * length,
+                             !hit.found(), depth == 0, settings.area_sampling, bsdf_pdf);
+      radiance += throughput * lamps;
     }
     if (!hit.found()) {
+      if (first) first->emission = lamps;
       if (depth == 0 && !world.background_visible_camera) break;
       const Environment& env = world.environment;
       const Vec3 seen = env.active()
                             ? environment_radiance(env, scene.textures()[size_t(env.texture)], glm::normalize(ray.dir))
                             : world.background;
       radiance += throughput * seen;
+      if (first) first->environment = seen;  // Cycles' Environment pass: the world seen directly
       break;
     }
     const SurfaceHit s = surface_at(scene, hit);
@@ -296,12 +300,16 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     const Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;
     const Material& m =
         s.material >= 0 && size_t(s.material) < materials.size() ? materials[size_t(s.material)] : kDefault;
-    if (first) *first = FirstHit{true, s.p, ns, Vec3(0.0f), Vec3(0.0f), hit.instance, s.material};
+    if (first) {
+      *first = FirstHit{true, s.p, ns, Vec3(0.0f), Vec3(0.0f), lamps, Vec3(0.0f), {wo, s.ng, s.ns, s.uv}};
+      first->instance = hit.instance;
+      first->material = s.material;
+    }
     // A camera or specular ray sees an emitting surface's radiance (both sides, as Cycles' mesh
     // lights); its BSDF (black for a pure Emission shader) still scatters below.
     if (scene.any_emission() && s.material >= 0 && size_t(s.material) < materials.size()) {
       radiance += throughput * scene.emission()[size_t(s.material)].radiance;
-      if (first) first->emission = scene.emission()[size_t(s.material)].radiance;
+      if (first) first->emission += scene.emission()[size_t(s.material)].radiance;
     }
     if (light_only) break;
     // One generic dispatch per hit, no per-type code: the lambda is instantiated per material
@@ -334,7 +342,10 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             return false;
           }
           if (sc.kind == Scatter::Kind::Glossy) {
-            if (first) first->diffuse = sc.f * kPi;  // the diffuse part beside the lobe (Mix, Add)
+            if (first) {
+              first->diffuse = sc.f * kPi;  // the diffuse part beside the lobe (Mix, Add)
+              first->glossy = glossy_pass_color(material, sc.glossy);
+            }
             if (sc.f != Vec3(0.0f))
               radiance +=
                   throughput *

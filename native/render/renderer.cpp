@@ -1,6 +1,7 @@
 #include "render/renderer.h"
 
 #include "core/parallel.h"
+#include "render/glossy_color.h"
 #include "render/pass_accumulation.h"
 #include "sampling/sobol_owen.h"
 
@@ -158,6 +159,7 @@ void render_pass(const Scene& scene, const Camera& camera, const RenderSettings&
     const int first = settings.first_sample;
     const bool with_passes = passes.any();  // read once: the plain loop below must stay as it was
     const bool with_cryptomatte = passes.cryptomatte.any();
+    const bool with_glossy = passes.has(Aov::GlossyColor);
     std::vector<CryptomattePixel::Entry> crypto_scratch;  // grows once per tile, only if asked for
     for (int j = t.y; j < t.y + t.height; ++j) {
       if (cancel.load(std::memory_order_relaxed)) return false;
@@ -177,6 +179,7 @@ void render_pass(const Scene& scene, const Camera& camera, const RenderSettings&
             FirstHit hit;
             const Vec3 L = trace_path(scene, primary_ray(px, py, pixel, uint32_t(s)), pixel, uint32_t(s),
                                       settings.integrator, &hit);
+            if (with_glossy) add_glass_pass_color(scene.materials(), hit);
             aov.add(hit, s == first);
             if (with_cryptomatte) crypto.add(hit.found ? hit.instance : -1, hit.material);
             return L;

@@ -29,7 +29,8 @@ NEW = bpy.app.version >= (5, 0, 0)
 NAMES = dict(depth="Depth", mist="Mist", position="Position", normal="Normal",
              diffuse="Diffuse Color" if NEW else "DiffCol", emit="Emission" if NEW else "Emit",
              object="Object Index" if NEW else "IndexOB", material="Material Index" if NEW else "IndexMA",
-             ao="Ambient Occlusion" if NEW else "AO")
+             ao="Ambient Occlusion" if NEW else "AO", glossy="Glossy Color" if NEW else "GlossCol",
+             env="Environment" if NEW else "Env")
 
 
 def build_scene():
@@ -186,6 +187,86 @@ def toyrt_passes_equal_cycles():
           f"where nothing is hit ({miss.sum()} pixels) Depth is 1e10 and Mist 1, as Cycles'")
 
 
+GLOSSY_SCENE = {  # name: (material maker, location); pass index = 1 + its place here
+    "glossy": (lambda: kit.glossy("glossy", (0.9, 0.6, 0.3), 0.3), (-1.2, 0.55)),
+    "metal": (lambda: kit.metal("metal", (0.95, 0.64, 0.54), 0.2), (-0.3, 0.55)),
+    "dielectric": (lambda: kit.principled_dielectric("dielectric", (0.5, 0.5, 0.5), 0.4), (0.6, 0.55)),
+    "matte": (lambda: kit.diffuse("matte", (0.5, 0.5, 0.5)), (-1.2, -0.4)),
+    # Multiscatter GGX: 4.0+'s energy compensation, whose share Cycles keeps in the weight.
+    "glossy_multiscatter": (lambda: kit.glossy("glossy_multiscatter", (0.9, 0.6, 0.3), 0.5, "MULTI_GGX"),
+                            (-0.3, -0.4)),
+    # Glass: its reflection (3.x a closure of weight F, 4.0+ the glass closure's reflection).
+    "glass": (lambda: kit.glass("glass", 1.5), (1.4, 0.55)),
+    "rough_glass": (lambda: rough_glass("rough_glass", 0.3), (1.4, -0.4)),
+}
+
+
+def rough_glass(name, roughness):
+    mat = kit.glass(name, 1.5)
+    bsdf = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfGlass")
+    bsdf.distribution = "GGX"
+    bsdf.inputs["Roughness"].default_value = roughness
+    return mat
+
+
+SKY = (0.2, 0.3, 0.4)
+
+
+def glossy_color_environment_and_lamps_equal_cycles():
+    """Glossy Color, Environment and Emission on a scene of a Glossy BSDF (GGX and Multiscatter
+    GGX), a Principled metal, a Principled dielectric, a Diffuse BSDF and sharp and rough Glass
+    BSDFs beside a constant world
+    and an area lamp facing the camera, against closed forms (the Glossy BSDF's colour, 0 on the
+    diffuse, the world's colour where nothing is hit, Combined = Environment there) and against
+    Cycles' passes."""
+    s = kit.clear_scene()
+    for k, (name, (make, (x, y))) in enumerate(GLOSSY_SCENE.items()):
+        kit.plane(name, 0.8, make(), location=(x, y, 0.0)).pass_index = 1 + k
+    kit.area_light("lamp", (0.6, -0.45, 0.5), 30.0, 0.5, rotation=(math.pi, 0.0, 0.0), visible_camera=True)
+    kit.camera((0.0, 0.0, 5.0))
+    kit.world(SKY)
+    kit.output(s, W, H)
+    layer = bpy.context.view_layer
+    for prop in ("use_pass_glossy_color", "use_pass_environment", "use_pass_emit", "use_pass_object_index"):
+        setattr(layer, prop, True)
+    t, result, printed = render("TOYRT", 16, "_glossy")
+    c, c_result, _ = render("CYCLES", 16, "_glossy")
+    names = [NAMES[k] for k in ("glossy", "env", "emit", "object")]
+    check(result == c_result == {"FINISHED"} and all(n in t and n in c for n in names),
+          f"both render {names} (TOYRT {sorted(t)}, Cycles {sorted(c)})")
+    if not all(n in t and n in c for n in names):
+        return
+    noted = [ln for ln in printed.splitlines() if "passes left black" in ln]
+    check(not any(NAMES[k] in ln for ln in noted for k in ("glossy", "env")),
+          f"Glossy Color and Environment are not noted as black ({noted})")
+    obj = t[NAMES["object"]][..., 0]
+    inner = interior(t[NAMES["object"]]) & interior(c[NAMES["object"]])
+    gt, gc = t[NAMES["glossy"]], c[NAMES["glossy"]]
+    for k, name in enumerate(GLOSSY_SCENE):
+        mask = inner & (obj == 1 + k)
+        d = np.abs(gt - gc)[mask]
+        print(f"  {NAMES['glossy']} on {name} ({mask.sum()} px): TOYRT mean {gt[mask].mean(0).round(4)}, "
+              f"Cycles {gc[mask].mean(0).round(4)}, max diff {d.max():.1e}", flush=True)
+        check(mask.sum() > 20 and d.max() < 5e-4,
+              f"{NAMES['glossy']} equals Cycles' on the {name} (max diff {d.max():.1e})")
+    check(np.allclose(gt[inner & (obj == 1)], (0.9, 0.6, 0.3), atol=1e-6),
+          "the Glossy BSDF's Glossy Color is its colour")
+    check(np.all(gt[inner & (obj == 4)] == 0), "the Diffuse BSDF has no Glossy Color")
+    et, ec = t[NAMES["env"]], c[NAMES["env"]]
+    emt, emc = t[NAMES["emit"]], c[NAMES["emit"]]
+    lamp = interior((emc[..., :1] > 0).astype(np.float32)) & (emc[..., 0] > 0) & (obj == 0)
+    sky = inner & (obj == 0) & (c[NAMES["object"]][..., 0] == 0) & ~lamp & (emt[..., 0] == 0)
+    check(sky.sum() > 20 and np.allclose(et[sky], SKY, atol=1e-6) and np.allclose(ec[sky], SKY, atol=1e-6),
+          f"Environment is the world's colour where nothing is hit ({sky.sum()} px), in both")
+    check(np.allclose(t["Combined"][..., :3][sky], et[sky], atol=1e-6), "and Combined equals it there")
+    check(np.all(et[inner & (obj > 0)] == 0), "Environment is 0 on surfaces")
+    d = np.abs(emt - emc)[lamp] / np.maximum(emc[lamp], 1e-6)
+    print(f"  {NAMES['emit']} on the lamp ({lamp.sum()} px): TOYRT {emt[lamp].mean(0).round(3)}, "
+          f"Cycles {emc[lamp].mean(0).round(3)}", flush=True)
+    check(lamp.sum() > 4 and d.max() < 1e-3, f"{NAMES['emit']} of the lamp seen directly equals Cycles' "
+          f"(max relative diff {d.max():.1e})")
+
+
 def each_view_layer_gets_its_own_passes():
     """A second view layer with Depth only: Blender renders the layers in turn, and each one's
     Combined and passes must land in its own layer of the result, not on the first."""
@@ -278,6 +359,7 @@ def denoising_data_passes_hold_what_the_denoiser_reads():
 
 
 run_script([passes_are_switched_where_blender_users_look, toyrt_passes_against_closed_forms,
-            toyrt_passes_equal_cycles, each_view_layer_gets_its_own_passes,
+            toyrt_passes_equal_cycles, glossy_color_environment_and_lamps_equal_cycles,
+            each_view_layer_gets_its_own_passes,
             denoising_lowers_the_error_or_says_why_not, denoising_data_passes_hold_what_the_denoiser_reads],
            "passes", TMP)

@@ -29,7 +29,14 @@ AovRequest all_passes() {
 }
 
 FirstHit hit_at(Vec3 p, Vec3 n, Vec3 albedo, int32_t instance = 1, int32_t material = 0) {
-  return FirstHit{true, p, n, albedo, Vec3(0.0f), instance, material};
+  FirstHit h;
+  h.found = true;
+  h.p = p;
+  h.normal = n;
+  h.diffuse = albedo;
+  h.instance = instance;
+  h.material = material;
+  return h;
 }
 
 // Reads pass `aov` of the one pixel of `b`.
@@ -80,6 +87,26 @@ TEST(AovPixel, NormalAlbedoAndMistAreAveragedWithMissesCountingAsNothingHit) {
   EXPECT_EQ(value(b, Aov::Normal), Vec3(0.0f, 0.0f, 0.5f));
   EXPECT_EQ(value(b, Aov::DiffuseColor), Vec3(0.4f, 0.2f, 0.1f));
   EXPECT_FLOAT_EQ(value(b, Aov::Mist).x, 1.0f - 0.5f * (1.0f - 0.5f));
+}
+
+TEST(AovPixel, EmissionAndEnvironmentCountOnMissesAndGlossyColorIsAveraged) {
+  const Camera cam = camera_above();
+  const AovRequest r = all_passes();
+  AovBuffers b;
+  b.allocate(r, 1, 1);
+  AovPixel px(r, cam);
+  FirstHit miss;  // a lamp in front of the world, then nothing
+  miss.emission = Vec3(4.0f, 2.0f, 0.0f);
+  miss.environment = Vec3(0.2f, 0.4f, 0.6f);
+  px.add(miss, true);
+  FirstHit hit = hit_at(Vec3(0.0f), Vec3(0, 0, 1), Vec3(0.0f));
+  hit.glossy = Vec3(0.8f, 0.6f, 0.4f);
+  px.add(hit, false);
+  px.store(b, 0, 0.5f);
+  EXPECT_EQ(value(b, Aov::Emission), Vec3(2.0f, 1.0f, 0.0f));
+  EXPECT_EQ(value(b, Aov::Environment), Vec3(0.1f, 0.2f, 0.3f));
+  EXPECT_EQ(value(b, Aov::GlossyColor), Vec3(0.4f, 0.3f, 0.2f));
+  EXPECT_EQ(value(b, Aov::Depth).x, 1e10f);  // the first sample missed
 }
 
 TEST(AovPixel, MistFollowsCyclesFalloffExponents) {

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 import toyrt
 
-ALL = ["depth", "mist", "position", "normal", "diffuse_color", "emission", "object_index",
-       "material_index"]
+ALL = ["depth", "mist", "position", "normal", "diffuse_color", "glossy_color", "emission", "environment",
+       "object_index", "material_index"]
 
 
 def camera_down(kind="ORTHO", height=5.0, resolution=16):
@@ -117,3 +117,57 @@ def test_diffuse_color_reads_the_texture_and_emission_the_radiance_and_glass_has
     assert np.allclose(p["emission"][glow_px], (2.0, 1.0, 0.5)) and np.all(p["emission"][tex_px] == 0)
     assert np.all(p["diffuse_color"][glow_px] == 0)  # black Diffuse under its emission
     assert np.all(p["diffuse_color"][glass_px] == 0) and np.allclose(p["normal"][glass_px], (0, 0, 1))
+
+
+def test_glossy_color_is_the_glossy_bsdfs_colour_and_a_lambert_surface_has_none():
+    s = two_tiles()
+    s.set_material(1, "glossy", color=(0.9, 0.6, 0.3), roughness=0.3)  # x > 0: a Glossy BSDF
+    s.commit()
+    s.render(camera_down(), samples=4, passes=["glossy_color", "diffuse_color"])
+    p = s.last_passes
+    left, right = (slice(None), slice(0, 7)), (slice(None), slice(9, 16))
+    assert np.all(p["glossy_color"][left] == 0)
+    assert np.allclose(p["glossy_color"][right], (0.9, 0.6, 0.3), atol=1e-6)
+    assert np.all(p["diffuse_color"][right] == 0)
+
+
+def test_a_metal_at_normal_incidence_has_its_colour_as_glossy_color():
+    # Blender 4.0+'s Principled metal, smooth and seen head-on by an orthographic camera: Cycles'
+    # albedo estimate mix(F0, 1, s) with s = 0 there, so exactly the base colour F0 (to the table's
+    # interpolation).
+    s = two_tiles()
+    s.set_material(1, "principled", color=(0.95, 0.64, 0.54), metallic=1.0, roughness=0.0, multiscatter=False)
+    s.commit()
+    s.render(camera_down(), samples=2, passes=["glossy_color"])
+    assert np.allclose(s.last_passes["glossy_color"][:, 9:16], (0.95, 0.64, 0.54), atol=1e-3)
+
+
+def test_the_world_seen_directly_is_the_environment_and_lamps_seen_directly_are_emission():
+    # A constant world of colour c beside a floor, and an area lamp facing the camera: Environment
+    # is c where the camera sees the world, Emission the lamp's radiance in Cycles' units, P / (4 A)
+    # (native/lights/area_light.h), where it sees the lamp; Combined is their sum with the rest of
+    # the light, exactly, where nothing else is seen.
+    s = toyrt.Scene()
+    s.add_material("diffuse", color=(0.5, 0.5, 0.5))
+    v = np.array([[-5, -5, 0], [0, -5, 0], [0, 5, 0], [-5, 5, 0]], np.float32)  # x < 0 only
+    s.add_mesh(v, [[0, 1, 2], [0, 2, 3]], material_ids=0)
+    lamp = np.diag([1.0, -1.0, -1.0, 1.0])  # emitting up, towards the camera
+    lamp[:3, 3] = (0.5, 0.5, 1.0)
+    s.add_light("AREA", matrix=lamp, size=0.5, power=20.0, color=(1.0, 0.5, 0.25))
+    s.background = (0.2, 0.3, 0.4)
+    s.commit()
+    image = np.asarray(s.render(camera_down(resolution=32), samples=8, passes=["environment", "emission"]))
+    p = s.last_passes
+    env, emit = p["environment"], p["emission"]
+    # 1/16 m per pixel over x, y in [-1, 1], rows from the top (+y first).
+    world_px = (slice(18, 32), slice(18, 32))  # x > 0, y < 0: below the lamp's square
+    lamp_px = (slice(7, 9), slice(23, 25))     # the lamp's centre, (0.5, 0.5)
+    floor_px = (slice(None), slice(0, 14))
+    assert np.allclose(env[world_px], (0.2, 0.3, 0.4), atol=1e-6) and np.all(emit[world_px] == 0)
+    assert np.all(env[floor_px] == 0) and np.all(emit[floor_px] == 0)
+    radiance = 20.0 / (4.0 * 0.25) * np.array([1.0, 0.5, 0.25])
+    assert np.allclose(emit[lamp_px], radiance, rtol=1e-5)
+    assert np.allclose(env[lamp_px], (0.2, 0.3, 0.4), atol=1e-6)  # the world behind the lamp
+    # Combined = Emission + Environment + (nothing else seen there), exactly.
+    for px in (world_px, lamp_px):
+        assert np.allclose(image[px][..., :3], emit[px] + env[px], rtol=1e-6, atol=1e-6)
