@@ -32,17 +32,6 @@ SchlickTable build_table() {
   return t;
 }
 
-// Linear interpolation on an axis of kSize entries over [0, 1], as Cycles reads its tables.
-struct Axis {
-  int i0, i1;
-  float t;
-};
-Axis on_axis(float x) {
-  x = (x >= 0.0f ? std::min(x, 1.0f) : 0.0f) * float(kSize - 1);  // NaN reads as 0
-  const int i0 = std::min(int(x), kSize - 1);
-  return {i0, std::min(i0 + 1, kSize - 1), x - float(i0)};
-}
-
 }  // namespace
 
 double estimate_schlick_blend(float roughness, float cos_o, float exponent, int n) {
@@ -62,12 +51,8 @@ double estimate_schlick_blend(float roughness, float cos_o, float exponent, int 
 }
 
 float schlick_blend(float roughness, float cos_o) {
-  static const SchlickTable table = build_table();  // thread-safe, once, only when asked for
-  const Axis x = on_axis(roughness), y = on_axis(cos_o);
-  const auto at = [&](int i, int j) { return table[size_t(j * kSize + i)]; };
-  const float lo = at(x.i0, y.i0) + x.t * (at(x.i1, y.i0) - at(x.i0, y.i0));
-  const float hi = at(x.i0, y.i1) + x.t * (at(x.i1, y.i1) - at(x.i0, y.i1));
-  return lo + y.t * (hi - lo);
+  static const SchlickTable table = build_table();          // thread-safe, once, only when asked for
+  return lookup_2d(table.data(), kSize, roughness, cos_o);  // as Cycles reads its tables
 }
 
 Vec3 lobe_albedo(const GlossyLobe& lobe) {

@@ -28,14 +28,6 @@ AxisPoint on_axis(float x, int n) {
 
 float lerp(float a, float b, float t) { return a + t * (b - a); }
 
-// Row-major as Cycles lays its tables out: roughness fastest, then cos_o, then z.
-float lookup_2d(const float* table, int n, float rough, float mu) {
-  const AxisPoint x = on_axis(rough, n), y = on_axis(mu, n);
-  const float lo = lerp(table[y.i0 * n + x.i0], table[y.i0 * n + x.i1], x.t);
-  const float hi = lerp(table[y.i1 * n + x.i0], table[y.i1 * n + x.i1], x.t);
-  return lerp(lo, hi, y.t);
-}
-
 // z = sqrt((ior - 1) / (ior + 1)): the fourth root of F0, Cycles' axis for the index.
 float ior_axis(float ior) {
   if (!(ior >= 1.0f)) ior = ior > 0.0f ? 1.0f / ior : 1.0f;
@@ -55,6 +47,13 @@ double stratified_mean(int n, G&& g) {
 }
 
 }  // namespace
+
+float lookup_2d(const float* table, int n, float rough, float mu) {
+  const AxisPoint x = on_axis(rough, n), y = on_axis(mu, n);
+  const float lo = lerp(table[y.i0 * n + x.i0], table[y.i0 * n + x.i1], x.t);
+  const float hi = lerp(table[y.i1 * n + x.i0], table[y.i1 * n + x.i1], x.t);
+  return lerp(lo, hi, y.t);
+}
 
 float ggx_albedo(float roughness, float cos_o) { return lookup_2d(kGgxE, kGgxAlbedoSize, roughness, cos_o); }
 

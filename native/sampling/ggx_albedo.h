@@ -33,6 +33,10 @@ float ggx_average_albedo(float roughness);
 // ior >= 1 (the reflection off the denser side); ior < 1 reads as 1 / ior.
 float ggx_fresnel_blend(float roughness, float cos_o, float ior);
 
+// An n x n table over (roughness, cos_o) in [0, 1]^2, laid out as Cycles lays its tables (roughness
+// fastest), read with the lookups above: linear between entries, the ends clamped, NaN as 0.
+float lookup_2d(const float* table, int n, float roughness, float cos_o);
+
 // The axes' values at entry i of n, as the tables were computed at them.
 float ggx_table_roughness(int i, int n);
 float ggx_table_cos(int i, int n);
