@@ -174,9 +174,9 @@ test-blender:
 # The same tests under a current Blender: the bpy module from PyPI (requirements-test.txt), one
 # process per file, the add-on and the module copied into a temporary user folder
 # (tests/blender/run_with_bpy.py). Command-line parts are skipped there (no blender executable).
-# test_viewport.py and test_ui_layout.py drive Debian's Blender with a window under Xvfb (the bpy
-# module has no UI).
-BPY_TESTS := $(filter-out tests/blender/test_viewport.py tests/blender/test_ui_layout.py,$(BLENDER_TESTS))
+# test_viewport.py, test_ui_layout.py and test_material_preview.py drive Debian's Blender with a window
+# under Xvfb (the bpy module has no UI, and renders no previews).
+BPY_TESTS := $(filter-out tests/blender/test_viewport.py tests/blender/test_ui_layout.py tests/blender/test_material_preview.py,$(BLENDER_TESTS))
 test-bpy:
 	@passed=0; for t in $(BPY_TESTS); do \
 		echo "bpy: $$t"; start=$$(date +%s); \

@@ -11,7 +11,7 @@ from bpy.app.handlers import persistent
 class TOYRTRenderEngine(bpy.types.RenderEngine):
     bl_idname = "TOYRT"
     bl_label = "TOYRT"
-    bl_use_preview = False
+    bl_use_preview = True  # the Material tab's preview sphere and the slots' icons (preview.py)
     bl_use_shading_nodes_custom = False  # the user's node materials are read, not replaced
 
     def __init__(self, *args, **kwargs):
@@ -52,7 +52,12 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         from . import native, report
 
         try:
-            self._render(depsgraph, native())
+            if self.is_preview:
+                from .preview import render_preview
+
+                render_preview(self, depsgraph, native(), _set_rect)
+            else:
+                self._render(depsgraph, native())
         except Exception as err:  # reaches the user (and makes a farm's frame fail), never crashes Blender
             report.error(f"render failed: {err}", self.report)
 
