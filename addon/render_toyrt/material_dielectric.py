@@ -31,10 +31,13 @@ def dielectric_spec(name, node, kind, label, notes):
     roughness^2; 3.x's separable masking and Fresnel-weighted pair of lobes, 4.0+'s height-correlated
     masking and Fresnel term per microfacet). Multiscatter GGX is 4.0+'s energy compensation; 3.x's
     (a random walk) is drawn as single-scatter GGX, noted. Returns a MaterialSpec."""
-    from .materials import MaterialSpec, _blender_version, _constant, _shadowing, input_socket
+    from .materials import MaterialSpec, _blender_version, _constant, _finite_color, _shadowing, input_socket
     color = input_socket(node, "Color")
-    if color is not None and (color.is_linked or tuple(color.default_value)[:3] != (1.0, 1.0, 1.0)):
-        notes.append(f"material '{name}': {label} tint (white)")
+    tint = (1.0, 1.0, 1.0)
+    if color is not None and color.is_linked:
+        notes.append(f"material '{name}': linked {label} Color (white)")
+    elif color is not None:  # every ray through or mirrored by the surface takes it, as in Cycles
+        tint = _finite_color(name, color.default_value, f"{label} Color", notes)
     distribution = getattr(node, "distribution", "GGX")
     roughness = 0.0
     if distribution != "SHARP":
@@ -46,6 +49,6 @@ def dielectric_spec(name, node, kind, label, notes):
     if roughness > 0.0 and distribution == "MULTI_GGX" and not multiscatter:
         notes.append(f"material '{name}': Multiscatter GGX {label} (single-scatter GGX: darker at high roughness)")
     fresnel = "microfacet" if new else "macro"
-    return MaterialSpec(kind, ior=ior_value(name, node, notes), roughness=roughness, shadowing=_shadowing(),
+    return MaterialSpec(kind, color=tint, ior=ior_value(name, node, notes), roughness=roughness, shadowing=_shadowing(),
                         fresnel=fresnel, distribution="beckmann" if distribution == "BECKMANN" else "ggx",
                         multiscatter=multiscatter)

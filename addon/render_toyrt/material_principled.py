@@ -45,8 +45,10 @@ def principled_spec(name, node, notes):
     layer = _specular_layer(name, node, base, extras, notes)
     if extras:
         notes.append(f"material '{name}': Principled {', '.join(extras)} (not modelled)")
-    if glass and (base.texture is not None or any(c != 1.0 for c in base.color)):
-        notes.append(f"material '{name}': Principled transmission colour (white)")
+    tint_3x = input_socket(node, "Specular Tint") if _blender_version() < (4, 0, 0) else None
+    if glass and tint_3x is not None and (tint_3x.is_linked or tint_3x.default_value > 0.0):
+        # 3.x tints the glass's reflection towards the base colour too (towards white at grazing)
+        notes.append(f"material '{name}': Principled Specular Tint on the glass's reflection (white)")
     if layer is None and (metallic > 0.0 or glass):   # no dielectric layer, but a metal or glass beside the base
         new = _blender_version() >= (4, 0, 0)
         layer = dict(roughness=_constant(name, input_socket(node, "Roughness"), "roughness", 0.5, notes, 0.0, 1.0),

@@ -45,7 +45,10 @@ enum class MicrofacetDistribution : uint8_t { Ggx, Beckmann };
 struct DielectricLobe {
   Frame frame{Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};  // z: the shading normal on wo's side
   Vec3 wo{0.0f, 0.0f, 1.0f};                                 // local, unit, wo.z > 0
-  Vec3 tint{1.0f};
+  // The colours of the two sides (Blender's Glass BSDF Color on both, Principled's Specular Tint
+  // and base colour on each), times 4.0+'s multiscatter energy scale.
+  Vec3 tint{1.0f};           // reflection
+  Vec3 transmit_tint{1.0f};  // transmission
   float alpha = 0.1f;
   MicrofacetDistribution distribution = MicrofacetDistribution::Ggx;
   float eta = 1.45f;  // n_far / n_near, != 1
@@ -138,7 +141,7 @@ inline BsdfEval dielectric_eval_local(const DielectricLobe& lobe, const Vec3& wi
   const float f = d * g2_over_cos(lobe, wi_up) * cos_oh * jacobian;
   const float pdf = normal_pdf(lobe, h, cos_oh) * jacobian;
   if (!std::isfinite(f) || !std::isfinite(pdf)) return {};
-  return {lobe.tint * (w * f), w * pdf};
+  return {lobe.transmit_tint * (w * f), w * pdf};
 }
 
 inline BsdfEval dielectric_eval(const DielectricLobe& lobe, const Vec3& wi) {
@@ -174,7 +177,7 @@ inline BsdfSample dielectric_sample_local(const DielectricLobe& lobe, const Vec2
     const float cos_im = glm::dot(s.wi, m);
     const float denom = cos_om + lobe.eta * cos_im;
     s.pdf = (1.0f - pr) * hpdf * lobe.eta * lobe.eta * -cos_im / (denom * denom);
-    s.weight = lobe.tint * sample_weight(lobe, m, cos_om, Vec3(s.wi.x, s.wi.y, -s.wi.z));
+    s.weight = lobe.transmit_tint * sample_weight(lobe, m, cos_om, Vec3(s.wi.x, s.wi.y, -s.wi.z));
   }
   if (!(s.pdf > 0.0f) || !std::isfinite(s.pdf) || !is_finite(s.weight)) s = BsdfSample{s.wi, Vec3(0.0f), 0.0f};
   return s;

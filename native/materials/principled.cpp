@@ -136,7 +136,17 @@ Scatter scatter(const Principled& m, const ShadingPoint& s, const MaterialContex
   // the base, always there in the opaque answer, carries (1 - transmission) of its weight over
   // the opaque draw's probability. The rest of the number, rescaled to [0, 1), is the metal's.
   const float u = ctx.lobe_uniform();
-  if (u < glass) return scatter(m.glass, s, ctx);
+  if (u < glass) {
+    // The glass's colours at this hit, as Cycles': 4.0+ tints the reflection by Specular Tint and
+    // each transmission by the square root of the base colour (two interfaces of a closed object
+    // give the base colour); 3.x tints the refraction by the base colour and leaves the
+    // reflection white (its Specular Tint there, not modelled, is noted by the add-on).
+    FresnelDielectric g = m.glass;
+    const Vec3 base = glm::max(albedo, Vec3(0.0f));
+    g.reflect_tint = m.layered ? m.specular_tint : Vec3(1.0f);
+    g.transmit_tint = m.layered ? glm::sqrt(base) : base;
+    return scatter(g, s, ctx);
+  }
   return opaque_scatter(m, s, ctx, albedo, (1.0f - m.transmission) / (1.0f - glass),
                         std::min((u - glass) / (1.0f - glass), 0x1.fffffep-1f));
 }

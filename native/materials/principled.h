@@ -32,8 +32,9 @@
 // the same roughness and masking (materials/refraction.h; 3.x's Fresnel-weighted lobe pair, 4.0+'s
 // Fresnel per microfacet with Multiscatter GGX as chosen), drawn with probability its share on the
 // lobe-choice number; otherwise the opaque parts answer as above with the base scaled so that its
-// expectation keeps its weight. Its colour is white (Cycles tints the transmission: the add-on's
-// note).
+// expectation keeps its weight. Its colours are Cycles' per version, from the base colour at the
+// hit (principled.cpp): 4.0+ sqrt(base) on each transmission and Specular Tint on the reflection,
+// 3.x the base colour on the refraction.
 #pragma once
 
 #include "core/params.h"

@@ -74,11 +74,11 @@ DielectricRoughness roughness_from_params(const Params& params) {
 
 }  // namespace
 
-PerfectRefraction PerfectRefraction::make(float ior, DielectricRoughness rough) {
-  return {checked_ior(ior), checked_roughness(rough)};
+PerfectRefraction PerfectRefraction::make(float ior, DielectricRoughness rough, const Vec3& color) {
+  return {checked_ior(ior), checked_roughness(rough), color};
 }
 FresnelDielectric FresnelDielectric::make(float ior, DielectricRoughness rough, bool macro_fresnel, bool multiscatter) {
-  FresnelDielectric m{checked_ior(ior), checked_roughness(rough), macro_fresnel, -1};
+  FresnelDielectric m{checked_ior(ior), checked_roughness(rough), macro_fresnel, -1, Vec3(1.0f), Vec3(1.0f)};
   if (!multiscatter) return m;
   if (macro_fresnel || rough.distribution != MicrofacetDistribution::Ggx)
     throw std::invalid_argument("glass: multiscatter needs distribution 'ggx' and fresnel 'microfacet'");
@@ -87,14 +87,17 @@ FresnelDielectric FresnelDielectric::make(float ior, DielectricRoughness rough, 
   return m;
 }
 PerfectRefraction PerfectRefraction::from_params(const Params& params) {
-  return make(float(params.positive("ior", PerfectRefraction{}.ior)), roughness_from_params(params));
+  return make(float(params.positive("ior", PerfectRefraction{}.ior)), roughness_from_params(params),
+              params.color("color", Vec3(1.0f)));
 }
 FresnelDielectric FresnelDielectric::from_params(const Params& params) {
   const std::string fresnel = params.text("fresnel", "microfacet");
   if (fresnel != "microfacet" && fresnel != "macro")
     throw std::invalid_argument("glass: fresnel must be 'microfacet' or 'macro', not '" + fresnel + "'");
-  return make(float(params.positive("ior", FresnelDielectric{}.ior)), roughness_from_params(params), fresnel == "macro",
-              params.flag("multiscatter", false));
+  FresnelDielectric m = make(float(params.positive("ior", FresnelDielectric{}.ior)), roughness_from_params(params),
+                             fresnel == "macro", params.flag("multiscatter", false));
+  m.reflect_tint = m.transmit_tint = params.color("color", Vec3(1.0f));
+  return m;
 }
 
 bool rough_dielectric(const ShadingPoint& s, float ior, const DielectricRoughness& rough, DielectricKind kind,
@@ -112,7 +115,7 @@ bool rough_dielectric(const ShadingPoint& s, float ior, const DielectricRoughnes
   lobe->eta = glm::dot(s.wo, s.ng) > 0.0f ? ior : 1.0f / ior;
   lobe->kind = kind;
   lobe->fresnel_macro = kind == DielectricKind::Glass3x ? fresnel_dielectric(g.wo.z, lobe->eta) : 0.0f;
-  lobe->tint = Vec3(1.0f);
+  lobe->tint = lobe->transmit_tint = Vec3(1.0f);
   return true;
 }
 
@@ -149,25 +152,38 @@ int split(const FresnelDielectric& m, const Vec3& wo, const Vec3& ng, const Vec3
 
 Scatter scatter(const PerfectRefraction& m, const ShadingPoint& s, const MaterialContext&) {
   DielectricLobe lobe;
-  if (rough_dielectric(s, m.ior, m.rough, DielectricKind::Refraction, &lobe)) return Scatter::dielectric_lobe(lobe);
-  return Scatter::specular(sample(m, s.wo, s.ng, s.ns));
+  if (rough_dielectric(s, m.ior, m.rough, DielectricKind::Refraction, &lobe)) {
+    lobe.tint = lobe.transmit_tint = m.color;
+    return Scatter::dielectric_lobe(lobe);
+  }
+  SpecularSample b = sample(m, s.wo, s.ng, s.ns);
+  b.weight = m.color;
+  return Scatter::specular(b);
 }
 
 Scatter scatter(const FresnelDielectric& m, const ShadingPoint& s, const MaterialContext& ctx) {
   DielectricLobe lobe;
   if (rough_dielectric(s, m.ior, m.rough, m.macro_fresnel ? DielectricKind::Glass3x : DielectricKind::Glass, &lobe)) {
-    if (m.albedo >= 0)
-      lobe.tint =
-          Vec3(multiscatter_glass_scale(dielectric_albedo_table(m.albedo), glm::dot(s.wo, s.ng) > 0.0f, lobe.wo.z));
+    const float scale = m.albedo >= 0 ? multiscatter_glass_scale(dielectric_albedo_table(m.albedo),
+                                                                 glm::dot(s.wo, s.ng) > 0.0f, lobe.wo.z)
+                                      : 1.0f;
+    lobe.tint = m.reflect_tint * scale;
+    lobe.transmit_tint = m.transmit_tint * scale;
     return Scatter::dielectric_lobe(lobe);
   }
-  if (!ctx.split) return Scatter::specular(sample(m, s.wo, s.ng, s.ns, ctx.uniform()));
+  if (!ctx.split) {
+    SpecularSample b = sample(m, s.wo, s.ng, s.ns, ctx.uniform());
+    b.weight = b.reflected ? m.reflect_tint : m.transmit_tint;
+    return Scatter::specular(b);
+  }
   // Splitting: both branches, each weighted by its Fresnel term, instead of choosing one with
   // that probability. A light seen in a reflection with F = 0.04 is otherwise an all-or-nothing
   // sample in 4 % of the paths, the largest variance in a glass scene (docs/render.md).
   Scatter out;
   out.kind = Scatter::Kind::Split;
   out.count = split(m, s.wo, s.ng, s.ns, out.branches);
+  for (int b = 0; b < out.count; ++b)
+    out.branches[b].weight = out.branches[b].reflected ? m.reflect_tint : m.transmit_tint;
   return out;
 }
 

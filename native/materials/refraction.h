@@ -51,10 +51,12 @@ struct PerfectRefraction {
   static constexpr const char* kType = "refraction";
   static constexpr const char* kParams =
       "ior (1.45), roughness (0; alpha = roughness^2), distribution ('ggx', 'beckmann'), shadowing\n"
-      "('separable' 3.x, 'correlated' 4.0+): refraction without reflection, Blender's Refraction BSDF";
+      "('separable' 3.x, 'correlated' 4.0+), color ((1, 1, 1)): refraction without reflection, Blender's\n"
+      "Refraction BSDF";
   float ior = 1.45f;  // Blender's default; must be positive and finite
   DielectricRoughness rough;
-  static PerfectRefraction make(float ior, DielectricRoughness rough = {});
+  Vec3 color{1.0f};  // the node's Color: every ray through (or mirrored by) it
+  static PerfectRefraction make(float ior, DielectricRoughness rough = {}, const Vec3& color = Vec3(1.0f));
   static PerfectRefraction from_params(const Params& params);
 };
 
@@ -63,14 +65,18 @@ struct FresnelDielectric {
   static constexpr const char* kParams =
       "ior (1.45), roughness (0; alpha = roughness^2), distribution ('ggx', 'beckmann'), shadowing\n"
       "('separable' 3.x, 'correlated' 4.0+), fresnel ('microfacet' 4.0+, 'macro' 3.x), multiscatter (False;\n"
-      "4.0+'s Multiscatter GGX: GGX with fresnel 'microfacet' only): Fresnel reflection and refraction, Blender's\n"
-      "Glass BSDF";
+      "4.0+'s Multiscatter GGX: GGX with fresnel 'microfacet' only), color ((1, 1, 1)): Fresnel reflection and\n"
+      "refraction, Blender's Glass BSDF";
   float ior = 1.45f;
   DielectricRoughness rough;
   bool macro_fresnel = false;
   // Multiscatter GGX (materials/dielectric_albedo.h): the id of the lobe's albedo table over
   // cos_o, made by make() (shared_dielectric_albedo); -1: single scattering (or a sharp material).
   int32_t albedo = -1;
+  // Colours of the reflected and the transmitted rays: the Glass BSDF's Color on both; the
+  // Principled BSDF's glass sets them per hit (principled.cpp). In [0, 1] per channel.
+  Vec3 reflect_tint{1.0f};
+  Vec3 transmit_tint{1.0f};
   // Throws std::invalid_argument for multiscatter with Beckmann or the macro Fresnel (Cycles has none).
   static FresnelDielectric make(float ior, DielectricRoughness rough = {}, bool macro_fresnel = false,
                                 bool multiscatter = false);

@@ -50,8 +50,8 @@ struct SpecularSample {
   bool reflected = false;  // mirror direction (always, under total internal reflection)
   bool total_internal_reflection = false;
   bool entering = false;     // wo was on the geometric normal's side
-  float probability = 1.0f;  // of this branch: 1, or F / 1 - F for FresnelDielectric; f / pdf is 1
-                             // (times the material's colour) in every case
+  float probability = 1.0f;  // of this branch: 1, or F / 1 - F for FresnelDielectric
+  Vec3 weight{1.0f};         // f / pdf: the material's colour on this branch's side
   // The geometric normal on the side wi leaves into: offset_ray_origin(p, offset_normal).
   Vec3 offset_normal{0.0f};
 };
@@ -59,7 +59,7 @@ struct SpecularSample {
 struct Scatter {
   enum class Kind : uint8_t {
     Diffuse,     // direct lighting with BRDF value f, then the path ends
-    Specular,    // the path continues along branches[0] with weight 1 (f / pdf = 1)
+    Specular,    // the path continues along branches[0], its throughput times the branch's weight
     Split,       // each of the `count` branches is traced on its own, weighted by its probability
     Glossy,      // lights sampled with MIS against `glossy`, then the path continues along its sample;
                  // a diffuse part f, if not 0, gets its direct light as a Diffuse answer does

@@ -63,10 +63,12 @@ py::dict core_defaults() {
 // add_material's and set_material's parameters: the keywords documented since the first
 // materials (color, texture, ior), which every kind accepts and ignores where it has no use for
 // them (the add-on sends all three whatever the kind), plus any other keyword, which the kind
-// must read (a typo is an error).
+// must read (a typo is an error). color None: the kind's own default (grey for the diffuse
+// kinds, white for glass and refraction).
 Params material_params(py::handle color, int64_t texture, float ior, const py::kwargs& extra) {
   Params p = to_params(extra);
-  p.set("color", to_vec3(color, "color")).set("texture", double(texture)).set("ior", double(ior));
+  if (!color.is_none()) p.set("color", to_vec3(color, "color"));
+  p.set("texture", double(texture)).set("ior", double(ior));
   for (const char* shared : {"color", "texture", "ior"}) p.allow_unread(shared);
   return p;
 }
@@ -169,7 +171,8 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       "Adds a material; returns its id. kind and its parameters (other keywords than color, texture and ior\n"
       "must be ones the kind reads):\n" +
       type_docs<Material>() +
-      "color, texture and ior are accepted by every kind; kinds without them ignore them. Every kind also\n"
+      "color, texture and ior are accepted by every kind; kinds without them ignore them (color None: the\n"
+      "kind's default, grey for the diffuse kinds, white for glass and refraction). Every kind also\n"
       "emits: emission (linear RGB radiance, Blender's colour x strength, both sides; (0, 0, 0): none) and\n"
       "emission_sampling ('AUTO', 'FRONT_AND_BACK', 'FRONT', 'BACK': sampled as a light towards those sides;\n"
       "'NONE': only seen by rays that hit it).";
@@ -193,8 +196,8 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
              const py::kwargs& params) {
             return self.add_material(kind, material_params(color, texture, ior, params));
           },
-          py::arg("kind") = kDefaultMaterialKind, py::arg("color") = as_tuple(Lambert{}.albedo),
-          py::arg("texture") = Lambert{}.texture, py::arg("ior") = tidy(PerfectRefraction{}.ior), material_doc.c_str())
+          py::arg("kind") = kDefaultMaterialKind, py::arg("color") = py::none(), py::arg("texture") = Lambert{}.texture,
+          py::arg("ior") = tidy(PerfectRefraction{}.ior), material_doc.c_str())
       .def("add_texture", &PyScene::add_texture, py::arg("pixels"), py::arg("srgb") = true,
            "Adds an image; returns its id. pixels: (height, width, 3 or 4), float 0..1 or uint8, rows from\n"
            "the bottom (Blender's Image.pixels order); srgb: decode from sRGB to linear, as Blender does.")
@@ -292,7 +295,7 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
              const py::kwargs& params) {
             self.set_material(material, kind, material_params(color, texture, ior, params));
           },
-          py::arg("material"), py::arg("kind") = kDefaultMaterialKind, py::arg("color") = as_tuple(Lambert{}.albedo),
+          py::arg("material"), py::arg("kind") = kDefaultMaterialKind, py::arg("color") = py::none(),
           py::arg("texture") = Lambert{}.texture, py::arg("ior") = tidy(PerfectRefraction{}.ior),
           "Replaces material `material` in place (same arguments as add_material); meshes keep their ids.")
       .def("set_texture", &PyScene::set_texture, py::arg("texture"), py::arg("pixels"), py::arg("srgb") = true,

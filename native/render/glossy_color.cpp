@@ -81,12 +81,13 @@ float glass_reflectance(float roughness, float cos_o, float eta) {
   // The lobe the material's scatter() makes there, or none where it is specular.
   DielectricLobe lobe;
   if (rough_dielectric(s, m.ior, m.rough, m.macro_fresnel ? DielectricKind::Glass3x : DielectricKind::Glass, &lobe))
-    return Vec3(m.macro_fresnel ? lobe.fresnel_macro : glass_reflectance(std::sqrt(lobe.alpha), lobe.wo.z, lobe.eta));
+    return m.reflect_tint *
+           (m.macro_fresnel ? lobe.fresnel_macro : glass_reflectance(std::sqrt(lobe.alpha), lobe.wo.z, lobe.eta));
   const bool entering = glm::dot(s.ng, s.wo) > 0.0f;
   const Vec3 ng = entering ? s.ng : -s.ng;
   const Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;
   const float cos_o = std::clamp(glm::dot(ns, s.wo), 0.0f, 1.0f), eta = entering ? m.ior : 1.0f / m.ior;
-  return Vec3(m.macro_fresnel ? fresnel_dielectric(cos_o, eta) : glass_reflectance(0.0f, cos_o, eta));
+  return m.reflect_tint * (m.macro_fresnel ? fresnel_dielectric(cos_o, eta) : glass_reflectance(0.0f, cos_o, eta));
 }
 
 void add_glass_pass_color(const std::vector<Material>& materials, FirstHit& hit) {

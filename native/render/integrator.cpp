@@ -383,10 +383,12 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             for (int b = 0; b < sc.count; ++b) {
               const SpecularSample& branch = sc.branches[b];
               const Ray next{offset_ray_origin(s.p, branch.offset_normal), 0.0f, branch.wi, kInfinity};
-              radiance += throughput * branch.probability * trace_from(scene, next, depth + 1, pixel, sample, settings);
+              radiance += throughput * branch.weight * branch.probability *
+                          trace_from(scene, next, depth + 1, pixel, sample, settings);
             }
             return false;
           }
+          throughput *= sc.branches[0].weight;
           ray = Ray{offset_ray_origin(s.p, sc.branches[0].offset_normal), 0.0f, sc.branches[0].wi, kInfinity};
           return true;
         },

@@ -102,7 +102,11 @@ def scene_area(p):
 def scene_glass(p):
     floor = checker("checker", 8, p["checker"][0], p["checker"][1], float_buffer=p["float_texture"])
     kit.plane("floor", 6.0, floor, uv_repeat=p["uv_repeat"])
-    kit.uv_sphere("ball", 0.7, (0.0, 0.0, 0.75), kit.glass("glass", p["ior"]))
+    glass = kit.glass("glass", p["ior"])
+    if "glass_color" in p:  # the Glass BSDF's Color: every ray through or mirrored by it takes it
+        next(n for n in glass.node_tree.nodes if n.type == "BSDF_GLASS").inputs["Color"].default_value = \
+            (*p["glass_color"], 1.0)
+    kit.uv_sphere("ball", 0.7, (0.0, 0.0, 0.75), glass)
     lamp = kit.area_light("panel", p["light"], p["power"], 1.5, 1.0, target=(0, 0, 0))
     if p["hide_light_from_specular"]:
         # The light hidden from camera and specular rays (the exporter passes the flags on).
@@ -295,6 +299,11 @@ SCENES_SPEC = [
                                                      hide_light_from_specular=True, world_lights_diffuse=False,
                                                      float_texture=True,
                                                      camera=(0.0, -5.0, 2.5)), 8),
+    # A tinted Glass BSDF (issue 14): the colour on each reflection and refraction, as Cycles.
+    ("glass_tinted", scene_glass, dict(light=(1.0, -1.0, 3.0), power=120.0, ior=1.45, uv_repeat=4.0,
+                                       checker=(0.15, 0.85), world=(0.05, 0.05, 0.05), glass_color=(0.95, 0.6, 0.3),
+                                       hide_light_from_specular=True, world_lights_diffuse=False, float_texture=False,
+                                       camera=(0.0, -5.0, 2.5)), 8),
     ("sun_hard_shadow", scene_sun, dict(strength=3.0, direction=(-0.4, 0.5, -1.0), angle=0.0,
                                         camera=(0.0, -6.0, 4.5)), 0),
     ("sun_soft_shadow", scene_sun, dict(strength=3.0, direction=(-0.4, 0.5, -1.0), angle=0.35,
@@ -398,7 +407,8 @@ SCENES_SPEC.append(("area_spread", scene_area_spread,
                          spread=0.5236, camera=(0.0, -6.0, 4.5), mean_limit=0.005, sample_factor=8), 0))
 
 
-# Principled Transmission (white base, so that neither version's transmission tint shows): a ball
+# Principled Transmission (a warm base colour, which tints the glass as each version's Cycles does:
+# 4.0+ by its square root per interface, 3.x by itself on each refraction): a ball
 # of Transmission 1 (the Glass BSDF's lobe) beside one of 0.5 (the glass drawn beside the opaque
 # parts: 3.x's Burley base and layer, 4.0+'s layered base), roughness 0.3, IOR 1.45, the rough
 # glass scene's lamp and floor. 16x the samples: the partial ball draws glass or opaque parts per
@@ -407,7 +417,7 @@ def scene_principled_glass(p):
     floor = checker("checker", 8, 0.15, 0.85)
     kit.plane("floor", 6.0, floor, uv_repeat=4.0)
     for i, (weight, x) in enumerate(((1.0, -0.8), (0.5, 0.8))):
-        mat = kit.principled_dielectric(f"principled_glass{i}", (1.0, 1.0, 1.0), p["roughness"])
+        mat = kit.principled_dielectric(f"principled_glass{i}", p["base"], p["roughness"])
         bsdf = mat.node_tree.nodes["Principled BSDF"]
         kit.input_of(bsdf, "Transmission Weight", "Transmission").default_value = weight
         bsdf.inputs["IOR"].default_value = 1.45
@@ -417,8 +427,8 @@ def scene_principled_glass(p):
     kit.world((0.05, 0.05, 0.05))
 
 
-SCENES_SPEC.append(("principled_glass", scene_principled_glass, dict(roughness=0.3, mean_limit=0.005,
-                                                                     sample_factor=16), 8))
+SCENES_SPEC.append(("principled_glass", scene_principled_glass, dict(roughness=0.3, base=(0.95, 0.8, 0.6),
+                                                                     mean_limit=0.005, sample_factor=16), 8))
 
 # ---- Cycles ------------------------------------------------------------------------------------
 

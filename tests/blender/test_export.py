@@ -467,8 +467,9 @@ def test_principled_specular_layer():
 def test_principled_transmission():
     """A Principled BSDF's Transmission (3.x) / Transmission Weight (4.0+) becomes the 'principled'
     kind's glass share, with the IOR socket's value as the glass's IOR (3.x's layer keeps its
-    Specular IOR) and the roughness kept, at 0.5 and at 1; the base colour's tint of the
-    transmission is noted (white); Metallic 1 stays the metal."""
+    Specular IOR) and the roughness kept, at 0.5 and at 1; the base colour tints the glass in the
+    core (nothing noted); 3.x's Specular Tint on the glass's reflection is noted (white); Metallic 1
+    stays the metal."""
     _, _ = addon()
     from render_toyrt import materials
 
@@ -482,17 +483,45 @@ def test_principled_transmission():
         check(c.spec.kind == "principled" and abs(c.spec.transmission - weight) < 1e-6
               and abs(c.spec.transmission_ior - 1.33) < 1e-6 and abs(c.spec.roughness - 0.3) < 1e-6
               and c.spec.burley == (not new) and c.spec.arguments()["transmission"] == c.spec.transmission
-              and any("transmission colour (white)" in n for n in c.notes)
-              and not any("not modelled" in n for n in c.notes),
+              and not c.notes,
               f"Transmission {weight}: a glass share beside the opaque parts: {c}")
     white = kit.principled_dielectric("white_glass", (1.0, 1.0, 1.0), 0.0)
     kit.input_of(white.node_tree.nodes["Principled BSDF"], "Transmission Weight", "Transmission").default_value = 1.0
     w = materials.material_spec(white)
     check(w.spec.transmission == 1.0 and not w.notes, f"white glass: nothing to note: {w}")
+    if not new:
+        kit.input_of(white.node_tree.nodes["Principled BSDF"], "Specular Tint").default_value = 0.5
+        t = materials.material_spec(white)
+        check(any("Specular Tint on the glass's reflection (white)" in n for n in t.notes),
+              f"3.x Specular Tint on the glass is noted: {t}")
     metal = kit.metal("glassy_metal", (0.9, 0.8, 0.7), 0.3)
     kit.input_of(metal.node_tree.nodes["Principled BSDF"], "Transmission Weight", "Transmission").default_value = 1.0
     m = materials.material_spec(metal)
     check(m.spec.metallic == 1.0 and m.spec.transmission == 0.0, f"Metallic 1 is the metal (no glass): {m}")
+
+
+def test_glass_color():
+    """The Glass and Refraction BSDFs' Color reaches the core's glass (every ray through or mirrored
+    by it takes the colour, as in Cycles); a linked Color is noted and white; NaN channels are 0,
+    noted."""
+    _, _ = addon()
+    from render_toyrt import materials
+
+    for shader, kind in (("ShaderNodeBsdfGlass", "glass"), ("ShaderNodeBsdfRefraction", "refraction")):
+        mat, node = kit.surface(f"tinted_{kind}", shader)
+        node.inputs["Color"].default_value = (0.9, 0.5, 0.2, 1.0)
+        c = materials.material_spec(mat)
+        check(c.spec.kind == kind and np.allclose(c.spec.color, (0.9, 0.5, 0.2)) and not c.notes
+              and np.allclose(c.spec.arguments()["color"], (0.9, 0.5, 0.2)), f"{kind} colour: {c}")
+        tex = mat.node_tree.nodes.new("ShaderNodeTexChecker")
+        mat.node_tree.links.new(tex.outputs["Color"], node.inputs["Color"])
+        linked = materials.material_spec(mat)
+        check(linked.spec.color == (1.0, 1.0, 1.0)
+              and any("linked" in n and "Color (white)" in n for n in linked.notes), f"linked {kind} colour: {linked}")
+    mat, node = kit.surface("nan_glass", "ShaderNodeBsdfGlass")
+    node.inputs["Color"].default_value = (float("nan"), 0.5, 0.5, 1.0)
+    c = materials.material_spec(mat)
+    check(c.spec.color == (0.0, 0.5, 0.5) and any("NaN" in n for n in c.notes), f"NaN glass colour: {c}")
 
 
 def test_rough_glass_and_refraction():
@@ -667,6 +696,6 @@ def test_command_line_range():
 
 
 PARTS = [test_counts_and_transforms, test_instancing_memory, test_missing_texture, test_unsupported_node,
-         test_principled_specular_layer, test_principled_transmission, test_rough_glass_and_refraction, test_cancel,
-         test_animation, test_command_line_range]
+         test_principled_specular_layer, test_principled_transmission, test_glass_color,
+         test_rough_glass_and_refraction, test_cancel, test_animation, test_command_line_range]
 run_script(PARTS, "export", TMP)

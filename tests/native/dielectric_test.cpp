@@ -319,7 +319,7 @@ TEST(Dielectric, MultiscatterGlassIsAWhiteFurnaceAndItsAlbedoTableMatchesAQuadra
         ASSERT_EQ(sc.kind, Scatter::Kind::Dielectric);
         // The table's E against the single-scatter lobe's quadrature over the sphere.
         DielectricLobe single = sc.dielectric;
-        single.tint = Vec3(1.0f);
+        single.tint = single.transmit_tint = Vec3(1.0f);
         const double e = sphere_integral(
             [&](const Vec3& wi) { return double(dielectric_eval_local(single, wi).f.x) * std::abs(wi.z); }, 3072, 256);
         EXPECT_NEAR(1.0 / sc.dielectric.tint.x, e, 5e-3) << "roughness " << roughness << " theta_o " << theta_o;
