@@ -27,6 +27,9 @@ SCENES = [
     ("sun_spot", "sun_spot", {}, 0, True),
     ("emitter_room", "emitter_room", {}, 0, True),
     ("hdri", "hdri", {}, 0, True),
+    # Issue 14's glossy reflections (Principled, metal, Glossy BSDF): paths through the lobes. Mitsuba
+    # has no integrator restricted to this transport, nor Cycles' Principled model.
+    ("glossy", "glossy", {}, 8, False),
 ]
 METHODS = [["solid_angle", "all"], ["solid_angle", "one"], ["area", "all"], ["area", "one"]]
 # Features switched on one at a time on the seed's Cornell box (scenes/bench/cornell.py).
