@@ -28,7 +28,8 @@ def principled_spec(name, node, notes):
     extras = []
     metallic = _constant(name, metal, "Metallic", 0.0, notes, 0.0, 1.0)
     glass = _transmission(name, node, notes)
-    for label, names in (("coat", ("Coat Weight", "Clearcoat")), ("sheen", ("Sheen Weight", "Sheen")),
+    coat = _coat(name, node, glass, notes)
+    for label, names in (("clearcoat", ("Clearcoat",)), ("sheen", ("Sheen Weight", "Sheen")),
                          ("subsurface", ("Subsurface Weight", "Subsurface")), ("anisotropy", ("Anisotropic",)),
                          ("diffuse roughness", ("Diffuse Roughness",)), ("thin film", ("Thin Film Thickness",))):
         sock = input_socket(node, *names)
@@ -54,8 +55,37 @@ def principled_spec(name, node, notes):
         layer = dict(roughness=_constant(name, input_socket(node, "Roughness"), "roughness", 0.5, notes, 0.0, 1.0),
                      ior=1.0, multiscatter=new and getattr(node, "distribution", "GGX") == "MULTI_GGX",
                      shadowing="correlated" if new else "separable", layered=new)
-    spec = base if layer is None else replace(base, kind="principled", metallic=metallic, **layer, **glass)
+    if layer is None and coat:   # a coat over a plain base: the 'principled' kind without a layer
+        layer = dict(roughness=0.5, ior=1.0, multiscatter=False, shadowing="correlated", layered=True)
+    spec = base if layer is None else replace(base, kind="principled", metallic=metallic, **layer, **glass, **coat)
     return replace(spec, emission=emission), image
+
+
+def _coat(name, node, glass, notes) -> dict:
+    """4.0+'s Coat (Weight, Roughness, IOR, Tint) as the 'principled' kind's coat arguments ({} for
+    none): Cycles 4.0+'s dielectric layer over everything opaque. A linked socket is its constant
+    value, a Coat Normal is not modelled, the glass of Transmission is not coated: each noted.
+    (3.x's Clearcoat, a GTR1 lobe added beside the rest, is noted by the caller.)"""
+    weight_sock = input_socket(node, "Coat Weight")
+    if weight_sock is None:
+        return {}
+    weight = _constant(name, weight_sock, "Coat Weight", 0.0, notes, 0.0, 1.0)
+    if weight <= 0.0:
+        return {}
+    rough = _constant(name, input_socket(node, "Coat Roughness"), "Coat Roughness", 0.03, notes, 0.0, 1.0)
+    ior = _constant(name, input_socket(node, "Coat IOR"), "Coat IOR", 1.5, notes, 1.0, 1e30)
+    tint_sock = input_socket(node, "Coat Tint")
+    tint = (1.0, 1.0, 1.0)
+    if tint_sock is not None:
+        if tint_sock.is_linked:
+            notes.append(f"material '{name}': linked Coat Tint (its constant colour)")
+        tint = _finite_color(name, tint_sock.default_value, "Coat Tint", notes)
+    normal = input_socket(node, "Coat Normal")
+    if normal is not None and normal.is_linked:
+        notes.append(f"material '{name}': Principled Coat Normal (not modelled)")
+    if glass:
+        notes.append(f"material '{name}': Principled coat over Transmission (the glass uncoated)")
+    return dict(coat_weight=weight, coat_roughness=rough, coat_ior=ior, coat_tint=tint)
 
 
 def _transmission(name, node, notes) -> dict:
@@ -130,9 +160,9 @@ def _metal(name, node, notes):
     blended from the base colour to white. The coat, anisotropy and other distributions go in the
     one note."""
     extras = []
-    coat = input_socket(node, "Coat Weight", "Clearcoat")
-    if coat is not None and (coat.is_linked or coat.default_value > 0.0):
-        extras.append("coat")
+    clearcoat = input_socket(node, "Clearcoat")   # 3.x; 4.0+'s Coat is modelled (_coat)
+    if clearcoat is not None and (clearcoat.is_linked or clearcoat.default_value > 0.0):
+        extras.append("clearcoat")
     aniso = input_socket(node, "Anisotropic")
     if aniso is not None and (aniso.is_linked or aniso.default_value > 0.0):
         extras.append("anisotropy")
@@ -161,7 +191,7 @@ def _metal(name, node, notes):
         specular = _constant(name, input_socket(node, "Specular"), "Specular", 0.5, notes, 0.0, 1e30)
         root = min(0.08 * specular, 0.99) ** 0.5
         layer = dict(ior=(1.0 + root) / (1.0 - root), multiscatter=False, shadowing="separable", layered=False)
-    spec = replace(base, kind="principled", roughness=rough, metallic=1.0, **layer)
+    spec = replace(base, kind="principled", roughness=rough, metallic=1.0, **layer, **_coat(name, node, {}, notes))
     emission = _emission(name, input_socket(node, "Emission Color", "Emission"),
                          input_socket(node, "Emission Strength"), notes)
     return replace(spec, emission=emission), image

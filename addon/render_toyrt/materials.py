@@ -60,6 +60,10 @@ class MaterialSpec:
     transmission: float = 0.0                                # 'principled': the glass's weight
     transmission_ior: float = 1.45                           # 'principled': the glass's IOR
     metallic: float = 0.0                                    # 'principled': Metallic (1: a metal of the base colour)
+    coat_weight: float = 0.0                                 # 'principled', 4.0+: the coat (0: none)
+    coat_roughness: float = 0.03
+    coat_ior: float = 1.5
+    coat_tint: tuple[float, float, float] = (1.0, 1.0, 1.0)
     emission: tuple[float, float, float] = (0.0, 0.0, 0.0)   # colour x strength, linear radiance
     emission_sampling: str = "AUTO"                           # Blender 4.x's names (3.x: AUTO or NONE)
     fresnel: str = "microfacet"                              # 'glass': 4.0+'s per microfacet, 3.x's 'macro'
@@ -81,6 +85,9 @@ class MaterialSpec:
             args.update(specular_ior_level=self.specular_ior_level, specular_tint=self.specular_tint,
                         layered=self.layered, metallic=self.metallic, burley=self.burley,
                         transmission=self.transmission, transmission_ior=self.transmission_ior)
+            if self.coat_weight > 0.0:
+                args.update(coat_weight=self.coat_weight, coat_roughness=self.coat_roughness, coat_ior=self.coat_ior,
+                            coat_tint=self.coat_tint)
         if self.kind == "diffuse_glossy":
             args.update(diffuse_weight=self.diffuse_weight, glossy_color=self.glossy_color)
         return args

@@ -53,6 +53,17 @@ Principled Principled::from_params(const Params& params) {
                       ? std::clamp((fresnel_dielectric_average(m.eta) - m.eta_f0) / (1.0f - m.eta_f0), 0.0f, 1.0f)
                       : 1.0f;
   m.fss = glm::mix(m.f0, Vec3(1.0f), s);
+  const double coat = params.number("coat_weight", 0.0);
+  if (!std::isfinite(coat)) throw std::invalid_argument("principled: coat_weight must be finite");
+  m.coat = float(std::clamp(coat, 0.0, 1.0));
+  const double coat_roughness = params.number("coat_roughness", m.coat_roughness);
+  if (!std::isfinite(coat_roughness)) throw std::invalid_argument("principled: coat_roughness must be finite");
+  m.coat_roughness = float(std::clamp(coat_roughness, 0.0, 1.0));
+  // Cycles takes max(coat_ior, 1): a coat below 1 would reflect as one above it.
+  m.coat_eta = std::max(float(params.positive("coat_ior", m.coat_eta)), 1.0f);
+  m.coat_f0 = f0_from_ior(m.coat_eta);
+  m.coat_tint = params.color("coat_tint", m.coat_tint);
+  if (m.coat > 0.0f && !m.layered) throw std::invalid_argument("principled: the coat is 4.0+'s (layered True)");
   return m;
 }
 
@@ -124,14 +135,19 @@ Scatter burley_base(const Principled& m, const ShadingPoint& s, Scatter sc) {
 // u: the lobe-choice number left for the metal's draw, or < 0: draw it here when needed.
 Scatter opaque_scatter(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx, const Vec3& albedo,
                        float scale, float u);
+Scatter coated(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx, const Vec3& albedo, float scale,
+               float u);
 
 }  // namespace
 
 Scatter scatter(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx) {
   const Vec3 albedo = lambert_albedo(m.base, *ctx.textures, s.uv);
-  if (m.metallic >= 1.0f) return Scatter::glossy_lobe(metal_lobe(m, s, albedo));
+  if (m.metallic >= 1.0f && m.coat <= 0.0f) return Scatter::glossy_lobe(metal_lobe(m, s, albedo));
   const float glass = (1.0f - m.metallic) * m.transmission;
-  if (glass <= 0.0f) return opaque_scatter(m, s, ctx, albedo, 1.0f, -1.0f);
+  if (glass <= 0.0f) {
+    if (m.coat > 0.0f) return coated(m, s, ctx, albedo, 1.0f, -1.0f);
+    return opaque_scatter(m, s, ctx, albedo, 1.0f, -1.0f);
+  }
   // One of glass and opaque parts, each with probability its weight and then counted unweighted;
   // the base, always there in the opaque answer, carries (1 - transmission) of its weight over
   // the opaque draw's probability. The rest of the number, rescaled to [0, 1), is the metal's.
@@ -147,8 +163,10 @@ Scatter scatter(const Principled& m, const ShadingPoint& s, const MaterialContex
     g.transmit_tint = m.layered ? glm::sqrt(base) : base;
     return scatter(g, s, ctx);
   }
-  return opaque_scatter(m, s, ctx, albedo, (1.0f - m.transmission) / (1.0f - glass),
-                        std::min((u - glass) / (1.0f - glass), 0x1.fffffep-1f));
+  const float rest = std::min((u - glass) / (1.0f - glass), 0x1.fffffep-1f);
+  const float scale = (1.0f - m.transmission) / (1.0f - glass);
+  if (m.coat > 0.0f) return coated(m, s, ctx, albedo, scale, rest);
+  return opaque_scatter(m, s, ctx, albedo, scale, rest);
 }
 
 namespace {
@@ -178,6 +196,39 @@ Scatter opaque_scatter(const Principled& m, const ShadingPoint& s, const Materia
   const Vec3 f = scale * dielectric * layer.base * lambert_f(albedo);
   if (m.metallic > 0.0f && metal_drawn()) return lobe_over(metal_lobe(m, s, albedo), f);
   return lobe_over(layer.lobe, f);
+}
+
+// 4.0+'s coat over what opaque_scatter answers (Principled.h): the coat's lobe drawn with
+// probability coat / 2 (its weight divided by that), else the answer below with its lobe divided
+// by the rest; the layers below are attenuated and tinted on both draws, the diffuse part kept.
+Scatter coated(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx, const Vec3& albedo, float scale,
+               float u) {
+  const float v = u < 0.0f ? ctx.lobe_uniform() : u;
+  GlossyLobe coat = oriented_lobe(s, m.coat_roughness, m.shadowing);
+  coat.fresnel = LobeFresnel::Dielectric;
+  coat.f0 = Vec3(m.coat_f0);
+  coat.ior = m.coat_eta;
+  coat.ior_f0 = m.coat_f0;
+  const float mu = coat.wo.z;
+  // What the coat leaves below, as the specular layer's estimate (single-scatter GGX), and the
+  // tint along the refracted path through it.
+  const float coat_albedo = m.coat_f0 + (1.0f - m.coat_f0) * ggx_fresnel_blend(m.coat_roughness, mu, m.coat_eta);
+  const float sin2_t = (1.0f - mu * mu) / (m.coat_eta * m.coat_eta);
+  const float depth = 1.0f / std::sqrt(std::max(1.0f - sin2_t, 1e-6f));
+  const Vec3 tinted = glm::pow(glm::max(m.coat_tint, Vec3(0.0f)), Vec3(depth));
+  const Vec3 below = std::clamp(1.0f - m.coat * coat_albedo, 0.0f, 1.0f) * glm::mix(Vec3(1.0f), tinted, m.coat);
+  const float p = 0.5f * m.coat;
+  Scatter sc = opaque_scatter(m, s, ctx, albedo, scale, std::min((std::max(v - p, 0.0f)) / (1.0f - p), 0x1.fffffep-1f));
+  sc.f *= below;
+  if (v < p) {
+    coat.tint = Vec3(m.coat / p);
+    const Vec3 f = sc.kind == Scatter::Kind::Diffuse || sc.kind == Scatter::Kind::Glossy ? sc.f : Vec3(0.0f);
+    Scatter out = lobe_over(coat, f);
+    out.burley = false;
+    return out;
+  }
+  if (sc.kind == Scatter::Kind::Glossy) sc.glossy.tint *= below / (1.0f - p);
+  return sc;
 }
 
 }  // namespace

@@ -35,6 +35,16 @@
 // expectation keeps its weight. Its colours are Cycles' per version, from the base colour at the
 // hit (principled.cpp): 4.0+ sqrt(base) on each transmission and Specular Tint on the reflection,
 // 3.x the base colour on the refraction.
+//
+// Coat (4.0+ only; 3.x's Clearcoat is noted by the add-on): coat_weight (0, clamped to [0, 1]),
+// coat_roughness (0.03), coat_ior (1.5, >= 1), coat_tint ((1, 1, 1)): a GGX dielectric layer over
+// everything opaque, as Cycles 4.0+ puts it there: its lobe weighted coat_weight, the layers
+// below scaled by 1 - coat_weight x its directional albedo (as the specular layer scales the
+// base) and tinted by mix(1, coat_tint ^ d, coat_weight), d = 1 / cos of wo refracted into the
+// coat (Beer's law over the path through a coat of unit thickness). One of the coat's lobe and
+// the layers' lobes is drawn per hit (the coat with probability coat_weight / 2), its weight
+// divided by that probability; the diffuse base gets its direct light on either draw. The glass
+// of Transmission is not coated (noted by the add-on).
 #pragma once
 
 #include "core/params.h"
@@ -53,7 +63,8 @@ struct Principled {
       "color, texture (the base colour), roughness (0.5), ior (1.45), specular_ior_level (0.5),\n"
       "specular_tint ((1, 1, 1)), multiscatter (True), layered (True; False: Blender 3.x's sum),\n"
       "shadowing ('correlated'; 'separable': 3.x), metallic (0), burley (False; True: 3.x's diffuse),\n"
-      "transmission (0), transmission_ior (the ior): the Principled BSDF";
+      "transmission (0), transmission_ior (the ior), coat_weight (0), coat_roughness (0.03), coat_ior (1.5),\n"
+      "coat_tint ((1, 1, 1); the coat: 4.0+ only): the Principled BSDF";
   Lambert base;
   float roughness = 0.5f;  // in [0, 1]
   bool multiscatter = true;
@@ -64,6 +75,11 @@ struct Principled {
   Vec3 specular_tint{1.0f};
   float transmission = 0.0f;  // in [0, 1]; > 0: `glass` takes (1 - metallic) transmission
   FresnelDielectric glass;
+  float coat = 0.0f;  // coat_weight, in [0, 1]; 0: no coat
+  float coat_roughness = 0.03f;
+  float coat_eta = 1.5f;  // >= 1
+  float coat_f0 = 0.04f;  // F0(coat_eta)
+  Vec3 coat_tint{1.0f};
   // Derived once from ior, specular_ior_level and specular_tint:
   float eta = 1.5f;      // the IOR whose curve shapes the Fresnel term; 1: no layer
   Vec3 f0{0.04f};        // the layer's reflectance at normal incidence, tint included, <= 1

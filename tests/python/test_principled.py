@@ -133,3 +133,44 @@ def test_principled_transmission_one_renders_the_glass_bsdf(version):
                               shadowing="correlated" if new else "separable")
     assert glass.mean() > 0.0
     np.testing.assert_array_equal(principled, glass)
+
+
+# ---- 4.0+'s coat ------------------------------------------------------------------------------
+
+def test_coat_over_a_bare_base_is_the_specular_layer_over_it():
+    # At normal incidence under the point straight above, a coat of weight 1 over a base without a
+    # specular layer (Specular IOR Level 0) is the same dielectric layer as the specular one with
+    # the coat's IOR and roughness (single-scatter GGX): the lobe F0 D G2 / 4 plus the base scaled
+    # by what the layer leaves. The coat is drawn on half the samples with twice the weight; 16
+    # Sobol samples split exactly in half, so the pixels agree to rounding.
+    for rough in (0.2, 0.5):
+        base = dict(color=(0.6, 0.3, 0.1), multiscatter=False)
+        layer = floor(ior=1.5, roughness=rough, **base)
+        coat = floor(ior=1.5, specular_ior_level=0.0, roughness=0.9, coat_weight=1.0, coat_roughness=rough,
+                     coat_ior=1.5, **base)
+        np.testing.assert_allclose(coat, layer, rtol=1e-5)
+
+
+def test_coat_tint_tints_what_lies_below_it_only():
+    # Head-on the path through a coat of unit thickness is 1: the base under it is tinted by the
+    # tint itself (Beer's law), the coat's own reflection is not. A black base isolates the coat.
+    common = dict(ior=1.5, specular_ior_level=0.0, roughness=0.5, coat_weight=1.0, coat_roughness=0.3)
+    lobe = floor(color=(0.0, 0.0, 0.0), **common)
+    white = floor(color=(0.7, 0.7, 0.7), **common)
+    tint = np.array([0.9, 0.5, 0.2])
+    tinted = floor(color=(0.7, 0.7, 0.7), coat_tint=tuple(tint), **common)
+    assert lobe.min() > 0.0 and (white - lobe).min() > 0.0
+    np.testing.assert_allclose(tinted, lobe + tint * (white - lobe), rtol=1e-5)
+    # Half a coat: half its lobe, and the tint mixed halfway towards white.
+    half = floor(color=(0.7, 0.7, 0.7), coat_tint=tuple(tint), **dict(common, coat_weight=0.5))
+    assert np.all(np.isfinite(half)) and np.all(half < white + 1e-6)
+
+
+def test_coated_metal_and_bad_coats():
+    coated = floor(color=(0.9, 0.6, 0.3), metallic=1.0, roughness=0.3, coat_weight=1.0)
+    bare = floor(color=(0.9, 0.6, 0.3), metallic=1.0, roughness=0.3)
+    assert np.all(np.isfinite(coated)) and coated.sum() != bare.sum()
+    with pytest.raises(ValueError, match="coat_weight"):
+        floor(coat_weight=float("nan"))
+    with pytest.raises(ValueError, match="layered"):
+        floor(coat_weight=0.5, layered=False, burley=True, shadowing="separable")
