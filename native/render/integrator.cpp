@@ -5,6 +5,7 @@
 #include "render/dielectric_lighting.h"
 #include "render/glossy_color.h"
 #include "render/glossy_lighting.h"
+#include "render/transparent_walk.h"
 #include "sampling/frame.h"
 #include "sampling/sobol_owen.h"
 #include "sampling/warp.h"
@@ -112,15 +113,19 @@ template <bool kBurley>
       env, image, sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 2), settings.seed));
   if (es.pdf > 0.0f) {
     const float cos_s = glm::dot(at.ns, es.wi);
-    if (cos_s > 0.0f && glm::dot(at.ng, es.wi) > 0.0f && !scene.shadowed(Ray{at.origin, 0.0f, es.wi, kInfinity})) {
-      sum += diffuse_f<kBurley>(at, retro, es.wi) * es.radiance * mis_cos_over_pdf(cos_s, es.pdf, cos_s * kInvPi);
+    Vec3 tr(1.0f);
+    if (cos_s > 0.0f && glm::dot(at.ng, es.wi) > 0.0f &&
+        shadow_passes(scene, Ray{at.origin, 0.0f, es.wi, kInfinity}, settings.transparent_max_bounces, tr)) {
+      sum += diffuse_f<kBurley>(at, retro, es.wi) * es.radiance * tr * mis_cos_over_pdf(cos_s, es.pdf, cos_s * kInvPi);
     }
   }
   // A BSDF-sampled direction is a path ray, not a shadow ray: an object with visible_shadow off
   // still stops it, as Cycles' does (docs/lights.md).
   const CosineDirection c = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings);
-  if (glm::dot(at.ng, c.wi) > 0.0f && c.cos > 0.0f && !scene.occluded(Ray{at.origin, 0.0f, c.wi, kInfinity}))
-    sum += diffuse_f<kBurley>(at, retro, c.wi) * environment_radiance(env, image, c.wi) *
+  Vec3 tr(1.0f);
+  if (glm::dot(at.ng, c.wi) > 0.0f && c.cos > 0.0f &&
+      path_passes(scene, Ray{at.origin, 0.0f, c.wi, kInfinity}, settings.transparent_max_bounces, tr))
+    sum += diffuse_f<kBurley>(at, retro, c.wi) * environment_radiance(env, image, c.wi) * tr *
            mis_cos_over_pdf(c.cos, c.cos * kInvPi, environment_pdf(env, c.wi));
   return sum;
 }
@@ -160,9 +165,12 @@ template <bool kBurley>
         emitters, p, sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 3), settings.seed));
     if (ls.valid()) {
       const float cos_s = glm::dot(at.ns, ls.wi);
+      Vec3 tr(1.0f);
       if (cos_s > 0.0f && glm::dot(at.ng, ls.wi) > 0.0f &&
-          !scene.shadowed(Ray{at.origin, 0.0f, ls.point - at.origin, 1.0f})) {
-        sum += diffuse_f<kBurley>(at, retro, ls.wi) * ls.radiance * mis_cos_over_pdf(cos_s, ls.pdf, cos_s * kInvPi);
+          shadow_passes(scene, Ray{at.origin, 0.0f, ls.point - at.origin, 1.0f}, settings.transparent_max_bounces,
+                        tr)) {
+        sum +=
+            diffuse_f<kBurley>(at, retro, ls.wi) * ls.radiance * tr * mis_cos_over_pdf(cos_s, ls.pdf, cos_s * kInvPi);
       }
     }
   }
@@ -197,14 +205,15 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     if (!ls.valid()) return;
     const float cos_s = glm::dot(ns, ls.wi);
     if (cos_s <= 0.0f || glm::dot(ng, ls.wi) <= 0.0f) return;  // below the shading or the true surface
+    Vec3 tr(1.0f);                                             // what cut-outs let through
     if (v.shadow) {
       // The shadow ray ends where the light sample is: t = 1 with an unnormalised direction; a
       // light at infinity (the sun) leaves the scene along wi.
       const Ray shadow =
           std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
-      if (scene.shadowed(shadow)) return;
+      if (!shadow_passes(scene, shadow, settings.transparent_max_bounces, tr)) return;
     }
-    sum += diffuse_f<kBurley>(at, retro, ls.wi) * ls.radiance * (cos_s / (ls.pdf * select_probability));
+    sum += diffuse_f<kBurley>(at, retro, ls.wi) * ls.radiance * tr * (cos_s / (ls.pdf * select_probability));
   };
   // The world, emissive meshes: each in a function of its own, out of line, so a scene of lamps
   // and a constant world runs the same small loop as before they existed.
@@ -214,8 +223,10 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     // A constant background: a cosine-distributed direction makes the estimate f L cos / pdf =
     // albedo L when nothing blocks it, exactly. A BSDF-sampled ray: every object stops it.
     const Vec3 wi = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings).wi;
-    if (glm::dot(ng, wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, wi, kInfinity}))
-      sum += diffuse_f<kBurley>(at, retro, wi) * world.background * kPi;  // f = albedo / pi
+    Vec3 tr(1.0f);
+    if (glm::dot(ng, wi) > 0.0f &&
+        path_passes(scene, Ray{origin, 0.0f, wi, kInfinity}, settings.transparent_max_bounces, tr))
+      sum += diffuse_f<kBurley>(at, retro, wi) * world.background * tr * kPi;  // f = albedo / pi
   }
   if (scene.any_emission()) sum += emission_lighting<kBurley>(scene, at, retro, s.p, pixel, sample, settings);
   const std::vector<Light>& lights = world.lights;
@@ -260,9 +271,10 @@ Vec3 visible_lights(const World& world, const Vec3& org, const Vec3& unit_dir, f
 }
 
 // The radiance arriving along `ray`, whose first vertex is path vertex `depth` (0: the camera
-// ray). Recursive only where a Fresnel surface is split, so at most split_depth levels deep.
+// ray), after `first_crossed` transparent surfaces. Recursive only where a Fresnel surface is
+// split, so at most split_depth levels deep.
 Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, uint32_t sample,
-                const IntegratorSettings& settings, FirstHit* first = nullptr) {
+                const IntegratorSettings& path_settings, FirstHit* first = nullptr, int first_crossed = 0) {
   static const Material kDefault = Lambert{};
   const World& world = scene.world();
   const std::vector<Material>& materials = scene.materials();
@@ -272,18 +284,28 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
   // for the emission it finds and shades nothing there).
   float bsdf_pdf = 0.0f;
   bool light_only = false;
+  // Transparent surfaces passed are path vertices but not bounces (Cycles counts them apart):
+  // `bounce` decides visibility, splitting and depth. After a crossing the path reads `budget`,
+  // with what is left of transparent_max_bounces (shadow rays' limit too); with none left, the
+  // next surface only shows its emission (Cycles' "terminate on next surface").
+  int crossed = first_crossed;
+  IntegratorSettings budget;
+  const IntegratorSettings* current = &path_settings;
+  bool end_at_next_surface = false;
   for (int depth = first_depth;; ++depth) {
+    const IntegratorSettings& settings = *current;
+    const int bounce = depth - crossed;
     const Hit hit = scene.intersect(ray);
     Vec3 lamps(0.0f);  // the lamps this ray sees: the Emission pass's at the camera ray
     if (!world.lights.empty()) {
       const float length = glm::length(ray.dir);
       lamps = visible_lights(world, ray.org, ray.dir / length, ray.tnear * length, std::min(hit.t, ray.tfar) * length,
-                             !hit.found(), depth == 0, settings.area_sampling, bsdf_pdf);
+                             !hit.found(), bounce == 0, settings.area_sampling, bsdf_pdf);
       radiance += throughput * lamps;
     }
     if (!hit.found()) {
       if (first) first->emission = lamps;
-      if (depth == 0 && !world.background_visible_camera) break;
+      if (bounce == 0 && !world.background_visible_camera) break;
       const Environment& env = world.environment;
       const Vec3 seen = env.active()
                             ? environment_radiance(env, scene.textures()[size_t(env.texture)], glm::normalize(ray.dir))
@@ -311,6 +333,23 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
       radiance += throughput * scene.emission()[size_t(s.material)].radiance;
       if (first) first->emission += scene.emission()[size_t(s.material)].radiance;
     }
+    if (end_at_next_surface) break;
+    if (scene.any_transparency() && s.material >= 0 && size_t(s.material) < materials.size() &&
+        scene.transparency()[size_t(s.material)].transparent()) {
+      const float u = sobol_owen_1d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 7), settings.seed);
+      if (passes_through(scene, scene.transparency()[size_t(s.material)], s.uv, u, throughput)) {
+        ray = continue_through(ray, s.p, s.ng);
+        ++crossed;
+        if (current != &budget) {
+          budget = path_settings;
+          current = &budget;
+        }
+        end_at_next_surface = --budget.transparent_max_bounces <= 0;
+        if (first) *first = FirstHit{};  // passes see the first surface the path shades
+        continue;
+      }
+      if (throughput == Vec3(0.0f)) break;
+    }
     if (light_only) break;
     // One generic dispatch per hit, no per-type code: the lambda is instantiated per material
     // type, so for an inline scatter() (Lambert's) the compiler sees the answer's kind as a
@@ -319,7 +358,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     // lambda a function of its own, and the Lambert path paid for the call (cachegrind,
     // docs/render.md "A scene pays for what it uses").
     const MaterialContext ctx{&scene.textures(),
-                              depth < settings.split_depth,
+                              bounce < settings.split_depth,
                               pixel,
                               sample,
                               vertex_dimension(depth, 0),
@@ -359,7 +398,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             if (!(g.pdf > 0.0f)) return false;
             throughput *= g.weight;
             bsdf_pdf = g.pdf;
-            light_only = depth >= settings.max_specular_depth;
+            light_only = bounce >= settings.max_specular_depth;
             ray = Ray{origin, 0.0f, g.wi, kInfinity};
             return true;
           }
@@ -373,17 +412,18 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             if (!(g.pdf > 0.0f)) return false;
             throughput *= g.weight;
             bsdf_pdf = g.pdf;
-            light_only = depth >= settings.max_specular_depth;
+            light_only = bounce >= settings.max_specular_depth;
             ray = Ray{g.origin, 0.0f, g.wi, kInfinity};
             return true;
           }
           bsdf_pdf = 0.0f;  // a delta branch: no lamp was sampled here
-          if (depth >= settings.max_specular_depth) return false;
+          if (bounce >= settings.max_specular_depth) return false;
           if (sc.kind == Scatter::Kind::Split) {
             for (int b = 0; b < sc.count; ++b) {
               const SpecularSample& branch = sc.branches[b];
               const Ray next{offset_ray_origin(s.p, branch.offset_normal), 0.0f, branch.wi, kInfinity};
-              radiance += throughput * branch.probability * trace_from(scene, next, depth + 1, pixel, sample, settings);
+              radiance += throughput * branch.probability *
+                          trace_from(scene, next, depth + 1, pixel, sample, settings, nullptr, crossed);
             }
             return false;
           }
