@@ -51,13 +51,17 @@ def _factor(name, socket, label, notes):
     return min(max(v, 0.0), 1.0), None, None, "alpha"
 
 
-def _with_opacity(spec, image, factor, invert, color=(1.0, 1.0, 1.0)):
+def _with_opacity(name, spec, image, factor, invert, notes, color=(1.0, 1.0, 1.0)):
     """(spec, image) of `spec` cut out by `factor` (from _factor): the opacity is the factor, or
-    1 - it when `invert`."""
+    1 - it when `invert`. The shader's emission is weighted by the opacity too, as Cycles weights
+    every closure of the shader; by a texture's, per texel, it is not (noted)."""
     value, key, opacity_image, channel = factor
     opacity = (1.0 - value if invert else value) if key is None else 1.0
+    emission = tuple(opacity * c for c in spec.emission)
+    if key is not None and any(c > 0.0 for c in spec.emission):
+        notes.append(f"material '{name}': emission of a cut-out by a texture (not weighted by its opacity)")
     spec = replace(spec, opacity=opacity, opacity_texture=key, opacity_channel=channel,
-                   opacity_invert=invert and key is not None, transparent_color=color)
+                   opacity_invert=invert and key is not None, transparent_color=color, emission=emission)
     return spec, (OpacityImages(image, opacity_image) if key is not None else image)
 
 
@@ -66,7 +70,7 @@ def principled_alpha(name, node, spec, image, notes):
     alpha = input_socket(node, "Alpha")
     if alpha is None or (not alpha.is_linked and alpha.default_value >= 1.0):
         return spec, image
-    return _with_opacity(spec, image, _factor(name, alpha, "Alpha", notes), False)
+    return _with_opacity(name, spec, image, _factor(name, alpha, "Alpha", notes), False, notes)
 
 
 def transparent_color(name, node, notes):
@@ -105,4 +109,5 @@ def transparent_mix(name, node, notes, convert):
             image = image.color
     color = transparent_color(name, sources[slot], notes)
     # Mix: (1 - Fac) x input 1 + Fac x input 2; the opaque part's weight is the opacity.
-    return _with_opacity(spec, image, _factor(name, node.inputs[0], "Mix factor", notes), slot == 1, color)
+    return _with_opacity(name, spec, image, _factor(name, node.inputs[0], "Mix factor", notes), slot == 1, notes,
+                         color)

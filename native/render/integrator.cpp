@@ -150,10 +150,9 @@ EmissiveTriangle emissive_triangle_at(const Scene& scene, const Hit& hit, const 
 
 // Emissive meshes, by two strategies combined with the power heuristic, as Cycles combines its
 // light sampling with the BSDF-sampled ray of the last bounce: a shadow ray to one emissive
-// triangle chosen by power (sample_emitters), and one cosine ray that collects the emission it
-// hits. The cosine ray wins beside a large emitter (a floor under a glowing ball, which the
-// power-chosen triangle rarely finds well) and is the only strategy for emitters, or sides of
-// them, that shadow rays do not sample (emission sampling None, Front, Back).
+// triangle chosen by power, and one cosine ray that collects the emission it hits. The cosine ray wins beside a large
+// emitter (a floor under a glowing ball, which the power-chosen triangle rarely finds well) and is the only strategy
+// for emitters, or sides of them, that shadow rays do not sample (emission sampling None, Front, Back).
 template <bool kBurley>
 [[gnu::noinline]] Vec3 emission_lighting(const Scene& scene, const DiffusePoint& at, const BurleyDiffuse* retro,
                                          const Vec3& p, uint32_t pixel, uint32_t sample,
@@ -177,18 +176,22 @@ template <bool kBurley>
   const CosineDirection c = cosine_direction(at, pixel, sample, kDimsPerVertex - 4, settings);
   const Vec3 wi = c.wi;
   if (glm::dot(at.ng, wi) <= 0.0f || c.cos <= 0.0f) return sum;
-  const Hit hit = scene.intersect(Ray{at.origin, 0.0f, wi, kInfinity});
+  Vec3 tr(1.0f);  // a cosine ray is a path ray: it passes cut-outs (render/transparent_walk.h)
+  const Hit hit =
+      nearest_past_cut_outs(scene, Ray{at.origin, 0.0f, wi, kInfinity}, settings.transparent_max_bounces, tr);
   const int32_t m = hit.found() ? material_of(scene, hit) : -1;
   if (m < 0 || size_t(m) >= scene.emission().size() || !scene.emission()[size_t(m)].emits()) return sum;
   const MaterialEmission& e = scene.emission()[size_t(m)];
   const EmissiveTriangle t = emissive_triangle_at(scene, hit, e);
   const float pl = emitter_pdf(emitters, p, t, wi, glm::dot(t.p0 + hit.u * t.e1 + hit.v * t.e2 - p, wi));
-  return sum + diffuse_f<kBurley>(at, retro, wi) * e.radiance * mis_cos_over_pdf(c.cos, c.cos * kInvPi, pl);
+  return sum + diffuse_f<kBurley>(at, retro, wi) * e.radiance * tr * mis_cos_over_pdf(c.cos, c.cos * kInvPi, pl);
 }
 
 // Light arriving at a diffuse point: one sample per light, or one light chosen by contribution.
 // kBurley: the BRDF is f times Burley's factor of *retro (else f; retro unread).
-template <bool kBurley>
+// kCutOuts: the scene has transparent materials (shadow rays walk through them); false compiles
+// the any-hit queries alone, so a scene without them runs the code it ran before they existed.
+template <bool kBurley, bool kCutOuts>
 Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f,
                      const BurleyDiffuse* retro, int depth, uint32_t pixel, uint32_t sample,
                      const IntegratorSettings& settings) {
@@ -211,7 +214,8 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
       // light at infinity (the sun) leaves the scene along wi.
       const Ray shadow =
           std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
-      if (!shadow_passes(scene, shadow, settings.transparent_max_bounces, tr)) return;
+      if (kCutOuts ? !shadow_passes(scene, shadow, settings.transparent_max_bounces, tr) : scene.shadowed(shadow))
+        return;
     }
     sum += diffuse_f<kBurley>(at, retro, ls.wi) * ls.radiance * tr * (cos_s / (ls.pdf * select_probability));
   };
@@ -225,7 +229,8 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     const Vec3 wi = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings).wi;
     Vec3 tr(1.0f);
     if (glm::dot(ng, wi) > 0.0f &&
-        path_passes(scene, Ray{origin, 0.0f, wi, kInfinity}, settings.transparent_max_bounces, tr))
+        (kCutOuts ? path_passes(scene, Ray{origin, 0.0f, wi, kInfinity}, settings.transparent_max_bounces, tr)
+                  : !scene.occluded(Ray{origin, 0.0f, wi, kInfinity})))
       sum += diffuse_f<kBurley>(at, retro, wi) * world.background * tr * kPi;  // f = albedo / pi
   }
   if (scene.any_emission()) sum += emission_lighting<kBurley>(scene, at, retro, s.p, pixel, sample, settings);
@@ -245,7 +250,9 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
 [[gnu::noinline]] Vec3 burley_direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns,
                                               const Vec3& f, const BurleyDiffuse& retro, int depth, uint32_t pixel,
                                               uint32_t sample, const IntegratorSettings& settings) {
-  return direct_lighting<true>(scene, s, ng, ns, f, &retro, depth, pixel, sample, settings);
+  return scene.any_transparency()
+             ? direct_lighting<true, true>(scene, s, ng, ns, f, &retro, depth, pixel, sample, settings)
+             : direct_lighting<true, false>(scene, s, ng, ns, f, &retro, depth, pixel, sample, settings);
 }
 
 // The radiance of the lights a camera (depth 0) or specular ray passes before distance `limit`
@@ -273,6 +280,7 @@ Vec3 visible_lights(const World& world, const Vec3& org, const Vec3& unit_dir, f
 // The radiance arriving along `ray`, whose first vertex is path vertex `depth` (0: the camera
 // ray), after `first_crossed` transparent surfaces. Recursive only where a Fresnel surface is
 // split, so at most split_depth levels deep.
+template <bool kCutOuts>
 Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, uint32_t sample,
                 const IntegratorSettings& path_settings, FirstHit* first = nullptr, int first_crossed = 0) {
   static const Material kDefault = Lambert{};
@@ -284,17 +292,10 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
   // for the emission it finds and shades nothing there).
   float bsdf_pdf = 0.0f;
   bool light_only = false;
-  // Transparent surfaces passed are path vertices but not bounces (Cycles counts them apart):
-  // `bounce` decides visibility, splitting and depth. After a crossing the path reads `budget`,
-  // with what is left of transparent_max_bounces (shadow rays' limit too); with none left, the
-  // next surface only shows its emission (Cycles' "terminate on next surface").
-  int crossed = first_crossed;
-  IntegratorSettings budget;
-  const IntegratorSettings* current = &path_settings;
-  bool end_at_next_surface = false;
+  CutOutPath cut(path_settings, first_crossed);  // kCutOuts only (render/transparent_walk.h)
   for (int depth = first_depth;; ++depth) {
-    const IntegratorSettings& settings = *current;
-    const int bounce = depth - crossed;
+    const IntegratorSettings& settings = kCutOuts ? cut.settings() : path_settings;
+    const int bounce = kCutOuts ? depth - cut.crossed() : depth;  // crossings are not bounces
     const Hit hit = scene.intersect(ray);
     Vec3 lamps(0.0f);  // the lamps this ray sees: the Emission pass's at the camera ray
     if (!world.lights.empty()) {
@@ -333,18 +334,10 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
       radiance += throughput * scene.emission()[size_t(s.material)].radiance;
       if (first) first->emission += scene.emission()[size_t(s.material)].radiance;
     }
-    if (end_at_next_surface) break;
-    if (scene.any_transparency() && s.material >= 0 && size_t(s.material) < materials.size() &&
-        scene.transparency()[size_t(s.material)].transparent()) {
+    if constexpr (kCutOuts) {
+      if (cut.ends_here()) break;
       const float u = sobol_owen_1d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 7), settings.seed);
-      if (passes_through(scene, scene.transparency()[size_t(s.material)], s.uv, u, throughput)) {
-        ray = continue_through(ray, s.p, s.ng);
-        ++crossed;
-        if (current != &budget) {
-          budget = path_settings;
-          current = &budget;
-        }
-        end_at_next_surface = --budget.transparent_max_bounces <= 0;
+      if (cut.pass(scene, s.material, s.p, s.ng, s.uv, u, throughput, ray)) {
         if (first) *first = FirstHit{};  // passes see the first surface the path shades
         continue;
       }
@@ -376,8 +369,8 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
               radiance +=
                   throughput * burley_direct_lighting(scene, s, ng, ns, f, sc.retro, depth, pixel, sample, settings);
             else
-              radiance +=
-                  throughput * direct_lighting<false>(scene, s, ng, ns, f, nullptr, depth, pixel, sample, settings);
+              radiance += throughput * direct_lighting<false, kCutOuts>(scene, s, ng, ns, f, nullptr, depth, pixel,
+                                                                        sample, settings);
             return false;
           }
           if (sc.kind == Scatter::Kind::Glossy) {
@@ -386,10 +379,10 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
               first->glossy = glossy_pass_color(material, sc.glossy);
             }
             if (sc.f != Vec3(0.0f))
-              radiance +=
-                  throughput *
-                  (sc.burley ? burley_direct_lighting(scene, s, ng, ns, sc.f, sc.retro, depth, pixel, sample, settings)
-                             : direct_lighting<false>(scene, s, ng, ns, sc.f, nullptr, depth, pixel, sample, settings));
+              radiance += throughput * (sc.burley ? burley_direct_lighting(scene, s, ng, ns, sc.f, sc.retro, depth,
+                                                                           pixel, sample, settings)
+                                                  : direct_lighting<false, kCutOuts>(scene, s, ng, ns, sc.f, nullptr,
+                                                                                     depth, pixel, sample, settings));
             const Vec3 origin = offset_ray_origin(s.p, ng);
             const GlossyStep g =
                 glossy_vertex(scene, s.p, origin, ng, sc.glossy, pixel, sample, vertex_dimension(depth, 1),
@@ -423,7 +416,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
               const SpecularSample& branch = sc.branches[b];
               const Ray next{offset_ray_origin(s.p, branch.offset_normal), 0.0f, branch.wi, kInfinity};
               radiance += throughput * branch.probability *
-                          trace_from(scene, next, depth + 1, pixel, sample, settings, nullptr, crossed);
+                          trace_from<kCutOuts>(scene, next, depth + 1, pixel, sample, settings, nullptr, cut.crossed());
             }
             return false;
           }
@@ -441,7 +434,9 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
 
 Vec3 trace_path(const Scene& scene, const Ray& camera_ray, uint32_t pixel, uint32_t sample,
                 const IntegratorSettings& settings, FirstHit* first) {
-  const Vec3 radiance = trace_from(scene, camera_ray, 0, pixel, sample, settings, first);
+  const Vec3 radiance = scene.any_transparency()
+                            ? trace_from<true>(scene, camera_ray, 0, pixel, sample, settings, first)
+                            : trace_from<false>(scene, camera_ray, 0, pixel, sample, settings, first);
   // A numerical failure anywhere (it should not happen) must not poison the pixel.
   if (!is_finite(radiance)) return Vec3(0.0f);
   return glm::max(radiance, Vec3(0.0f));

@@ -51,6 +51,23 @@ Vec3 transmittance_walk(const Scene& scene, Ray ray, int budget, bool casters_on
   }
 }
 
+Hit walk_to_opaque(const Scene& scene, Ray ray, int budget, Vec3& tr) {
+  const std::vector<MaterialTransparency>& table = scene.transparency();
+  for (int crossed = 0;; ++crossed) {
+    const Hit hit = ray.tnear > ray.tfar ? Hit{} : scene.intersect(ray);
+    if (!hit.found()) return hit;
+    const CrossedSurface s = crossed_surface(scene, hit);
+    if (s.material < 0 || size_t(s.material) >= table.size() || !table[size_t(s.material)].transparent()) return hit;
+    if (crossed >= budget) {
+      tr = Vec3(0.0f);
+      return hit;
+    }
+    const MaterialTransparency& t = table[size_t(s.material)];
+    tr *= (1.0f - t.opacity_at(scene.textures(), s.uv)) * t.color;
+    ray = continue_through(ray, s.p, s.ng);
+  }
+}
+
 bool passes_through(const Scene& scene, const MaterialTransparency& t, const Vec2& uv, float u, Vec3& throughput) {
   const float o = t.opacity_at(scene.textures(), uv);
   const Vec3 through = (1.0f - o) * t.color;

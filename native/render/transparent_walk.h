@@ -12,6 +12,7 @@
 
 #include "core/math.h"
 #include "core/ray.h"
+#include "render/render_settings.h"
 #include "scene/scene.h"
 
 #include <cstdint>
@@ -43,6 +44,47 @@ Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng);
 // branches together are unbiased; the other branch shades the material, weighted by the opacity.
 [[gnu::noinline]] bool passes_through(const Scene& scene, const MaterialTransparency& t, const Vec2& uv, float u,
                                       Vec3& throughput);
+
+// The nearest hit along `ray` on a surface that is not cut out, multiplying `tr` by what the cut-
+// outs before it let through (0 past `budget` of them: then the hit is the one that blocked);
+// scene.intersect(ray) when the scene has no transparent material.
+[[gnu::noinline]] Hit walk_to_opaque(const Scene& scene, Ray ray, int budget, Vec3& tr);
+inline Hit nearest_past_cut_outs(const Scene& scene, const Ray& ray, int budget, Vec3& tr) {
+  if (!scene.any_transparency()) return scene.intersect(ray);
+  return walk_to_opaque(scene, ray, budget, tr);
+}
+
+// What a path knows of the cut-outs it crossed (the integrator's, for scenes with transparent
+// materials): crossings are path vertices but not bounces (as in Cycles), and each lowers what is
+// left of transparent_max_bounces, which the path's shadow rays read from settings(); with none
+// left, the next surface only emits (Cycles' "terminate on next surface").
+class CutOutPath {
+ public:
+  CutOutPath(const IntegratorSettings& given, int crossed) : given_(&given), crossed_(crossed) {}
+  const IntegratorSettings& settings() const { return own_ ? budget_ : *given_; }
+  int crossed() const { return crossed_; }
+  bool ends_here() const { return end_at_next_surface_; }
+  // At a surface of material `material` (p, unit geometric normal ng, uv): whether the path passes
+  // through (passes_through on u), then `ray` goes on beyond it and the crossing is counted.
+  bool pass(const Scene& scene, int32_t material, const Vec3& p, const Vec3& ng, const Vec2& uv, float u,
+            Vec3& throughput, Ray& ray) {
+    if (material < 0 || size_t(material) >= scene.transparency().size()) return false;
+    const MaterialTransparency& t = scene.transparency()[size_t(material)];
+    if (!t.transparent() || !passes_through(scene, t, uv, u, throughput)) return false;
+    ray = continue_through(ray, p, ng);
+    ++crossed_;
+    if (!own_) budget_ = *given_, own_ = true;
+    end_at_next_surface_ = --budget_.transparent_max_bounces <= 0;
+    return true;
+  }
+
+ private:
+  const IntegratorSettings* given_;
+  IntegratorSettings budget_;
+  bool own_ = false;
+  int crossed_ = 0;
+  bool end_at_next_surface_ = false;
+};
 
 // The render's shadow query: whether light arrives along `ray`, multiplying `tr` by what the
 // surfaces passed let through (left alone without transparency in the scene).

@@ -145,3 +145,24 @@ TEST(Transparency, RefusesAnUnknownOpacityTextureAndANegativeColour) {
   EXPECT_THROW(scene.add_material(Lambert{}, {}, t), std::invalid_argument);
   EXPECT_THROW(scene.add_material(Lambert{}, {}, cut_out(0.5f, Vec3(-1.0f))), std::invalid_argument);
 }
+
+// An emissive square beside the camera's pixel lights the floor through a fully transparent cut-out
+// of colour C that covers both: the camera ray passes it once and the light, by both strategies
+// (the shadow ray to the emitter and the cosine ray that finds it), once more, so the pixel is
+// C^2 times the pixel without the cut-out.
+TEST(Transparency, AnEmitterBehindACutOutLightsThroughItByBothStrategies) {
+  double pixel[2];
+  for (int with_cut_out = 0; with_cut_out < 2; ++with_cut_out) {
+    Scene scene = floor_of(Lambert{Vec3(0.5f), -1});
+    MaterialEmission glow;
+    glow.radiance = Vec3(20.0f);
+    const uint32_t lamp = scene.add_material(Lambert{Vec3(0.0f), -1}, glow);
+    add_quad(scene, 0.6f, 1.0f, int32_t(lamp), 0.3f);
+    if (with_cut_out)
+      add_quad(scene, 0.0f, 0.5f, int32_t(scene.add_material(Lambert{}, {}, cut_out(0.0f, Vec3(0.5f)))), 2.0f);
+    scene.commit();
+    pixel[with_cut_out] = render(scene, pixel_above(1e-3f), few_samples(4096)).rgba[0];
+  }
+  EXPECT_GT(pixel[0], 0.0);
+  EXPECT_NEAR(pixel[1] / pixel[0], 0.25, 0.01);
+}
