@@ -73,7 +73,10 @@ class CutOutPath {
     if (!t.transparent() || !passes_through(scene, t, uv, u, throughput)) return false;
     ray = continue_through(ray, p, ng);
     ++crossed_;
-    if (!own_) budget_ = *given_, own_ = true;
+    if (!own_) {
+      budget_ = *given_;
+      own_ = true;
+    }
     end_at_next_surface_ = --budget_.transparent_max_bounces <= 0;
     return true;
   }

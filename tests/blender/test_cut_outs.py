@@ -87,6 +87,13 @@ def test_alpha_out_of_range_is_clamped_and_nan_is_opaque_and_renders():
     kit.plane("leaf", 1.0, mat, location=(0, 0, 0.5))
     kit.plane("hole", 1.0, kit.principled("hole", (0.5, 0.5, 0.5)), location=(0.8, 0, 0.6))
     bpy.data.materials["hole"].node_tree.nodes["Principled BSDF"].inputs["Alpha"].default_value = -3.0
+    missing = kit.cut_out("no_mask", (0.2, 0.6, 0.1), mask())
+    next(n for n in missing.node_tree.nodes if n.type == "TEX_IMAGE").image = None
+    converted = materials.material_spec(missing)
+    check(converted.spec.opacity_texture is not None and converted.spec.opacity_texture.placeholder
+          and any("without an image" in n for n in converted.notes),
+          f"a cut-out whose Image Texture has no image: the placeholder (opaque), noted: {converted.notes}")
+    kit.plane("no_mask", 1.0, missing, location=(-0.8, 0, 0.6))
     kit.sun_light("sun", 3.0, (0.2, 0.1, -1.0))
     kit.camera((0, -3, 3), (0, 0, 0))
     kit.output(scene, 32, 24)
@@ -95,7 +102,7 @@ def test_alpha_out_of_range_is_clamped_and_nan_is_opaque_and_renders():
     result, log = render_still(path)
     px = kit.read_image(path)
     check(result == {"FINISHED"} and np.isfinite(px).all() and px[..., :3].max() > 0.0,
-          f"NaN and negative Alpha render, finite ({result!r:.80})")
+          f"NaN and negative Alpha and a missing mask render, finite ({result!r:.80})")
 
 
 run_script([test_the_three_shapes_become_opacity_and_a_transparent_colour,
