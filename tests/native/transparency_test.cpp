@@ -166,3 +166,20 @@ TEST(Transparency, AnEmitterBehindACutOutLightsThroughItByBothStrategies) {
   EXPECT_GT(pixel[0], 0.0);
   EXPECT_NEAR(pixel[1] / pixel[0], 0.25, 0.01);
 }
+
+// A crossing keeps the ray's kind, as in Cycles: a camera ray through a Transparent BSDF of colour
+// C still sees the world as a camera ray (C x background), and sees black when the world is hidden
+// from the camera.
+TEST(Transparency, ACameraRayThroughACutOutIsStillACameraRay) {
+  for (bool visible : {true, false}) {
+    Scene scene;
+    const uint32_t m = scene.add_material(Lambert{}, {}, cut_out(0.0f, Vec3(0.5f, 0.25f, 1.0f)));
+    add_quad(scene, 0.0f, 1.0f, int32_t(m));
+    scene.set_background(Vec3(0.3f));
+    scene.set_background_visible_camera(visible);
+    scene.commit();
+    const RenderResult r = render(scene, pixel_above(1e-3f), few_samples(4));
+    EXPECT_FLOAT_EQ(r.rgba[0], visible ? 0.15f : 0.0f);
+    EXPECT_FLOAT_EQ(r.rgba[1], visible ? 0.075f : 0.0f);
+  }
+}
