@@ -27,6 +27,9 @@ def configure_cycles(scene, samples, specular_depth):
     c.diffuse_bounces = 0
     if specular_depth:
         c.max_bounces = specular_depth
-        c.glossy_bounces = c.transmission_bounces = c.transparent_max_bounces = specular_depth
+        c.glossy_bounces = c.transmission_bounces = specular_depth
     else:
         c.max_bounces = 0
+    # Transparent surfaces do not count as bounces in either engine: the same limit, TOYRT's.
+    toyrt = getattr(scene, "toyrt", None)
+    c.transparent_max_bounces = int(getattr(toyrt, "transparent_max_bounces", 8))

@@ -147,6 +147,30 @@ def input_of(node, *names):
     raise KeyError(f"{node.bl_idname} has none of the inputs {names}")
 
 
+def cut_out(name, color, image, kind="mix"):
+    """A leaf-like cut-out of linear RGB `color` masked by `image`'s alpha: kind "mix", a Mix Shader
+    whose Fac is the Image Texture's Alpha, a Transparent BSDF in its first input and a Diffuse
+    BSDF in its second (the classic leaf material); kind "principled", a Principled BSDF whose
+    Alpha is the image's Alpha."""
+    if kind == "principled":
+        mat = principled(name, color)
+        bsdf = mat.node_tree.nodes["Principled BSDF"]
+        alpha = bsdf.inputs["Alpha"]
+    else:
+        mat, mix = surface(name, "ShaderNodeMixShader")
+        nodes, links = mat.node_tree.nodes, mat.node_tree.links
+        links.new(nodes.new("ShaderNodeBsdfTransparent").outputs[0], mix.inputs[1])
+        bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+        bsdf.inputs["Color"].default_value = (*color, 1.0)
+        links.new(bsdf.outputs[0], mix.inputs[2])
+        alpha = mix.inputs[0]
+    tex = mat.node_tree.nodes.new("ShaderNodeTexImage")
+    tex.image = image
+    tex.interpolation, tex.extension = "Linear", "REPEAT"
+    mat.node_tree.links.new(tex.outputs["Alpha"], alpha)
+    return mat
+
+
 def principled(name, color):
     """Blender's default node material, a Principled BSDF, of base colour `color`: what most
     users' materials are (the add-on renders it as a diffuse of that colour)."""
@@ -178,12 +202,12 @@ def principled_dielectric(name, color, roughness, specular=0.5, tint=None, distr
     return mat
 
 
-def image(name, rgba, float_buffer=False, colorspace=None):
+def image(name, rgba, float_buffer=False, colorspace=None, alpha=False):
     """A packed image of an (h, w, 4) array, rows from the bottom (Blender's order): 8-bit, or float
     with float_buffer. `colorspace` names how Blender decodes the values (default: sRGB for 8-bit,
-    linear for float)."""
+    linear for float). alpha: the image keeps its alpha channel (a cut-out's mask)."""
     rgba = np.asarray(rgba, np.float32)
-    img = bpy.data.images.new(name, rgba.shape[1], rgba.shape[0], alpha=False, float_buffer=float_buffer)
+    img = bpy.data.images.new(name, rgba.shape[1], rgba.shape[0], alpha=alpha, float_buffer=float_buffer)
     img.pixels.foreach_set(rgba.ravel())
     img.pack()
     if colorspace is not None:

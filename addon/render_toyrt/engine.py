@@ -144,6 +144,7 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         progress.rendering()
         image = t_scene.render(
             camera, samples=samples, seed=settings.seed + frame, max_specular_depth=settings.max_specular_depth,
+            transparent_max_bounces=settings.transparent_max_bounces,
             area_light_sampling=settings.area_light_sampling, light_sampling=settings.light_sampling,
             threads=self._threads(scene), tile_size=tile, on_tile=on_tile, should_cancel=progress.poll,
             passes=computed, mist=passes.mist(scene.world),

@@ -29,6 +29,7 @@ class ImageKey:
     name ''."""
     name: str
     srgb: bool
+    alpha: bool = False     # keep the image's alpha channel (an opacity texture reads it)
 
     @property
     def placeholder(self) -> bool:
@@ -68,11 +69,26 @@ class MaterialSpec:
     emission_sampling: str = "AUTO"                           # Blender 4.x's names (3.x: AUTO or NONE)
     fresnel: str = "microfacet"                              # 'glass': 4.0+'s per microfacet, 3.x's 'macro'
     distribution: str = "ggx"                                # 'glass', 'refraction': or 'beckmann'
+    # The part rays pass through (material_alpha.py, the core's materials/transparency.h): the
+    # BSDF's weight `opacity` (or a texture's alpha or gray, 1 - it when inverted), the rest a
+    # transparent closure of colour transparent_color. Every kind takes them.
+    opacity: float = 1.0
+    opacity_texture: ImageKey | None = None
+    opacity_channel: str = "alpha"
+    opacity_invert: bool = False
+    transparent_color: tuple[float, float, float] = (1.0, 1.0, 1.0)
 
-    def arguments(self, texture_id: int = -1) -> dict:
-        """Keyword arguments of toyrt.Scene.add_material / set_material, with the texture's id."""
+    @property
+    def transparent(self) -> bool:
+        return self.opacity < 1.0 or self.opacity_texture is not None or self.opacity_invert
+
+    def arguments(self, texture_id: int = -1, opacity_texture_id: int = -1) -> dict:
+        """Keyword arguments of toyrt.Scene.add_material / set_material, with the textures' ids."""
         args = dict(kind=self.kind, color=self.color, texture=texture_id, ior=self.ior, emission=self.emission,
                     emission_sampling=self.emission_sampling)
+        if self.transparent:
+            args.update(opacity=self.opacity, opacity_texture=opacity_texture_id, opacity_channel=self.opacity_channel,
+                        opacity_invert=self.opacity_invert, transparent_color=self.transparent_color)
         if self.kind in ("glossy", "diffuse_glossy", "principled"):   # the core refuses keywords a kind does not read
             args.update(roughness=self.roughness, shadowing=self.shadowing)
         if self.kind in ("glossy", "principled"):
@@ -100,6 +116,7 @@ class ConvertedMaterial:
     spec: MaterialSpec
     notes: tuple[str, ...] = ()
     image: object = field(default=None, compare=False)
+    opacity_image: object = field(default=None, compare=False)   # the image opacity_texture reads
 
 
 def material_spec(mat) -> ConvertedMaterial:
@@ -108,7 +125,18 @@ def material_spec(mat) -> ConvertedMaterial:
     spec, image = _convert(mat, notes)
     if any(c > 0.0 for c in spec.emission):
         spec = replace(spec, emission_sampling=_emission_sampling(mat))
-    return ConvertedMaterial(spec, tuple(dict.fromkeys(notes)), image)
+    opacity_image = None
+    if isinstance(image, OpacityImages):
+        image, opacity_image = image.color, image.opacity
+    return ConvertedMaterial(spec, tuple(dict.fromkeys(notes)), image, opacity_image)
+
+
+@dataclass(frozen=True)
+class OpacityImages:
+    """What a converter returns in the image's place when the material reads an opacity image
+    too (material_alpha.py): both images."""
+    color: object
+    opacity: object
 
 
 def _emission_sampling(mat) -> str:
@@ -138,9 +166,9 @@ def image_key(image) -> ImageKey:
     return ImageKey(image.name_full, image.colorspace_settings.name == "sRGB" and not image.is_float)
 
 
-def image_pixels(image) -> np.ndarray | None:
-    """(height, width, 3) pixels, rows from the bottom (uint8 for 8-bit images, float32 for
-    float images); None if the image has no data."""
+def image_pixels(image, alpha: bool = False) -> np.ndarray | None:
+    """(height, width, 3) pixels, or (height, width, 4) with `alpha`, rows from the bottom (uint8
+    for 8-bit images, float32 for float images); None if the image has no data."""
     try:
         w, h = image.size[:]            # reading the size loads the image (packed or on disk)
         channels = image.channels
@@ -154,9 +182,10 @@ def image_pixels(image) -> np.ndarray | None:
     buf = np.empty(n, np.float32)
     image.pixels.foreach_get(buf)
     buf = buf.reshape(h, w, channels)
+    a = buf[..., 3:4] if channels == 4 else (buf[..., 1:2] if channels == 2 else np.ones_like(buf[..., :1]))
     if channels == 1 or channels == 2:
         buf = np.repeat(buf[..., :1], 3, axis=2)
-    buf = buf[..., :3]
+    buf = np.concatenate([buf[..., :3], a], axis=2) if alpha else buf[..., :3]
     if not image.is_float:
         # An 8-bit image: pass its bytes (exact: Blender's pixels are byte / 255), a quarter of
         # the memory, and the core knows it is an 8-bit image (Cycles filters 8-bit sRGB
@@ -165,12 +194,12 @@ def image_pixels(image) -> np.ndarray | None:
     return np.ascontiguousarray(buf)
 
 
-def image_data(image) -> tuple[np.ndarray | None, tuple[str, ...]]:
+def image_data(image, alpha: bool = False) -> tuple[np.ndarray | None, tuple[str, ...]]:
     """The image's pixels (image_pixels) ready for the core, and what loading it approximated
     (image_notes). Non-finite floats (HDR files can hold inf or NaN texels) become 0 (NaN, -inf)
     or float16's largest value (+inf), with a note: the core refuses non-finite texels, and one
     must not fail a render or poison every pixel that samples it."""
-    pixels = image_pixels(image)
+    pixels = image_pixels(image, alpha)
     notes = image_notes(image, pixels)
     if pixels is not None and pixels.dtype == np.float32:
         bad = int(np.count_nonzero(~np.isfinite(pixels)))
@@ -276,12 +305,18 @@ def _convert_node(name, node, notes):
             notes.append(f"material '{name}': Diffuse roughness (Lambert)")
         return _color_material(name, input_socket(node, "Color"), notes)
     if t == "BSDF_PRINCIPLED":
+        from .material_alpha import principled_alpha
         from .material_principled import principled_spec  # it reads this module's socket helpers
-        return principled_spec(name, node, notes)
+        return principled_alpha(name, node, *principled_spec(name, node, notes), notes)
+    if t == "BSDF_TRANSPARENT":
+        from .material_alpha import transparent_alone
+        return transparent_alone(name, node, notes)
     if t in ("BSDF_GLOSSY", "BSDF_ANISOTROPIC"):   # 4.0+: the Glossy node is ShaderNodeBsdfAnisotropic
         return _glossy(name, node, notes)
     if t in ("MIX_SHADER", "ADD_SHADER"):
-        mixed = mix_of_diffuse_and_glossy(name, node, notes, _convert_node)
+        from .material_alpha import transparent_mix
+        mixed = transparent_mix(name, node, notes, _convert_node) or mix_of_diffuse_and_glossy(
+            name, node, notes, _convert_node)
         if mixed is not None:
             return mixed
     if t == "EMISSION":

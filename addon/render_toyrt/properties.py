@@ -56,6 +56,10 @@ class TOYRTRenderSettings(bpy.types.PropertyGroup):
     max_specular_depth: bpy.props.IntProperty(
         name="Max Specular Depth", description="Refractions and reflections a path may take through glass",
         default=8, min=0, max=128, update=_redraw_viewports)
+    transparent_max_bounces: bpy.props.IntProperty(
+        name="Transparent Max Bounces", description="Transparent surfaces (alpha cut-outs, Transparent BSDF) a "
+        "path or a shadow ray may pass through, as Cycles' setting of that name: past them a path stops at the "
+        "next surface and a shadow is cast", default=8, min=0, max=1024, update=_redraw_viewports)
     use_denoising: bpy.props.BoolProperty(
         name="Denoise", description="Denoise the final render with Intel Open Image Denoise (the pyoidn package), "
         "its albedo and normal from the Diffuse Color and Normal passes; the noisy render is kept as the "

@@ -39,13 +39,15 @@ class MaterialSync:
 
     def _material_arguments(self, converted: materials.ConvertedMaterial) -> dict:
         self._note(converted.notes)
-        texture = converted.spec.texture
-        return converted.spec.arguments(self._texture_id(texture, converted.image) if texture is not None else -1)
+        spec = converted.spec
+        texture, opacity = spec.texture, spec.opacity_texture
+        return spec.arguments(self._texture_id(texture, converted.image) if texture is not None else -1,
+                              self._texture_id(opacity, converted.opacity_image) if opacity is not None else -1)
 
     def _texture_id(self, key: ImageKey, image) -> int:
         tid = self.textures.get(key)
         if tid is None:
-            pixels, notes = (None, ()) if key.placeholder else materials.image_data(image)
+            pixels, notes = (None, ()) if key.placeholder else materials.image_data(image, key.alpha)
             self.texture_notes[key] = notes
             tid = self._placeholder_id() if pixels is None else self.scene.add_texture(pixels, srgb=key.srgb)
             self.textures[key] = tid
@@ -84,14 +86,16 @@ class MaterialSync:
         for key, tid in list(self.textures.items()):
             if key.placeholder or key.name != image.name_full:
                 continue
-            pixels, notes = materials.image_data(image)
+            pixels, notes = materials.image_data(image, key.alpha)
             if pixels is None:
                 continue
             if tid == placeholder:
                 tid = self.textures[key] = self.scene.add_texture(pixels, srgb=key.srgb)
                 for mid, spec in self.materials.values():
-                    if spec.texture == key:
-                        self.scene.set_material(mid, **spec.arguments(tid))
+                    if key in (spec.texture, spec.opacity_texture):
+                        ids = [self.textures.get(k, -1) if k is not None else -1
+                               for k in (spec.texture, spec.opacity_texture)]
+                        self.scene.set_material(mid, **spec.arguments(*ids))
             else:
                 self.scene.set_texture(tid, pixels, srgb=key.srgb)
             self.texture_notes[key] = notes

@@ -139,6 +139,7 @@ class RENDER_PT_toyrt_light_paths_max_bounces(ToyrtRenderPanel, bpy.types.Panel)
 
     def draw_settings(self, layout, settings):
         layout.prop(settings, "max_specular_depth", text="Specular")
+        layout.prop(settings, "transparent_max_bounces", text="Transparent")
 
 
 class RENDER_PT_toyrt_performance(ToyrtRenderPanel, bpy.types.Panel):

@@ -113,6 +113,7 @@ class ViewportSession:
         s = scene.toyrt
         threads = 0 if scene.render.threads_mode == "AUTO" else scene.render.threads
         return dict(samples=int(s.viewport_samples), seed=int(s.seed), max_specular_depth=int(s.max_specular_depth),
+                    transparent_max_bounces=int(s.transparent_max_bounces),
                     area_light_sampling=s.area_light_sampling, light_sampling=s.light_sampling, threads=threads,
                     denoise=self._denoising(s))
 

@@ -47,6 +47,7 @@ py::dict core_defaults() {
   d["seed"] = render.integrator.seed;
   d["max_specular_depth"] = render.integrator.max_specular_depth;
   d["split_depth"] = render.integrator.split_depth;
+  d["transparent_max_bounces"] = render.integrator.transparent_max_bounces;
   d["area_light_sampling"] = area_sampling_name(render.integrator.area_sampling);
   d["light_sampling"] = light_sampling_name(render.integrator.light_sampling);
   d["all_lights_up_to"] = kAllLightsUpTo;
@@ -139,6 +140,8 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       "before anything is allocated.\n"
       "split_depth: glass (Fresnel) surfaces among the first split_depth path vertices trace both reflection\n"
       "and refraction, weighted by F and 1 - F; deeper ones choose one. 0: never split.\n"
+      "transparent_max_bounces: transparent surfaces a path or shadow ray passes (Cycles' setting of that name):\n"
+      "a path past that many shades nothing at its next surface; a shadow ray meeting more is blocked.\n"
       "passes: names of render passes to fill beside the image, read afterwards from last_passes, defined\n"
       "as Cycles' data passes: 'depth' (planar camera z, first sample, 1e10 on a miss), 'mist', 'position'\n"
       "(first sample), 'normal' (world, averaged), 'diffuse_color' (albedo, averaged), 'glossy_color' (the\n"
@@ -279,7 +282,8 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
            py::arg("use_adaptive_sampling") = AdaptiveSettings{}.use,
            py::arg("adaptive_threshold") = AdaptiveSettings{}.threshold,
            py::arg("adaptive_min_samples") = AdaptiveSettings{}.min_samples,
-           py::arg("time_limit") = RenderSettings{}.time_limit, py::arg("on_progress") = py::none(), render_doc.c_str())
+           py::arg("time_limit") = RenderSettings{}.time_limit, py::arg("on_progress") = py::none(),
+           py::arg("transparent_max_bounces") = IntegratorSettings{}.transparent_max_bounces, render_doc.c_str())
       .def_property_readonly(
           "last_render", &PyScene::last_render,
           "What the last render did: cancelled, cancel_latency_ms, tiles_done, tiles_total, render_ms,\n"

@@ -67,18 +67,37 @@ MaterialEmission emission_of(const Params& params) {
   return e;
 }
 
+// The transparency every material kind accepts (materials/transparency.h): opacity (1: opaque;
+// the constant, clamped to [0, 1] where read), opacity_texture (-1: none), opacity_channel
+// ('alpha' or 'gray'), opacity_invert (False) and transparent_color ((1, 1, 1)).
+MaterialTransparency transparency_of(const Params& params) {
+  MaterialTransparency t;
+  t.opacity = float(params.number("opacity", t.opacity));
+  t.texture = int32_t(params.integer("opacity_texture", t.texture));
+  const std::string channel = params.text("opacity_channel", "alpha");
+  if (channel == "gray")
+    t.channel = OpacityChannel::Gray;
+  else if (channel != "alpha")
+    throw std::invalid_argument("opacity_channel must be 'alpha' or 'gray', got '" + channel + "'");
+  t.invert = params.flag("opacity_invert", t.invert);
+  t.color = params.color("transparent_color", t.color);
+  return t;
+}
+
 }  // namespace
 
 uint32_t PyScene::add_material(const std::string& kind, const Params& params) {
   const MaterialEmission emission = emission_of(params);
+  const MaterialTransparency transparency = transparency_of(params);
   const Material material = make_material(kind, params);
-  return write([&] { return scene_.add_material(material, emission); });
+  return write([&] { return scene_.add_material(material, emission, transparency); });
 }
 
 void PyScene::set_material(int64_t id, const std::string& kind, const Params& params) {
   const MaterialEmission emission = emission_of(params);
+  const MaterialTransparency transparency = transparency_of(params);
   const Material material = make_material(kind, params);
-  write([&] { scene_.set_material(id, material, emission); });
+  write([&] { scene_.set_material(id, material, emission, transparency); });
 }
 
 uint32_t PyScene::add_texture(py::handle pixels, bool srgb) {
@@ -224,7 +243,8 @@ py::array_t<float> PyScene::render(const py::dict& camera_settings, int samples,
                                    int first_sample, int split_depth, py::handle passes, py::handle mist,
                                    py::handle object_index, py::handle material_index, py::handle cryptomatte,
                                    int cryptomatte_depth, bool use_adaptive_sampling, float adaptive_threshold,
-                                   int adaptive_min_samples, double time_limit, py::object on_progress) {
+                                   int adaptive_min_samples, double time_limit, py::object on_progress,
+                                   int transparent_max_bounces) {
   const AovRequest request = aov_request(passes, mist, object_index, material_index, cryptomatte, cryptomatte_depth);
   const Camera camera = Camera::make(to_camera(camera_settings));
   RenderSettings settings;
@@ -235,6 +255,7 @@ py::array_t<float> PyScene::render(const py::dict& camera_settings, int samples,
   settings.integrator.seed = seed;
   settings.integrator.max_specular_depth = max_specular_depth;
   settings.integrator.split_depth = split_depth;
+  settings.integrator.transparent_max_bounces = transparent_max_bounces;
   settings.integrator.area_sampling = parse_area_sampling(area_light_sampling);
   settings.integrator.light_sampling = parse_light_sampling(light_sampling);
   settings.adaptive.use = use_adaptive_sampling;

@@ -52,7 +52,7 @@ class PyScene {
                             int split_depth, py::handle passes, py::handle mist, py::handle object_index,
                             py::handle material_index, py::handle cryptomatte, int cryptomatte_depth,
                             bool use_adaptive_sampling, float adaptive_threshold, int adaptive_min_samples,
-                            double time_limit, py::object on_progress);
+                            double time_limit, py::object on_progress, int transparent_max_bounces);
   py::dict last_render() { return last_render_; }
   py::dict last_passes() { return last_passes_; }
 

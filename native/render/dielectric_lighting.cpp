@@ -2,6 +2,7 @@
 
 #include "geometry/offset_ray.h"
 #include "render/glossy_lighting.h"
+#include "render/transparent_walk.h"
 #include "sampling/sobol_owen.h"
 
 #include <cmath>
@@ -29,13 +30,14 @@ DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& 
     const BsdfEval e = dielectric_eval(lobe, ls.wi);
     if (e.f == Vec3(0.0f)) continue;
     const Vec3 origin = side > 0.0f ? above : below;
+    Vec3 tr(1.0f);  // what cut-outs on the way let through
     if (v.shadow) {
       const Ray shadow =
           std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
-      if (scene.shadowed(shadow)) continue;
+      if (!shadow_passes(scene, shadow, settings.transparent_max_bounces, tr)) continue;
     }
     const float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, e.pdf);
-    step.radiance += e.f * ls.radiance * (std::abs(cos_i) * w / ls.pdf);
+    step.radiance += e.f * ls.radiance * tr * (std::abs(cos_i) * w / ls.pdf);
   }
   const BsdfSample g = dielectric_sample(lobe, sobol_owen_2d(pixel, sample, lobe_dim, settings.seed),
                                          sobol_owen_1d(pixel, sample, side_dim, settings.seed));

@@ -1,5 +1,6 @@
 #include "render/glossy_lighting.h"
 
+#include "render/transparent_walk.h"
 #include "sampling/sobol_owen.h"
 
 #include <cmath>
@@ -23,14 +24,15 @@ Vec3 glossy_direct_lighting(const Scene& scene, const Vec3& p, const Vec3& origi
     const BsdfEval e = evaluate_lobe(lobe, ls.wi);
     const float cos_i = glm::dot(lobe.frame.n, ls.wi);
     if (cos_i <= 0.0f || e.f == Vec3(0.0f)) continue;
+    Vec3 tr(1.0f);  // what cut-outs on the way let through
     if (v.shadow) {
       const Ray shadow =
           std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
-      if (scene.shadowed(shadow)) continue;
+      if (!shadow_passes(scene, shadow, settings.transparent_max_bounces, tr)) continue;
     }
     // A delta lamp cannot be hit by the continuation ray: its sample is the only strategy.
     const float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, e.pdf);
-    sum += e.f * ls.radiance * (cos_i * w / ls.pdf);
+    sum += e.f * ls.radiance * tr * (cos_i * w / ls.pdf);
   }
   return sum;
 }

@@ -5,6 +5,7 @@
 #include "render/dielectric_lighting.h"
 #include "render/glossy_color.h"
 #include "render/glossy_lighting.h"
+#include "render/transparent_walk.h"
 #include "sampling/frame.h"
 #include "sampling/sobol_owen.h"
 #include "sampling/warp.h"
@@ -112,15 +113,19 @@ template <bool kBurley>
       env, image, sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 2), settings.seed));
   if (es.pdf > 0.0f) {
     const float cos_s = glm::dot(at.ns, es.wi);
-    if (cos_s > 0.0f && glm::dot(at.ng, es.wi) > 0.0f && !scene.shadowed(Ray{at.origin, 0.0f, es.wi, kInfinity})) {
-      sum += diffuse_f<kBurley>(at, retro, es.wi) * es.radiance * mis_cos_over_pdf(cos_s, es.pdf, cos_s * kInvPi);
+    Vec3 tr(1.0f);
+    if (cos_s > 0.0f && glm::dot(at.ng, es.wi) > 0.0f &&
+        shadow_passes(scene, Ray{at.origin, 0.0f, es.wi, kInfinity}, settings.transparent_max_bounces, tr)) {
+      sum += diffuse_f<kBurley>(at, retro, es.wi) * es.radiance * tr * mis_cos_over_pdf(cos_s, es.pdf, cos_s * kInvPi);
     }
   }
   // A BSDF-sampled direction is a path ray, not a shadow ray: an object with visible_shadow off
   // still stops it, as Cycles' does (docs/lights.md).
   const CosineDirection c = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings);
-  if (glm::dot(at.ng, c.wi) > 0.0f && c.cos > 0.0f && !scene.occluded(Ray{at.origin, 0.0f, c.wi, kInfinity}))
-    sum += diffuse_f<kBurley>(at, retro, c.wi) * environment_radiance(env, image, c.wi) *
+  Vec3 tr(1.0f);
+  if (glm::dot(at.ng, c.wi) > 0.0f && c.cos > 0.0f &&
+      path_passes(scene, Ray{at.origin, 0.0f, c.wi, kInfinity}, settings.transparent_max_bounces, tr))
+    sum += diffuse_f<kBurley>(at, retro, c.wi) * environment_radiance(env, image, c.wi) * tr *
            mis_cos_over_pdf(c.cos, c.cos * kInvPi, environment_pdf(env, c.wi));
   return sum;
 }
@@ -145,10 +150,9 @@ EmissiveTriangle emissive_triangle_at(const Scene& scene, const Hit& hit, const 
 
 // Emissive meshes, by two strategies combined with the power heuristic, as Cycles combines its
 // light sampling with the BSDF-sampled ray of the last bounce: a shadow ray to one emissive
-// triangle chosen by power (sample_emitters), and one cosine ray that collects the emission it
-// hits. The cosine ray wins beside a large emitter (a floor under a glowing ball, which the
-// power-chosen triangle rarely finds well) and is the only strategy for emitters, or sides of
-// them, that shadow rays do not sample (emission sampling None, Front, Back).
+// triangle chosen by power, and one cosine ray that collects the emission it hits. The cosine ray wins beside a large
+// emitter (a floor under a glowing ball, which the power-chosen triangle rarely finds well) and is the only strategy
+// for emitters, or sides of them, that shadow rays do not sample (emission sampling None, Front, Back).
 template <bool kBurley>
 [[gnu::noinline]] Vec3 emission_lighting(const Scene& scene, const DiffusePoint& at, const BurleyDiffuse* retro,
                                          const Vec3& p, uint32_t pixel, uint32_t sample,
@@ -160,27 +164,34 @@ template <bool kBurley>
         emitters, p, sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 3), settings.seed));
     if (ls.valid()) {
       const float cos_s = glm::dot(at.ns, ls.wi);
+      Vec3 tr(1.0f);
       if (cos_s > 0.0f && glm::dot(at.ng, ls.wi) > 0.0f &&
-          !scene.shadowed(Ray{at.origin, 0.0f, ls.point - at.origin, 1.0f})) {
-        sum += diffuse_f<kBurley>(at, retro, ls.wi) * ls.radiance * mis_cos_over_pdf(cos_s, ls.pdf, cos_s * kInvPi);
+          shadow_passes(scene, Ray{at.origin, 0.0f, ls.point - at.origin, 1.0f}, settings.transparent_max_bounces,
+                        tr)) {
+        sum +=
+            diffuse_f<kBurley>(at, retro, ls.wi) * ls.radiance * tr * mis_cos_over_pdf(cos_s, ls.pdf, cos_s * kInvPi);
       }
     }
   }
   const CosineDirection c = cosine_direction(at, pixel, sample, kDimsPerVertex - 4, settings);
   const Vec3 wi = c.wi;
   if (glm::dot(at.ng, wi) <= 0.0f || c.cos <= 0.0f) return sum;
-  const Hit hit = scene.intersect(Ray{at.origin, 0.0f, wi, kInfinity});
+  Vec3 tr(1.0f);  // a cosine ray is a path ray: it passes cut-outs (render/transparent_walk.h)
+  const Hit hit =
+      nearest_past_cut_outs(scene, Ray{at.origin, 0.0f, wi, kInfinity}, settings.transparent_max_bounces, tr);
   const int32_t m = hit.found() ? material_of(scene, hit) : -1;
   if (m < 0 || size_t(m) >= scene.emission().size() || !scene.emission()[size_t(m)].emits()) return sum;
   const MaterialEmission& e = scene.emission()[size_t(m)];
   const EmissiveTriangle t = emissive_triangle_at(scene, hit, e);
   const float pl = emitter_pdf(emitters, p, t, wi, glm::dot(t.p0 + hit.u * t.e1 + hit.v * t.e2 - p, wi));
-  return sum + diffuse_f<kBurley>(at, retro, wi) * e.radiance * mis_cos_over_pdf(c.cos, c.cos * kInvPi, pl);
+  return sum + diffuse_f<kBurley>(at, retro, wi) * e.radiance * tr * mis_cos_over_pdf(c.cos, c.cos * kInvPi, pl);
 }
 
 // Light arriving at a diffuse point: one sample per light, or one light chosen by contribution.
 // kBurley: the BRDF is f times Burley's factor of *retro (else f; retro unread).
-template <bool kBurley>
+// kCutOuts: the scene has transparent materials (shadow rays walk through them); false compiles
+// the any-hit queries alone, so a scene without them runs the code it ran before they existed.
+template <bool kBurley, bool kCutOuts>
 Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns, const Vec3& f,
                      const BurleyDiffuse* retro, int depth, uint32_t pixel, uint32_t sample,
                      const IntegratorSettings& settings) {
@@ -197,14 +208,16 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     if (!ls.valid()) return;
     const float cos_s = glm::dot(ns, ls.wi);
     if (cos_s <= 0.0f || glm::dot(ng, ls.wi) <= 0.0f) return;  // below the shading or the true surface
+    Vec3 tr(1.0f);                                             // what cut-outs let through
     if (v.shadow) {
       // The shadow ray ends where the light sample is: t = 1 with an unnormalised direction; a
       // light at infinity (the sun) leaves the scene along wi.
       const Ray shadow =
           std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
-      if (scene.shadowed(shadow)) return;
+      if (kCutOuts ? !shadow_passes(scene, shadow, settings.transparent_max_bounces, tr) : scene.shadowed(shadow))
+        return;
     }
-    sum += diffuse_f<kBurley>(at, retro, ls.wi) * ls.radiance * (cos_s / (ls.pdf * select_probability));
+    sum += diffuse_f<kBurley>(at, retro, ls.wi) * ls.radiance * tr * (cos_s / (ls.pdf * select_probability));
   };
   // The world, emissive meshes: each in a function of its own, out of line, so a scene of lamps
   // and a constant world runs the same small loop as before they existed.
@@ -214,8 +227,11 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     // A constant background: a cosine-distributed direction makes the estimate f L cos / pdf =
     // albedo L when nothing blocks it, exactly. A BSDF-sampled ray: every object stops it.
     const Vec3 wi = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings).wi;
-    if (glm::dot(ng, wi) > 0.0f && !scene.occluded(Ray{origin, 0.0f, wi, kInfinity}))
-      sum += diffuse_f<kBurley>(at, retro, wi) * world.background * kPi;  // f = albedo / pi
+    Vec3 tr(1.0f);
+    if (glm::dot(ng, wi) > 0.0f &&
+        (kCutOuts ? path_passes(scene, Ray{origin, 0.0f, wi, kInfinity}, settings.transparent_max_bounces, tr)
+                  : !scene.occluded(Ray{origin, 0.0f, wi, kInfinity})))
+      sum += diffuse_f<kBurley>(at, retro, wi) * world.background * tr * kPi;  // f = albedo / pi
   }
   if (scene.any_emission()) sum += emission_lighting<kBurley>(scene, at, retro, s.p, pixel, sample, settings);
   const std::vector<Light>& lights = world.lights;
@@ -234,7 +250,9 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
 [[gnu::noinline]] Vec3 burley_direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, const Vec3& ns,
                                               const Vec3& f, const BurleyDiffuse& retro, int depth, uint32_t pixel,
                                               uint32_t sample, const IntegratorSettings& settings) {
-  return direct_lighting<true>(scene, s, ng, ns, f, &retro, depth, pixel, sample, settings);
+  return scene.any_transparency()
+             ? direct_lighting<true, true>(scene, s, ng, ns, f, &retro, depth, pixel, sample, settings)
+             : direct_lighting<true, false>(scene, s, ng, ns, f, &retro, depth, pixel, sample, settings);
 }
 
 // The radiance of the lights a camera (depth 0) or specular ray passes before distance `limit`
@@ -260,9 +278,11 @@ Vec3 visible_lights(const World& world, const Vec3& org, const Vec3& unit_dir, f
 }
 
 // The radiance arriving along `ray`, whose first vertex is path vertex `depth` (0: the camera
-// ray). Recursive only where a Fresnel surface is split, so at most split_depth levels deep.
+// ray), after `first_crossed` transparent surfaces. Recursive only where a Fresnel surface is
+// split, so at most split_depth levels deep.
+template <bool kCutOuts>
 Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, uint32_t sample,
-                const IntegratorSettings& settings, FirstHit* first = nullptr) {
+                const IntegratorSettings& path_settings, FirstHit* first = nullptr, int first_crossed = 0) {
   static const Material kDefault = Lambert{};
   const World& world = scene.world();
   const std::vector<Material>& materials = scene.materials();
@@ -272,18 +292,21 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
   // for the emission it finds and shades nothing there).
   float bsdf_pdf = 0.0f;
   bool light_only = false;
+  CutOutPath cut(path_settings, first_crossed);  // kCutOuts only (render/transparent_walk.h)
   for (int depth = first_depth;; ++depth) {
+    const IntegratorSettings& settings = kCutOuts ? cut.settings() : path_settings;
+    const int bounce = kCutOuts ? depth - cut.crossed() : depth;  // crossings are not bounces
     const Hit hit = scene.intersect(ray);
     Vec3 lamps(0.0f);  // the lamps this ray sees: the Emission pass's at the camera ray
     if (!world.lights.empty()) {
       const float length = glm::length(ray.dir);
       lamps = visible_lights(world, ray.org, ray.dir / length, ray.tnear * length, std::min(hit.t, ray.tfar) * length,
-                             !hit.found(), depth == 0, settings.area_sampling, bsdf_pdf);
+                             !hit.found(), bounce == 0, settings.area_sampling, bsdf_pdf);
       radiance += throughput * lamps;
     }
     if (!hit.found()) {
       if (first) first->emission = lamps;
-      if (depth == 0 && !world.background_visible_camera) break;
+      if (bounce == 0 && !world.background_visible_camera) break;
       const Environment& env = world.environment;
       const Vec3 seen = env.active()
                             ? environment_radiance(env, scene.textures()[size_t(env.texture)], glm::normalize(ray.dir))
@@ -311,6 +334,15 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
       radiance += throughput * scene.emission()[size_t(s.material)].radiance;
       if (first) first->emission += scene.emission()[size_t(s.material)].radiance;
     }
+    if constexpr (kCutOuts) {
+      if (cut.ends_here()) break;
+      const float u = sobol_owen_1d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 7), settings.seed);
+      if (cut.pass(scene, s.material, s.p, s.ng, s.uv, u, throughput, ray)) {
+        if (first) *first = FirstHit{};  // passes see the first surface the path shades
+        continue;
+      }
+      if (throughput == Vec3(0.0f)) break;
+    }
     if (light_only) break;
     // One generic dispatch per hit, no per-type code: the lambda is instantiated per material
     // type, so for an inline scatter() (Lambert's) the compiler sees the answer's kind as a
@@ -319,7 +351,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     // lambda a function of its own, and the Lambert path paid for the call (cachegrind,
     // docs/render.md "A scene pays for what it uses").
     const MaterialContext ctx{&scene.textures(),
-                              depth < settings.split_depth,
+                              bounce < settings.split_depth,
                               pixel,
                               sample,
                               vertex_dimension(depth, 0),
@@ -337,8 +369,8 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
               radiance +=
                   throughput * burley_direct_lighting(scene, s, ng, ns, f, sc.retro, depth, pixel, sample, settings);
             else
-              radiance +=
-                  throughput * direct_lighting<false>(scene, s, ng, ns, f, nullptr, depth, pixel, sample, settings);
+              radiance += throughput * direct_lighting<false, kCutOuts>(scene, s, ng, ns, f, nullptr, depth, pixel,
+                                                                        sample, settings);
             return false;
           }
           if (sc.kind == Scatter::Kind::Glossy) {
@@ -347,10 +379,10 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
               first->glossy = glossy_pass_color(material, sc.glossy);
             }
             if (sc.f != Vec3(0.0f))
-              radiance +=
-                  throughput *
-                  (sc.burley ? burley_direct_lighting(scene, s, ng, ns, sc.f, sc.retro, depth, pixel, sample, settings)
-                             : direct_lighting<false>(scene, s, ng, ns, sc.f, nullptr, depth, pixel, sample, settings));
+              radiance += throughput * (sc.burley ? burley_direct_lighting(scene, s, ng, ns, sc.f, sc.retro, depth,
+                                                                           pixel, sample, settings)
+                                                  : direct_lighting<false, kCutOuts>(scene, s, ng, ns, sc.f, nullptr,
+                                                                                     depth, pixel, sample, settings));
             const Vec3 origin = offset_ray_origin(s.p, ng);
             const GlossyStep g =
                 glossy_vertex(scene, s.p, origin, ng, sc.glossy, pixel, sample, vertex_dimension(depth, 1),
@@ -359,7 +391,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             if (!(g.pdf > 0.0f)) return false;
             throughput *= g.weight;
             bsdf_pdf = g.pdf;
-            light_only = depth >= settings.max_specular_depth;
+            light_only = bounce >= settings.max_specular_depth;
             ray = Ray{origin, 0.0f, g.wi, kInfinity};
             return true;
           }
@@ -373,18 +405,18 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             if (!(g.pdf > 0.0f)) return false;
             throughput *= g.weight;
             bsdf_pdf = g.pdf;
-            light_only = depth >= settings.max_specular_depth;
+            light_only = bounce >= settings.max_specular_depth;
             ray = Ray{g.origin, 0.0f, g.wi, kInfinity};
             return true;
           }
           bsdf_pdf = 0.0f;  // a delta branch: no lamp was sampled here
-          if (depth >= settings.max_specular_depth) return false;
+          if (bounce >= settings.max_specular_depth) return false;
           if (sc.kind == Scatter::Kind::Split) {
             for (int b = 0; b < sc.count; ++b) {
               const SpecularSample& branch = sc.branches[b];
               const Ray next{offset_ray_origin(s.p, branch.offset_normal), 0.0f, branch.wi, kInfinity};
               radiance += throughput * branch.weight * branch.probability *
-                          trace_from(scene, next, depth + 1, pixel, sample, settings);
+                          trace_from<kCutOuts>(scene, next, depth + 1, pixel, sample, settings, nullptr, cut.crossed());
             }
             return false;
           }
@@ -403,7 +435,9 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
 
 Vec3 trace_path(const Scene& scene, const Ray& camera_ray, uint32_t pixel, uint32_t sample,
                 const IntegratorSettings& settings, FirstHit* first) {
-  const Vec3 radiance = trace_from(scene, camera_ray, 0, pixel, sample, settings, first);
+  const Vec3 radiance = scene.any_transparency()
+                            ? trace_from<true>(scene, camera_ray, 0, pixel, sample, settings, first)
+                            : trace_from<false>(scene, camera_ray, 0, pixel, sample, settings, first);
   // A numerical failure anywhere (it should not happen) must not poison the pixel.
   if (!is_finite(radiance)) return Vec3(0.0f);
   return glm::max(radiance, Vec3(0.0f));

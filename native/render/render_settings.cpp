@@ -40,6 +40,7 @@ void RenderSettings::check() const {
   if (tile_size < 1) throw std::invalid_argument("tile_size must be at least 1");
   if (integrator.max_specular_depth < 0) throw std::invalid_argument("max_specular_depth must be >= 0");
   if (integrator.split_depth < 0) throw std::invalid_argument("split_depth must be >= 0");
+  if (integrator.transparent_max_bounces < 0) throw std::invalid_argument("transparent_max_bounces must be >= 0");
   if (!(adaptive.threshold >= 0.0f) || !std::isfinite(adaptive.threshold))
     throw std::invalid_argument("adaptive_threshold must be a finite number >= 0");
   if (adaptive.min_samples < 0) throw std::invalid_argument("adaptive_min_samples must be >= 0");

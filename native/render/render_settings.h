@@ -38,6 +38,12 @@ struct IntegratorSettings {
   // F and 1 - F; deeper ones pick one branch with those probabilities. 0 turns splitting off.
   // Costs extra rays only in pixels that see glass; see docs/render.md for the measured gain.
   int split_depth = 2;
+  // Transparent surfaces (materials/transparency.h) a path or a shadow ray may pass, Cycles'
+  // transparent_max_bounces: a path that crossed this many shades nothing at its next surface (it
+  // sees that surface's emission and the world beyond), and a shadow ray that meets more than
+  // what remains of it along its path is blocked. >= 0. Within one path the integrator lowers it
+  // by each crossing, so shadow rays read what remains.
+  int transparent_max_bounces = 8;
 };
 
 struct RenderSettings {

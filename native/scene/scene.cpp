@@ -100,11 +100,22 @@ void check_texture_id(const Material& m, size_t textures) {
 }
 }  // namespace
 
-uint32_t Scene::add_material(const Material& material, const MaterialEmission& emission) {
+void check_transparency(const MaterialTransparency& t, size_t textures) {
+  t.check();
+  if (t.texture < -1 || t.texture >= int64_t(textures))
+    throw std::invalid_argument("unknown opacity_texture id " + std::to_string(t.texture) + " (the scene has " +
+                                std::to_string(textures) + " textures)");
+}
+
+uint32_t Scene::add_material(const Material& material, const MaterialEmission& emission,
+                             const MaterialTransparency& transparency) {
   check_texture_id(material, textures_.size());
   emission.check();
+  check_transparency(transparency, textures_.size());
   materials_.push_back(material);
   emission_.push_back(emission);
+  transparency_.push_back(transparency);
+  any_transparency_ = any_transparency_ || transparency.transparent();
   if (emission.emits()) {
     any_emission_ = true;
     committed_ = false;
@@ -112,12 +123,17 @@ uint32_t Scene::add_material(const Material& material, const MaterialEmission& e
   return uint32_t(materials_.size() - 1);
 }
 
-void Scene::set_material(int64_t material, const Material& replacement, const MaterialEmission& emission) {
+void Scene::set_material(int64_t material, const Material& replacement, const MaterialEmission& emission,
+                         const MaterialTransparency& transparency) {
   if (material < 0 || size_t(material) >= materials_.size())
     throw std::invalid_argument("unknown material id " + std::to_string(material));
   check_texture_id(replacement, textures_.size());
   emission.check();
+  check_transparency(transparency, textures_.size());
   materials_[size_t(material)] = replacement;
+  transparency_[size_t(material)] = transparency;
+  any_transparency_ = std::any_of(transparency_.begin(), transparency_.end(),
+                                  [](const MaterialTransparency& t) { return t.transparent(); });
   if (!(emission_[size_t(material)] == emission)) {
     emission_[size_t(material)] = emission;
     any_emission_ =
@@ -358,6 +374,12 @@ bool Scene::occluded_by_shadow_casters(const Ray& ray) const {
   return trace<true, true>(ray, unused);
 }
 
+Hit Scene::intersect_shadow_casters(const Ray& ray) const {
+  Hit hit;
+  if (!(all_cast_shadows_ ? trace<false>(ray, hit) : trace<false, true>(ray, hit))) hit = Hit{};
+  return hit;
+}
+
 namespace {
 
 // Rays per task: enough to amortise scheduling, few enough to balance incoherent batches.
@@ -418,7 +440,7 @@ size_t Scene::memory_bytes() const {
   bytes += (grid.conditional.capacity() + grid.marginal.capacity() + grid.density.capacity()) * sizeof(float);
   bytes += emitters_.triangles.capacity() * sizeof(EmissiveTriangle) + emitters_.cdf.capacity() * sizeof(float);
   bytes += materials_.capacity() * sizeof(Material) + emission_.capacity() * sizeof(MaterialEmission) +
-           world_.lights.capacity() * sizeof(Light);
+           transparency_.capacity() * sizeof(MaterialTransparency) + world_.lights.capacity() * sizeof(Light);
   return bytes + light_tree_.memory_bytes();
 }
 

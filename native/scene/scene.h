@@ -19,6 +19,7 @@
 #include "materials/emission.h"
 #include "materials/material.h"
 #include "materials/texture.h"
+#include "materials/transparency.h"
 #include "scene/instance.h"
 #include "scene/mesh_shading.h"
 #include "scene/world.h"
@@ -111,9 +112,13 @@ class Scene {
   // do not touch the geometry (no commit needed).
   // A Lambert texture id must name one of the scene's textures (or be -1).
   // `emission`: what the material emits beside its BSDF (materials/emission.h); a change of it
-  // leaves the scene uncommitted, since commit() gathers the emissive triangles.
-  uint32_t add_material(const Material& material, const MaterialEmission& emission = {});
-  void set_material(int64_t material, const Material& replacement, const MaterialEmission& emission = {});
+  // leaves the scene uncommitted, since commit() gathers the emissive triangles. `transparency`:
+  // the part of the surface rays pass through (materials/transparency.h); its texture id is checked
+  // as the material's.
+  uint32_t add_material(const Material& material, const MaterialEmission& emission = {},
+                        const MaterialTransparency& transparency = {});
+  void set_material(int64_t material, const Material& replacement, const MaterialEmission& emission = {},
+                    const MaterialTransparency& transparency = {});
   uint32_t add_texture(Texture texture);
   void set_texture(int64_t texture, Texture replacement);
   uint32_t add_light(const Light& light, LightVisibility visibility = {});
@@ -166,6 +171,12 @@ class Scene {
   const std::vector<Texture>& textures() const { return textures_; }
   const std::vector<MaterialEmission>& emission() const { return emission_; }  // parallel to materials()
   bool any_emission() const { return any_emission_; }
+  const std::vector<MaterialTransparency>& transparency() const { return transparency_; }  // parallel to materials()
+  // Whether some material lets rays through: the render walks shadow rays through surfaces
+  // (render/transparent_walk.h) only then; otherwise they stay occluded()'s any-hit query.
+  bool any_transparency() const { return any_transparency_; }
+  // The nearest hit on an instance that casts shadows (the shadow walk's step).
+  Hit intersect_shadow_casters(const Ray& ray) const;
   const MeshEmitters& emitters() const { return emitters_; }  // the sampled emissive triangles, by commit()
   const World& world() const { return world_; }
   // The tree the render selects lights with: built by commit() over more than kLightTreeFrom
@@ -196,6 +207,8 @@ class Scene {
   std::vector<Material> materials_;
   std::vector<MaterialEmission> emission_;  // parallel to materials_
   bool any_emission_ = false;
+  std::vector<MaterialTransparency> transparency_;  // parallel to materials_
+  bool any_transparency_ = false;
   MeshEmitters emitters_;
   std::vector<Texture> textures_;
   World world_;

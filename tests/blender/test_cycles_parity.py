@@ -452,6 +452,32 @@ def scene_coat(p):
 
 SCENES_SPEC.append(("coat", scene_coat, dict(from_version=(4, 0, 0), mean_limit=0.005, sample_factor=4), 8))
 
+def scene_cut_out(p):
+    # Alpha cut-outs (the materials issue): two planes masked by one generated 8-bit image's alpha
+    # (a checker of holes, alpha 0, 0.5 and 1), over a floor, lit by a sun and the world: the camera
+    # sees the floor through the holes and half through the 0.5 cells, and the sun's shadow is
+    # patterned likewise. Left, a Mix Shader of a Transparent and a Diffuse BSDF (the leaf
+    # material); right, a Principled BSDF's Alpha; behind, a pane of a Transparent BSDF alone (its
+    # colour tints what is seen through it and its shadow).
+    n = 6
+    ij = np.add.outer(np.arange(n), np.arange(n))
+    alpha = np.where(ij % 2 == 0, 1.0, np.where(ij % 3 == 0, 0.5, 0.0)).astype(np.float32)
+    rgba = np.concatenate([np.ones((n, n, 3), np.float32), alpha[..., None]], axis=2)
+    mask = kit.image("leaf_mask", rgba, alpha=True)
+    kit.plane("floor", 8.0, kit.diffuse("floor", (0.8, 0.8, 0.8)))
+    for i, (kind, color, x) in enumerate((("mix", (0.2, 0.6, 0.15), -0.75), ("principled", (0.7, 0.3, 0.1), 0.75))):
+        kit.plane(f"leaf{i}", 1.3, kit.cut_out(f"leaf_{kind}", color, mask, kind), location=(x, 0.0, 0.7))
+    pane, node = kit.surface("tinted_pane", "ShaderNodeBsdfTransparent")  # a Transparent BSDF alone
+    node.inputs["Color"].default_value = (*p["pane"], 1.0)
+    kit.plane("pane", 1.0, pane, location=(0.0, 1.3, 0.5))
+    kit.sun_light("sun", 3.0, p["direction"])
+    camera((0.0, -3.5, 3.2), (0, 0, 0.2))
+    kit.world((0.3, 0.35, 0.4))
+
+
+SCENES_SPEC.append(("cut_out", scene_cut_out, dict(direction=(0.35, 0.25, -1.0), pane=(0.9, 0.55, 0.3),
+                                                   mean_limit=0.005), 0))
+
 # ---- Cycles ------------------------------------------------------------------------------------
 
 def render_cycles(scene, path):
@@ -660,6 +686,12 @@ def write_doc(results):
         "roughness-dependent retro-reflection) with the layer added. metal_sweep (Metallic 1, Blender's "
         "defaults otherwise: 3.x GGX with its Fresnel blend from the base colour, 4.0+ Multiscatter GGX with "
         "F82-tint) is asserted on both.",
+        "- Alpha cut-outs (docs/render.md, 'Alpha cut-outs and the Transparent BSDF'): cut_out masks two planes "
+        "with one generated 8-bit image's alpha (0, 0.5 and 1 cells) over a floor under a sun and the world: "
+        "left a Mix Shader of a Transparent and a Diffuse BSDF (Fac the image's Alpha), right a Principled "
+        "BSDF's Alpha; behind them a pane of a Transparent BSDF alone, tinted. Camera rays pass the holes "
+        "(and half the 0.5 cells), shadow rays are attenuated by them "
+        "(Cycles' transparent shadows, transparent_max_bounces 8 in both); asserted on both at the 0.5 % limit.",
         "",
     ]
     DOC.write_text("\n".join(lines))

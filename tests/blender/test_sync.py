@@ -197,7 +197,8 @@ def test_defaults_match_the_core():
     core = render_toyrt.native().defaults
     settings = bpy.types.Scene.bl_rna.properties["toyrt"].fixed_type.bl_rna.properties
     compared = 0
-    names = ("samples", "max_specular_depth", "area_light_sampling", "light_sampling", "builder", "seed",
+    names = ("samples", "max_specular_depth", "transparent_max_bounces", "area_light_sampling",
+             "light_sampling", "builder", "seed",
              "use_adaptive_sampling", "adaptive_threshold", "adaptive_min_samples", "time_limit")
     for name in names:
         ours = settings[name].default  # an enum's: its identifier
