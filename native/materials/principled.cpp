@@ -210,9 +210,10 @@ Scatter coated(const Principled& m, const ShadingPoint& s, const MaterialContext
   coat.ior = m.coat_eta;
   coat.ior_f0 = m.coat_f0;
   const float mu = coat.wo.z;
-  // What the coat leaves below, as the specular layer's estimate (single-scatter GGX), and the
-  // tint along the refracted path through it.
-  const float coat_albedo = m.coat_f0 + (1.0f - m.coat_f0) * ggx_fresnel_blend(m.coat_roughness, mu, m.coat_eta);
+  // What the coat leaves below: Cycles estimates a lobe with the plain dielectric Fresnel (not the
+  // specular layer's generalised Schlick, which it reads from a table) as a smooth surface, the
+  // Fresnel term at wo; and the tint along the refracted path through the coat.
+  const float coat_albedo = fresnel_dielectric(mu, m.coat_eta);
   const float sin2_t = (1.0f - mu * mu) / (m.coat_eta * m.coat_eta);
   const float depth = 1.0f / std::sqrt(std::max(1.0f - sin2_t, 1e-6f));
   const Vec3 tinted = glm::pow(glm::max(m.coat_tint, Vec3(0.0f)), Vec3(depth));

@@ -137,18 +137,20 @@ def test_principled_transmission_one_renders_the_glass_bsdf(version):
 
 # ---- 4.0+'s coat ------------------------------------------------------------------------------
 
-def test_coat_over_a_bare_base_is_the_specular_layer_over_it():
+def test_coat_head_on_is_its_lobe_plus_the_base_it_leaves():
     # At normal incidence under the point straight above, a coat of weight 1 over a base without a
-    # specular layer (Specular IOR Level 0) is the same dielectric layer as the specular one with
-    # the coat's IOR and roughness (single-scatter GGX): the lobe F0 D G2 / 4 plus the base scaled
-    # by what the layer leaves. The coat is drawn on half the samples with twice the weight; 16
-    # Sobol samples split exactly in half, so the pixels agree to rounding.
-    for rough in (0.2, 0.5):
-        base = dict(color=(0.6, 0.3, 0.1), multiscatter=False)
-        layer = floor(ior=1.5, roughness=rough, **base)
-        coat = floor(ior=1.5, specular_ior_level=0.0, roughness=0.9, coat_weight=1.0, coat_roughness=rough,
-                     coat_ior=1.5, **base)
-        np.testing.assert_allclose(coat, layer, rtol=1e-5)
+    # specular layer (Specular IOR Level 0): the coat's lobe D(n) G2 F0 / 4 = F0 / (4 pi alpha^2)
+    # (G2 = 1, F = F0 on the normal) plus the base scaled by 1 - F0, Cycles' estimate of what a
+    # coat reflects (its Fresnel term at wo: F0 head-on). The coat is drawn on half the samples
+    # with twice the weight; 16 Sobol samples split exactly in half, so this is exact to rounding.
+    color = np.array([0.6, 0.3, 0.1])
+    f0 = ((1.5 - 1.0) / (1.5 + 1.0)) ** 2
+    for rough in (0.3, 0.6):
+        alpha = rough ** 2
+        got = floor(color=tuple(color), ior=1.5, specular_ior_level=0.0, roughness=0.9, coat_weight=1.0,
+                    coat_roughness=rough, coat_ior=1.5)
+        want = IRRADIANCE * (color / math.pi * (1.0 - f0) + f0 / (4.0 * math.pi * alpha ** 2))
+        np.testing.assert_allclose(got, want, rtol=1e-4)
 
 
 def test_coat_tint_tints_what_lies_below_it_only():
