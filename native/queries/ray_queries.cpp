@@ -31,8 +31,17 @@ float reported_t(double t, float tnear, float tfar) {
 void count_intersections(const Scene& scene, const RayBatch& rays, uint32_t* counts, int threads) {
   scene.check_committed();
   check_threads(threads);
+  // Scenes that fit the caches walk one ray at a time; larger ones interleave the rays' walks
+  // (queries/interleaved_walk.h: 1.3x at 82K triangles, 1.9x at 5.2M).
+  const bool interleave = interleaving_pays(scene);
   run_with_threads(threads, [&] {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.count, kRayGrain), [&](const tbb::blocked_range<size_t>& r) {
+      if (interleave) {
+        std::fill(counts + r.begin(), counts + r.end(), 0u);
+        for_each_crossing_of_rays(scene, rays, r.begin(), r.end(),
+                                  [&](uint32_t i, uint32_t, uint32_t, uint32_t, const Crossing&) { ++counts[i]; });
+        return;
+      }
       for (size_t i = r.begin(); i != r.end(); ++i) {
         uint32_t n = 0;
         for_each_crossing(scene, rays.at(i), [&](uint32_t, uint32_t, uint32_t, const Crossing&) { ++n; });
@@ -61,37 +70,46 @@ HitList list_intersections(const Scene& scene, const RayBatch& rays, size_t max_
   out.mesh.resize(total);
   out.instance.resize(total);
   out.prim.resize(total);
+  const bool interleave = interleaving_pays(scene);
   run_with_threads(threads, [&] {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.count, kRayGrain), [&](const tbb::blocked_range<size_t>& r) {
       struct Entry {
+        uint32_t ray;
         double t;
         int32_t instance, mesh, prim;
         float u, v;
       };
-      std::vector<Entry> entries;  // one per task, reused by its rays
-      for (size_t i = r.begin(); i != r.end(); ++i) {
-        const Ray ray = rays.at(i);
-        entries.clear();
-        for_each_crossing(scene, ray, [&](uint32_t instance, uint32_t mesh, uint32_t prim, const Crossing& c) {
-          entries.push_back({c.t, int32_t(instance), int32_t(mesh), int32_t(prim), float(c.u), float(c.v)});
-        });
-        // The same walk as the count: the same crossings, in a traversal order made canonical here.
-        std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
-          if (a.t != b.t) return a.t < b.t;
-          if (a.instance != b.instance) return a.instance < b.instance;
-          return a.prim < b.prim;
-        });
-        size_t k = size_t(out.offsets[i]);
-        for (const Entry& e : entries) {
-          out.ray[k] = uint32_t(i);
-          out.t[k] = reported_t(e.t, ray.tnear, ray.tfar);
-          out.u[k] = e.u;
-          out.v[k] = e.v;
-          out.mesh[k] = e.mesh;
-          out.instance[k] = e.instance;
-          out.prim[k] = e.prim;
-          ++k;
-        }
+      // The same walks as the count: the same crossings, in a traversal order made canonical by
+      // the sort (ray, then t, instance, prim).
+      std::vector<Entry> entries;
+      const auto add = [&](uint32_t i, uint32_t instance, uint32_t mesh, uint32_t prim, const Crossing& c) {
+        entries.push_back({i, c.t, int32_t(instance), int32_t(mesh), int32_t(prim), float(c.u), float(c.v)});
+      };
+      if (interleave) {
+        for_each_crossing_of_rays(scene, rays, r.begin(), r.end(), add);
+      } else {
+        for (size_t i = r.begin(); i != r.end(); ++i)
+          for_each_crossing(scene, rays.at(i), [&](uint32_t instance, uint32_t mesh, uint32_t prim, const Crossing& c) {
+            add(uint32_t(i), instance, mesh, prim, c);
+          });
+      }
+      std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+        if (a.ray != b.ray) return a.ray < b.ray;
+        if (a.t != b.t) return a.t < b.t;
+        if (a.instance != b.instance) return a.instance < b.instance;
+        return a.prim < b.prim;
+      });
+      size_t k = size_t(out.offsets[r.begin()]);  // the task's rays' crossings, contiguous from here
+      for (const Entry& e : entries) {
+        const Ray ray = rays.at(e.ray);
+        out.ray[k] = e.ray;
+        out.t[k] = reported_t(e.t, ray.tnear, ray.tfar);
+        out.u[k] = e.u;
+        out.v[k] = e.v;
+        out.mesh[k] = e.mesh;
+        out.instance[k] = e.instance;
+        out.prim[k] = e.prim;
+        ++k;
       }
     });
   });
