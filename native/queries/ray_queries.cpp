@@ -79,38 +79,48 @@ HitList list_intersections(const Scene& scene, const RayBatch& rays, size_t max_
         int32_t instance, mesh, prim;
         float u, v;
       };
-      // The same walks as the count: the same crossings, in a traversal order made canonical by
-      // the sort (ray, then t, instance, prim).
-      std::vector<Entry> entries;
-      const auto add = [&](uint32_t i, uint32_t instance, uint32_t mesh, uint32_t prim, const Crossing& c) {
-        entries.push_back({i, c.t, int32_t(instance), int32_t(mesh), int32_t(prim), float(c.u), float(c.v)});
+      // The same walks as the count: the same crossings, in a traversal order made canonical here.
+      const auto write_ray = [&](size_t i, Entry* first, Entry* last) {
+        std::sort(first, last, [](const Entry& a, const Entry& b) {
+          if (a.t != b.t) return a.t < b.t;
+          if (a.instance != b.instance) return a.instance < b.instance;
+          return a.prim < b.prim;
+        });
+        const Ray ray = rays.at(i);
+        size_t k = size_t(out.offsets[i]);
+        for (const Entry* e = first; e != last; ++e, ++k) {
+          out.ray[k] = uint32_t(i);
+          out.t[k] = reported_t(e->t, ray.tnear, ray.tfar);
+          out.u[k] = e->u;
+          out.v[k] = e->v;
+          out.mesh[k] = e->mesh;
+          out.instance[k] = e->instance;
+          out.prim[k] = e->prim;
+        }
       };
-      if (interleave) {
-        for_each_crossing_of_rays(scene, rays, r.begin(), r.end(), add);
-      } else {
-        for (size_t i = r.begin(); i != r.end(); ++i)
+      std::vector<Entry> entries;  // one per task, reused by its rays
+      if (!interleave) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+          entries.clear();
           for_each_crossing(scene, rays.at(i), [&](uint32_t instance, uint32_t mesh, uint32_t prim, const Crossing& c) {
-            add(uint32_t(i), instance, mesh, prim, c);
+            entries.push_back(
+                {uint32_t(i), c.t, int32_t(instance), int32_t(mesh), int32_t(prim), float(c.u), float(c.v)});
           });
+          write_ray(i, entries.data(), entries.data() + entries.size());
+        }
+        return;
       }
-      std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
-        if (a.ray != b.ray) return a.ray < b.ray;
-        if (a.t != b.t) return a.t < b.t;
-        if (a.instance != b.instance) return a.instance < b.instance;
-        return a.prim < b.prim;
-      });
-      size_t k = size_t(out.offsets[r.begin()]);  // the task's rays' crossings, contiguous from here
-      for (const Entry& e : entries) {
-        const Ray ray = rays.at(e.ray);
-        out.ray[k] = e.ray;
-        out.t[k] = reported_t(e.t, ray.tnear, ray.tfar);
-        out.u[k] = e.u;
-        out.v[k] = e.v;
-        out.mesh[k] = e.mesh;
-        out.instance[k] = e.instance;
-        out.prim[k] = e.prim;
-        ++k;
-      }
+      // The rays' crossings come mixed: each is placed in its ray's range (known from the counts).
+      const int64_t base = out.offsets[r.begin()];
+      entries.resize(size_t(out.offsets[r.end()] - base));
+      std::vector<int64_t> next(out.offsets.begin() + int64_t(r.begin()), out.offsets.begin() + int64_t(r.end()));
+      for_each_crossing_of_rays(scene, rays, r.begin(), r.end(),
+                                [&](uint32_t i, uint32_t instance, uint32_t mesh, uint32_t prim, const Crossing& c) {
+                                  entries[size_t(next[i - r.begin()]++ - base)] = {
+                                      i, c.t, int32_t(instance), int32_t(mesh), int32_t(prim), float(c.u), float(c.v)};
+                                });
+      for (size_t i = r.begin(); i != r.end(); ++i)
+        write_ray(i, entries.data() + (out.offsets[i] - base), entries.data() + (out.offsets[i + 1] - base));
     });
   });
   return out;

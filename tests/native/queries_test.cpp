@@ -297,9 +297,10 @@ TEST(CountIntersections, InterleavedWalksFindTheCrossingsOfTheSingleWalk) {
   EXPECT_GT(crossings, rays.size());  // most rays cross something, so the comparison means something
 }
 
-// A mesh large enough for count_intersections to interleave its walks (queries/crossing_walk.h:
-// kInterleaveBytes): the counts equal brute force.
-TEST(CountIntersections, LargeMeshCountsMatchBruteForce) {
+// A mesh large enough for count_intersections and list_intersections to interleave their walks
+// (queries/crossing_walk.h: kInterleaveBytes): the counts equal brute force, and the list gives
+// each ray brute force's triangles in t order.
+TEST(CountIntersections, LargeMeshCountsAndListsMatchBruteForce) {
   const MeshData m = icosphere(6);  // 81,920 triangles, about 5 MB of nodes and blocks
   Committed c(m);
   ASSERT_TRUE(queries::interleaving_pays(c.scene));
@@ -322,6 +323,37 @@ TEST(CountIntersections, LargeMeshCountsMatchBruteForce) {
   }
   EXPECT_EQ(wrong, 0u);
   EXPECT_GT(total, rays.size() / 2);
+
+  std::vector<float> org, dir, tnear, tfar;
+  for (const Ray& r : rays) {
+    org.insert(org.end(), {r.org.x, r.org.y, r.org.z});
+    dir.insert(dir.end(), {r.dir.x, r.dir.y, r.dir.z});
+    tnear.push_back(r.tnear);
+    tfar.push_back(r.tfar);
+  }
+  const RayBatch batch{org.data(), dir.data(), tnear.data(), 1, tfar.data(), 1, rays.size()};
+  const queries::HitList hits = queries::list_intersections(c.scene, batch, 1u << 20, 2);
+  size_t wrong_lists = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    const queries::ExactRay exact{DVec3(rays[i].org), DVec3(rays[i].dir)};
+    std::vector<std::pair<double, int32_t>> expected;  // (t, prim) of brute force, in t order
+    for (size_t k = 0; k < m.triangles.size(); ++k) {
+      const Triangle& t = m.triangles[k];
+      queries::Crossing x;
+      if (queries::exact_crossing(exact, m.vertices[t.x], m.vertices[t.y], m.vertices[t.z], x) &&
+          x.t >= rays[i].tnear && x.t < rays[i].tfar)
+        expected.emplace_back(x.t, int32_t(k));
+    }
+    std::sort(expected.begin(), expected.end());
+    std::vector<int32_t> want, got;
+    for (const auto& e : expected) want.push_back(e.second);
+    for (int64_t k = hits.offsets[i]; k < hits.offsets[i + 1]; ++k) {
+      got.push_back(hits.prim[size_t(k)]);
+      wrong_lists += hits.ray[size_t(k)] != i;
+    }
+    wrong_lists += got != want;
+  }
+  EXPECT_EQ(wrong_lists, 0u);
 }
 
 // The float filter may only drop lanes the exact test rejects: on every block of meshes at the
