@@ -12,6 +12,7 @@ Speed: Mqueries/s on icospheres of 5K to 5.2M triangles, 1 and 2 threads, TOYRT 
 side (interleaved calls, medians), with the machine's load average.
 
 Usage: python bench/queries_bench.py [--build build] [--out docs/queries-bench.md] [--quick]
+       [--speed-only] [--kinds count ...] [--clock cpu]   (CPU time: steadier on a loaded machine)
 """
 import argparse
 import os
