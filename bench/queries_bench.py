@@ -12,6 +12,7 @@ Speed: Mqueries/s on icospheres of 5K to 5.2M triangles, 1 and 2 threads, TOYRT 
 side (interleaved calls, medians), with the machine's load average.
 
 Usage: python bench/queries_bench.py [--build build] [--out docs/queries-bench.md] [--quick]
+       [--speed-only] [--kinds count ...] [--clock cpu]   (CPU time: steadier on a loaded machine)
 """
 import argparse
 import os
@@ -163,22 +164,25 @@ def wrong_counts(lib, sets):
     return out
 
 
-def speed_side_by_side(engines, o, d, p, q, threads, repeats):
+def speed_side_by_side(engines, o, d, p, q, threads, repeats, clock=time.perf_counter,
+                       only=("count", "occupancy", "distance")):
     """Mqueries/s of count, occupancy and distance per engine: the engines run interleaved (one
     call each, in turn, `repeats` times after a warm-up call), so a change in the machine's load
-    hits both alike; the median of the repeats. {engine name: {kind: Mqueries/s}}."""
+    hits both alike; the median of the repeats. `clock` is wall time, or the process's CPU time
+    (all its threads), which other processes on a loaded machine disturb far less.
+    {engine name: {kind: Mqueries/s}}."""
     kinds = (("count", lambda e: e.count(o, d, threads), len(o)),
              ("occupancy", lambda e: e.occupancy(p, threads), len(p)),
              ("distance", lambda e: e.distance(q, threads), len(q)))
     res = {name: {} for name in engines}
-    for kind, f, n in kinds:
+    for kind, f, n in (k for k in kinds if k[0] in only):
         times = {name: [] for name in engines}
         for r in range(repeats + 1):
             for name, e in engines.items():
-                t0 = time.perf_counter()
+                t0 = clock()
                 f(e)
                 if r:  # the first round warms caches and thread pools
-                    times[name].append(time.perf_counter() - t0)
+                    times[name].append(clock() - t0)
         for name in engines:
             res[name][kind] = n / float(np.median(times[name])) / 1e6
     return res
@@ -191,6 +195,9 @@ def main():
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--levels", type=int, nargs="*", help="icosphere levels of the speed table (default 4-9)")
     ap.add_argument("--speed-only", action="store_true", help="skip the wrong-answer table")
+    ap.add_argument("--clock", choices=("wall", "cpu"), default="wall",
+                    help="time per call: wall, or the process's CPU time (steadier on a loaded machine)")
+    ap.add_argument("--kinds", nargs="*", default=("count", "occupancy", "distance"), help="queries to time")
     args = ap.parse_args()
     sys.path.insert(0, str((ROOT / args.build / "python").resolve()))
     import toyrt
@@ -242,7 +249,9 @@ def main():
     n = 50_000 if args.quick else 200_000
     repeats = 3 if args.quick else 5
     load_before = os.getloadavg()
-    lines += ["", f"## Speed (Mqueries/s, median of {repeats}, TOYRT and Open3D interleaved): icospheres, "
+    clock = time.process_time if args.clock == "cpu" else time.perf_counter
+    lines += ["", f"## Speed (Mqueries/s of {args.clock} time, median of {repeats}, TOYRT and Open3D interleaved): "
+              "icospheres, "
               f"{n // 1000}K random rays from [-1.5, 1.5]^3 and points in [-1.2, 1.2]^3 (2K to 20K points for "
               "distance, fewer on the larger meshes)", "",
               "| triangles | threads | count: TOYRT / Open3D | ratio | occupancy: TOYRT / Open3D | ratio | "
@@ -259,9 +268,12 @@ def main():
         q = p[: max(2000, n // 10 >> max(0, level - 6))]  # distance: little pruning near the centre
         engines = {name: make(mesh) for name, make in peers}
         for threads in (1, 2):
-            r = speed_side_by_side(engines, o, d, p, q, threads, repeats)
+            r = speed_side_by_side(engines, o, d, p, q, threads, repeats, clock, args.kinds)
             cells = []
             for kind in ("count", "occupancy", "distance"):
+                if kind not in args.kinds:
+                    cells += ["-", "-"]
+                    continue
                 vals = [r[name][kind] for name, _ in peers]
                 fmt = "{:.2f}" if kind != "distance" else "{:.3f}"
                 cells.append(" / ".join(fmt.format(v) for v in vals))

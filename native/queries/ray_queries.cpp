@@ -31,8 +31,17 @@ float reported_t(double t, float tnear, float tfar) {
 void count_intersections(const Scene& scene, const RayBatch& rays, uint32_t* counts, int threads) {
   scene.check_committed();
   check_threads(threads);
+  // Scenes that fit the caches walk one ray at a time; larger ones interleave the rays' walks
+  // (queries/interleaved_walk.h: 1.3x at 82K triangles, 1.9x at 5.2M).
+  const bool interleave = interleaving_pays(scene);
   run_with_threads(threads, [&] {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.count, kRayGrain), [&](const tbb::blocked_range<size_t>& r) {
+      if (interleave) {
+        std::fill(counts + r.begin(), counts + r.end(), 0u);
+        for_each_crossing_of_rays(scene, rays, r.begin(), r.end(),
+                                  [&](uint32_t i, uint32_t, uint32_t, uint32_t, const Crossing&) { ++counts[i]; });
+        return;
+      }
       for (size_t i = r.begin(); i != r.end(); ++i) {
         uint32_t n = 0;
         for_each_crossing(scene, rays.at(i), [&](uint32_t, uint32_t, uint32_t, const Crossing&) { ++n; });
@@ -61,38 +70,57 @@ HitList list_intersections(const Scene& scene, const RayBatch& rays, size_t max_
   out.mesh.resize(total);
   out.instance.resize(total);
   out.prim.resize(total);
+  const bool interleave = interleaving_pays(scene);
   run_with_threads(threads, [&] {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.count, kRayGrain), [&](const tbb::blocked_range<size_t>& r) {
       struct Entry {
+        uint32_t ray;
         double t;
         int32_t instance, mesh, prim;
         float u, v;
       };
-      std::vector<Entry> entries;  // one per task, reused by its rays
-      for (size_t i = r.begin(); i != r.end(); ++i) {
-        const Ray ray = rays.at(i);
-        entries.clear();
-        for_each_crossing(scene, ray, [&](uint32_t instance, uint32_t mesh, uint32_t prim, const Crossing& c) {
-          entries.push_back({c.t, int32_t(instance), int32_t(mesh), int32_t(prim), float(c.u), float(c.v)});
-        });
-        // The same walk as the count: the same crossings, in a traversal order made canonical here.
-        std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+      // The same walks as the count: the same crossings, in a traversal order made canonical here.
+      const auto write_ray = [&](size_t i, Entry* first, Entry* last) {
+        std::sort(first, last, [](const Entry& a, const Entry& b) {
           if (a.t != b.t) return a.t < b.t;
           if (a.instance != b.instance) return a.instance < b.instance;
           return a.prim < b.prim;
         });
+        const Ray ray = rays.at(i);
         size_t k = size_t(out.offsets[i]);
-        for (const Entry& e : entries) {
+        for (const Entry* e = first; e != last; ++e, ++k) {
           out.ray[k] = uint32_t(i);
-          out.t[k] = reported_t(e.t, ray.tnear, ray.tfar);
-          out.u[k] = e.u;
-          out.v[k] = e.v;
-          out.mesh[k] = e.mesh;
-          out.instance[k] = e.instance;
-          out.prim[k] = e.prim;
-          ++k;
+          out.t[k] = reported_t(e->t, ray.tnear, ray.tfar);
+          out.u[k] = e->u;
+          out.v[k] = e->v;
+          out.mesh[k] = e->mesh;
+          out.instance[k] = e->instance;
+          out.prim[k] = e->prim;
         }
+      };
+      std::vector<Entry> entries;  // one per task, reused by its rays
+      if (!interleave) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+          entries.clear();
+          for_each_crossing(scene, rays.at(i), [&](uint32_t instance, uint32_t mesh, uint32_t prim, const Crossing& c) {
+            entries.push_back(
+                {uint32_t(i), c.t, int32_t(instance), int32_t(mesh), int32_t(prim), float(c.u), float(c.v)});
+          });
+          write_ray(i, entries.data(), entries.data() + entries.size());
+        }
+        return;
       }
+      // The rays' crossings come mixed: each is placed in its ray's range (known from the counts).
+      const int64_t base = out.offsets[r.begin()];
+      entries.resize(size_t(out.offsets[r.end()] - base));
+      std::vector<int64_t> next(out.offsets.begin() + int64_t(r.begin()), out.offsets.begin() + int64_t(r.end()));
+      for_each_crossing_of_rays(scene, rays, r.begin(), r.end(),
+                                [&](uint32_t i, uint32_t instance, uint32_t mesh, uint32_t prim, const Crossing& c) {
+                                  entries[size_t(next[i - r.begin()]++ - base)] = {
+                                      i, c.t, int32_t(instance), int32_t(mesh), int32_t(prim), float(c.u), float(c.v)};
+                                });
+      for (size_t i = r.begin(); i != r.end(); ++i)
+        write_ray(i, entries.data() + (out.offsets[i] - base), entries.data() + (out.offsets[i + 1] - base));
     });
   });
   return out;

@@ -4,6 +4,7 @@
 // occupancy and distances against closed forms.
 #include "queries/block_crossing.h"
 #include "queries/closest_point_triangle.h"
+#include "queries/crossing_walk.h"
 #include "queries/exact_crossing.h"
 #include "queries/point_queries.h"
 #include "queries/ray_queries.h"
@@ -12,9 +13,11 @@
 #include <gtest/gtest.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <random>
+#include <tuple>
 
 using namespace toyrt;
 using namespace toyrt::testing;
@@ -235,6 +238,122 @@ TEST(CountIntersections, BvhWalkMatchesBruteForceAndTheDoubleOracle) {
   EXPECT_EQ(brute_wrong, 0u);
   EXPECT_EQ(oracle_wrong, 0u);
   EXPECT_GT(oracle_checked, 2000u);  // the oracle decided most rays, so the comparison means something
+}
+
+// The interleaved walks (queries/interleaved_walk.h) find, ray by ray, the crossings of the single
+// walk: forced on small meshes (threshold 0), with several instances (one identity, one
+// transformed), rays at vertices and edges, random rays with finite and infinite segments, and
+// invalid rays among them.
+TEST(CountIntersections, InterleavedWalksFindTheCrossingsOfTheSingleWalk) {
+  Scene scene;
+  const MeshData bumpy = uv_sphere(30, 60, 1.0f, 0.3f), ico = icosphere(3), box = cube(2.0f, Vec3(3.0f, 0.0f, 0.0f));
+  scene.add_instance(scene.add_mesh(bumpy.vertices, bumpy.triangles), Mat4(1.0f));
+  Mat4 to_world = glm::scale(glm::rotate(Mat4(1.0f), 0.7f, Vec3(1, 2, 3)), Vec3(2.0f, 0.5f, 1.0f));
+  to_world[3] = glm::vec4(0.5f, -0.3f, 0.2f, 1.0f);
+  scene.add_instance(scene.add_mesh(ico.vertices, ico.triangles), to_world);
+  scene.add_instance(scene.add_mesh(box.vertices, box.triangles), Mat4(1.0f));
+  scene.commit();
+  std::vector<Ray> rays = rays_at_vertices_and_edges(bumpy, Vec3(0.1f, 0.05f, -0.1f), 1, 5);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> unit(-3.0f, 3.0f);
+  for (int i = 0; i < 4000; ++i) {
+    Ray r;
+    r.org = Vec3(unit(rng), unit(rng), unit(rng));
+    r.dir = i % 97 == 0 ? Vec3(0.0f) : Vec3(unit(rng), unit(rng), unit(rng));
+    r.tnear = i % 3 == 0 ? -kInfinity : 0.0f;
+    r.tfar = i % 5 == 0 ? 0.5f : kInfinity;
+    rays.push_back(r);
+  }
+  std::vector<float> org, dir, tnear, tfar;
+  for (const Ray& r : rays) {
+    org.insert(org.end(), {r.org.x, r.org.y, r.org.z});
+    dir.insert(dir.end(), {r.dir.x, r.dir.y, r.dir.z});
+    tnear.push_back(r.tnear);
+    tfar.push_back(r.tfar);
+  }
+  const RayBatch batch{org.data(), dir.data(), tnear.data(), 1, tfar.data(), 1, rays.size()};
+  using Key = std::tuple<uint32_t, uint32_t, double>;  // instance, prim, t
+  std::vector<std::vector<Key>> single(rays.size()), interleaved(rays.size());
+  for (size_t i = 0; i < rays.size(); ++i)
+    queries::for_each_crossing(scene, batch.at(i),
+                               [&](uint32_t inst, uint32_t, uint32_t prim, const queries::Crossing& c) {
+                                 single[i].emplace_back(inst, prim, c.t);
+                               });
+  for (size_t begin = 0; begin < rays.size(); begin += 64)  // in tasks of 64 rays, as the batch runs
+    queries::for_each_crossing_of_rays(
+        scene, batch, begin, std::min(rays.size(), begin + 64),
+        [&](uint32_t i, uint32_t inst, uint32_t, uint32_t prim, const queries::Crossing& c) {
+          interleaved[i].emplace_back(inst, prim, c.t);
+        },
+        0);
+  size_t differ = 0, crossings = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    std::sort(single[i].begin(), single[i].end());
+    std::sort(interleaved[i].begin(), interleaved[i].end());
+    differ += single[i] != interleaved[i];
+    crossings += single[i].size();
+  }
+  EXPECT_EQ(differ, 0u);
+  EXPECT_GT(crossings, rays.size());  // most rays cross something, so the comparison means something
+}
+
+// A mesh large enough for count_intersections and list_intersections to interleave their walks
+// (queries/crossing_walk.h: kInterleaveBytes): the counts equal brute force, and the list gives
+// each ray brute force's triangles in t order.
+TEST(CountIntersections, LargeMeshCountsAndListsMatchBruteForce) {
+  const MeshData m = icosphere(6);  // 81,920 triangles, about 5 MB of nodes and blocks
+  Committed c(m);
+  ASSERT_TRUE(queries::interleaving_pays(c.scene));
+  std::vector<Ray> rays;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> unit(-1.5f, 1.5f);
+  for (int i = 0; i < 300; ++i) {
+    Ray r;
+    r.org = Vec3(unit(rng), unit(rng), unit(rng));
+    r.dir = i % 4 == 0 ? Vec3(m.vertices[size_t(i) * 97 % m.vertices.size()]) - r.org
+                       : Vec3(unit(rng), unit(rng), unit(rng));
+    r.tnear = i % 3 == 0 ? -kInfinity : 0.0f;
+    rays.push_back(r);
+  }
+  const std::vector<uint32_t> counts = counts_of(c.scene, rays);
+  size_t wrong = 0, total = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    wrong += counts[i] != brute_force_count(m, rays[i]);
+    total += counts[i];
+  }
+  EXPECT_EQ(wrong, 0u);
+  EXPECT_GT(total, rays.size() / 2);
+
+  std::vector<float> org, dir, tnear, tfar;
+  for (const Ray& r : rays) {
+    org.insert(org.end(), {r.org.x, r.org.y, r.org.z});
+    dir.insert(dir.end(), {r.dir.x, r.dir.y, r.dir.z});
+    tnear.push_back(r.tnear);
+    tfar.push_back(r.tfar);
+  }
+  const RayBatch batch{org.data(), dir.data(), tnear.data(), 1, tfar.data(), 1, rays.size()};
+  const queries::HitList hits = queries::list_intersections(c.scene, batch, 1u << 20, 2);
+  size_t wrong_lists = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    const queries::ExactRay exact{DVec3(rays[i].org), DVec3(rays[i].dir)};
+    std::vector<std::pair<double, int32_t>> expected;  // (t, prim) of brute force, in t order
+    for (size_t k = 0; k < m.triangles.size(); ++k) {
+      const Triangle& t = m.triangles[k];
+      queries::Crossing x;
+      if (queries::exact_crossing(exact, m.vertices[t.x], m.vertices[t.y], m.vertices[t.z], x) &&
+          x.t >= rays[i].tnear && x.t < rays[i].tfar)
+        expected.emplace_back(x.t, int32_t(k));
+    }
+    std::sort(expected.begin(), expected.end());
+    std::vector<int32_t> want, got;
+    for (const auto& e : expected) want.push_back(e.second);
+    for (int64_t k = hits.offsets[i]; k < hits.offsets[i + 1]; ++k) {
+      got.push_back(hits.prim[size_t(k)]);
+      wrong_lists += hits.ray[size_t(k)] != i;
+    }
+    wrong_lists += got != want;
+  }
+  EXPECT_EQ(wrong_lists, 0u);
 }
 
 // The float filter may only drop lanes the exact test rejects: on every block of meshes at the
