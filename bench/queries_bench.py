@@ -68,6 +68,9 @@ class Toyrt:
     def count(self, o, d, threads=0):
         return self.s.count_intersections(o, d, threads=threads)
 
+    def list(self, o, d, threads=0):
+        return self.s.list_intersections(o, d, threads=threads)["t"]
+
     def occupancy(self, p, threads=0):
         return self.s.compute_occupancy(p, threads=threads)
 
@@ -86,6 +89,10 @@ class Open3d:
     def count(self, o, d, threads=0):
         rays = self.o3d.core.Tensor(np.concatenate([o, d], axis=1).astype(np.float32))
         return self.s.count_intersections(rays, nthreads=threads).numpy()
+
+    def list(self, o, d, threads=0):
+        rays = self.o3d.core.Tensor(np.concatenate([o, d], axis=1).astype(np.float32))
+        return self.s.list_intersections(rays, nthreads=threads)["t_hit"].numpy()
 
     def occupancy(self, p, threads=0):
         return self.s.compute_occupancy(self.o3d.core.Tensor(p), nthreads=threads).numpy() > 0.5
@@ -172,6 +179,7 @@ def speed_side_by_side(engines, o, d, p, q, threads, repeats, clock=time.perf_co
     (all its threads), which other processes on a loaded machine disturb far less.
     {engine name: {kind: Mqueries/s}}."""
     kinds = (("count", lambda e: e.count(o, d, threads), len(o)),
+             ("list", lambda e: e.list(o, d, threads), len(o)),
              ("occupancy", lambda e: e.occupancy(p, threads), len(p)),
              ("distance", lambda e: e.distance(q, threads), len(q)))
     res = {name: {} for name in engines}
@@ -197,7 +205,8 @@ def main():
     ap.add_argument("--speed-only", action="store_true", help="skip the wrong-answer table")
     ap.add_argument("--clock", choices=("wall", "cpu"), default="wall",
                     help="time per call: wall, or the process's CPU time (steadier on a loaded machine)")
-    ap.add_argument("--kinds", nargs="*", default=("count", "occupancy", "distance"), help="queries to time")
+    ap.add_argument("--kinds", nargs="*", default=("count", "occupancy", "distance"),
+                    help="queries to time (count, occupancy, distance, list)")
     args = ap.parse_args()
     sys.path.insert(0, str((ROOT / args.build / "python").resolve()))
     import toyrt
@@ -255,8 +264,9 @@ def main():
               f"{n // 1000}K random rays from [-1.5, 1.5]^3 and points in [-1.2, 1.2]^3 (2K to 20K points for "
               "distance, fewer on the larger meshes)", "",
               "| triangles | threads | count: TOYRT / Open3D | ratio | occupancy: TOYRT / Open3D | ratio | "
-              "distance: TOYRT / Open3D | ratio |",
-              "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+              "distance: TOYRT / Open3D | ratio |"
+              + (" list: TOYRT / Open3D | ratio |" if "list" in args.kinds else ""),
+              "| --- | --- | --- | --- | --- | --- | --- | --- |" + (" --- | --- |" if "list" in args.kinds else "")]
     rng = np.random.default_rng(0)
     levels = args.levels or ((4, 5) if args.quick else (4, 5, 6, 7, 8, 9))
     peers = [lib for lib in libs[:2]]  # trimesh is too slow to time at these sizes
@@ -270,7 +280,7 @@ def main():
         for threads in (1, 2):
             r = speed_side_by_side(engines, o, d, p, q, threads, repeats, clock, args.kinds)
             cells = []
-            for kind in ("count", "occupancy", "distance"):
+            for kind in ("count", "occupancy", "distance") + (("list",) if "list" in args.kinds else ()):
                 if kind not in args.kinds:
                     cells += ["-", "-"]
                     continue

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -17,6 +18,9 @@ namespace {
 // Rays per task, as in the nearest-hit batch: every ray here walks its whole length, so smaller
 // grains balance better than there.
 constexpr size_t kRayGrain = 64;
+// list_intersections adds a chunk's crossings to the batch's total at least this often, so a batch
+// past max_hits stops storing within this many crossings per thread.
+constexpr size_t kBoundStep = 1 << 16;
 
 // The float the API reports for a crossing's double t: rounded, then kept inside [tnear, tfar)
 // (rounding may land a t just below tfar onto it).
@@ -52,17 +56,67 @@ void count_intersections(const Scene& scene, const RayBatch& rays, uint32_t* cou
 }
 
 HitList list_intersections(const Scene& scene, const RayBatch& rays, size_t max_hits, int threads) {
-  // Counted first, so the bound is checked before anything of the answer's size is allocated.
-  std::vector<uint32_t> counts(rays.count);
-  count_intersections(scene, rays, counts.data(), threads);
+  scene.check_committed();
+  check_threads(threads);
+  // One walk per ray (Open3D counts first and walks again to fill): each chunk of rays keeps its
+  // crossings and per-ray counts; the offsets follow from the counts, then each chunk sorts its
+  // rays' crossings into t order and writes them in place. The bound is checked while walking,
+  // so a batch past max_hits stops early with the error and holds at most about max_hits
+  // crossings.
+  struct Entry {
+    uint32_t ray;
+    double t;
+    int32_t instance, mesh, prim;
+    float u, v;
+  };
+  const size_t chunks = (rays.count + kRayGrain - 1) / kRayGrain;
+  std::vector<std::vector<Entry>> found(chunks);
+  std::vector<uint32_t> counts(rays.count, 0u);
+  std::atomic<size_t> seen{0};
+  std::atomic<bool> too_many{false};
+  const bool interleave = interleaving_pays(scene);
+  run_with_threads(threads, [&] {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks, 1), [&](const tbb::blocked_range<size_t>& cr) {
+      for (size_t c = cr.begin(); c != cr.end(); ++c) {
+        if (too_many.load(std::memory_order_relaxed)) return;
+        const size_t begin = c * kRayGrain, end = std::min(rays.count, begin + kRayGrain);
+        std::vector<Entry>& entries = found[c];
+        size_t counted = 0;  // of `entries`, already added to `seen`
+        const auto keep = [&](uint32_t i, uint32_t instance, uint32_t mesh, uint32_t prim, const Crossing& x) {
+          if (entries.size() - counted >= kBoundStep) {  // a batch past the bound stops growing
+            if (seen.fetch_add(entries.size() - counted, std::memory_order_relaxed) + entries.size() - counted >
+                max_hits)
+              too_many.store(true, std::memory_order_relaxed);
+            counted = entries.size();
+          }
+          if (too_many.load(std::memory_order_relaxed)) return;
+          entries.push_back({i, x.t, int32_t(instance), int32_t(mesh), int32_t(prim), float(x.u), float(x.v)});
+          ++counts[i];
+        };
+        if (interleave) {
+          for_each_crossing_of_rays(scene, rays, begin, end, keep);
+        } else {
+          for (size_t i = begin; i != end; ++i)
+            for_each_crossing(scene, rays.at(i),
+                              [&](uint32_t instance, uint32_t mesh, uint32_t prim, const Crossing& x) {
+                                keep(uint32_t(i), instance, mesh, prim, x);
+                              });
+        }
+        if (seen.fetch_add(entries.size() - counted, std::memory_order_relaxed) + entries.size() - counted > max_hits)
+          too_many.store(true, std::memory_order_relaxed);
+      }
+    });
+  });
   HitList out;
   out.offsets.resize(rays.count + 1);
   out.offsets[0] = 0;
   for (size_t i = 0; i < rays.count; ++i) out.offsets[i + 1] = out.offsets[i] + int64_t(counts[i]);
   const size_t total = size_t(out.offsets[rays.count]);
-  if (total > max_hits)
-    throw std::length_error("list_intersections would return " + std::to_string(total) + " hits, more than max_hits=" +
-                            std::to_string(max_hits) + ": split the rays or raise max_hits");
+  if (too_many.load() || total > max_hits)
+    throw std::length_error("list_intersections would return " +
+                            (too_many.load() ? "more than " + std::to_string(max_hits) : std::to_string(total)) +
+                            " hits, more than max_hits=" + std::to_string(max_hits) +
+                            ": split the rays or raise max_hits");
   out.ray.resize(total);
   out.t.resize(total);
   out.u.resize(total);
@@ -70,57 +124,40 @@ HitList list_intersections(const Scene& scene, const RayBatch& rays, size_t max_
   out.mesh.resize(total);
   out.instance.resize(total);
   out.prim.resize(total);
-  const bool interleave = interleaving_pays(scene);
   run_with_threads(threads, [&] {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.count, kRayGrain), [&](const tbb::blocked_range<size_t>& r) {
-      struct Entry {
-        uint32_t ray;
-        double t;
-        int32_t instance, mesh, prim;
-        float u, v;
-      };
-      // The same walks as the count: the same crossings, in a traversal order made canonical here.
-      const auto write_ray = [&](size_t i, Entry* first, Entry* last) {
-        std::sort(first, last, [](const Entry& a, const Entry& b) {
-          if (a.t != b.t) return a.t < b.t;
-          if (a.instance != b.instance) return a.instance < b.instance;
-          return a.prim < b.prim;
-        });
-        const Ray ray = rays.at(i);
-        size_t k = size_t(out.offsets[i]);
-        for (const Entry* e = first; e != last; ++e, ++k) {
-          out.ray[k] = uint32_t(i);
-          out.t[k] = reported_t(e->t, ray.tnear, ray.tfar);
-          out.u[k] = e->u;
-          out.v[k] = e->v;
-          out.mesh[k] = e->mesh;
-          out.instance[k] = e->instance;
-          out.prim[k] = e->prim;
-        }
-      };
-      std::vector<Entry> entries;  // one per task, reused by its rays
-      if (!interleave) {
-        for (size_t i = r.begin(); i != r.end(); ++i) {
-          entries.clear();
-          for_each_crossing(scene, rays.at(i), [&](uint32_t instance, uint32_t mesh, uint32_t prim, const Crossing& c) {
-            entries.push_back(
-                {uint32_t(i), c.t, int32_t(instance), int32_t(mesh), int32_t(prim), float(c.u), float(c.v)});
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks, 1), [&](const tbb::blocked_range<size_t>& cr) {
+      std::vector<Entry> ordered;
+      for (size_t c = cr.begin(); c != cr.end(); ++c) {
+        std::vector<Entry>& entries = found[c];
+        const size_t begin = c * kRayGrain, end = std::min(rays.count, begin + kRayGrain);
+        const int64_t base = out.offsets[begin];
+        // Into ray order (a counting sort: the interleaved walks deliver the rays' crossings mixed),
+        // then each ray's into a canonical t order.
+        ordered.resize(entries.size());
+        std::vector<int64_t> next(out.offsets.begin() + int64_t(begin), out.offsets.begin() + int64_t(end));
+        for (const Entry& e : entries) ordered[size_t(next[e.ray - begin]++ - base)] = e;
+        for (size_t i = begin; i != end; ++i) {
+          Entry* first = ordered.data() + (out.offsets[i] - base);
+          Entry* last = ordered.data() + (out.offsets[i + 1] - base);
+          std::sort(first, last, [](const Entry& a, const Entry& b) {
+            if (a.t != b.t) return a.t < b.t;
+            if (a.instance != b.instance) return a.instance < b.instance;
+            return a.prim < b.prim;
           });
-          write_ray(i, entries.data(), entries.data() + entries.size());
+          const Ray ray = rays.at(i);
+          size_t k = size_t(out.offsets[i]);
+          for (const Entry* e = first; e != last; ++e, ++k) {
+            out.ray[k] = uint32_t(i);
+            out.t[k] = reported_t(e->t, ray.tnear, ray.tfar);
+            out.u[k] = e->u;
+            out.v[k] = e->v;
+            out.mesh[k] = e->mesh;
+            out.instance[k] = e->instance;
+            out.prim[k] = e->prim;
+          }
         }
-        return;
+        std::vector<Entry>().swap(entries);  // freed as soon as written
       }
-      // The rays' crossings come mixed: each is placed in its ray's range (known from the counts).
-      const int64_t base = out.offsets[r.begin()];
-      entries.resize(size_t(out.offsets[r.end()] - base));
-      std::vector<int64_t> next(out.offsets.begin() + int64_t(r.begin()), out.offsets.begin() + int64_t(r.end()));
-      for_each_crossing_of_rays(scene, rays, r.begin(), r.end(),
-                                [&](uint32_t i, uint32_t instance, uint32_t mesh, uint32_t prim, const Crossing& c) {
-                                  entries[size_t(next[i - r.begin()]++ - base)] = {
-                                      i, c.t, int32_t(instance), int32_t(mesh), int32_t(prim), float(c.u), float(c.v)};
-                                });
-      for (size_t i = r.begin(); i != r.end(); ++i)
-        write_ray(i, entries.data() + (out.offsets[i] - base), entries.data() + (out.offsets[i + 1] - base));
     });
   });
   return out;
