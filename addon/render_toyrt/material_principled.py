@@ -61,6 +61,17 @@ def principled_spec(name, node, notes):
     return replace(spec, emission=emission), image
 
 
+def _color_socket(name, node, socket, notes) -> tuple[float, float, float]:
+    """A colour socket of 4.0+'s Principled (white if absent, or not a colour): its constant
+    value, NaN or negative channels 0 (noted); a linked one is its constant colour, noted."""
+    sock = input_socket(node, socket)
+    if sock is None or not hasattr(sock.default_value, "__len__"):
+        return (1.0, 1.0, 1.0)
+    if sock.is_linked:
+        notes.append(f"material '{name}': linked {socket} (its constant colour)")
+    return _finite_color(name, sock.default_value, socket, notes)
+
+
 def _coat(name, node, glass, notes) -> dict:
     """4.0+'s Coat (Weight, Roughness, IOR, Tint) as the 'principled' kind's coat arguments ({} for
     none): Cycles 4.0+'s dielectric layer over everything opaque. A linked socket is its constant
@@ -74,12 +85,7 @@ def _coat(name, node, glass, notes) -> dict:
         return {}
     rough = _constant(name, input_socket(node, "Coat Roughness"), "Coat Roughness", 0.03, notes, 0.0, 1.0)
     ior = _constant(name, input_socket(node, "Coat IOR"), "Coat IOR", 1.5, notes, 1.0, 1e30)
-    tint_sock = input_socket(node, "Coat Tint")
-    tint = (1.0, 1.0, 1.0)
-    if tint_sock is not None:
-        if tint_sock.is_linked:
-            notes.append(f"material '{name}': linked Coat Tint (its constant colour)")
-        tint = _finite_color(name, tint_sock.default_value, "Coat Tint", notes)
+    tint = _color_socket(name, node, "Coat Tint", notes)
     normal = input_socket(node, "Coat Normal")
     if normal is not None and normal.is_linked:
         notes.append(f"material '{name}': Principled Coat Normal (not modelled)")
@@ -119,12 +125,7 @@ def _specular_layer(name, node, base, extras, notes):
         # Level, tinted by the Specular Tint colour; Multiscatter GGX by default.
         ior = _constant(name, input_socket(node, "IOR"), "IOR", 1.5, notes, 1e-5, 1e30)
         level = _constant(name, input_socket(node, "Specular IOR Level"), "Specular IOR Level", 0.5, notes, 0.0, 1e30)
-        tint_sock = input_socket(node, "Specular Tint")
-        tint = (1.0, 1.0, 1.0)
-        if tint_sock is not None:
-            if tint_sock.is_linked:
-                notes.append(f"material '{name}': linked Specular Tint (its constant colour)")
-            tint = _finite_color(name, tint_sock.default_value, "Specular Tint", notes)
+        tint = _color_socket(name, node, "Specular Tint", notes)
         if ior == 1.0 or level == 0.0:
             return None
         if distribution not in ("GGX", "MULTI_GGX"):
@@ -179,12 +180,7 @@ def _metal(name, node, notes):
         base = replace(base, color=_finite_color(name, base.color, "base colour", notes))
     rough = _constant(name, input_socket(node, "Roughness"), "roughness", 0.5, notes, 0.0, 1.0)
     if new:
-        tint_sock = input_socket(node, "Specular Tint")
-        tint = (1.0, 1.0, 1.0)
-        if tint_sock is not None and hasattr(tint_sock.default_value, "__len__"):
-            if tint_sock.is_linked:
-                notes.append(f"material '{name}': linked Specular Tint (its constant colour)")
-            tint = _finite_color(name, tint_sock.default_value, "Specular Tint", notes)
+        tint = _color_socket(name, node, "Specular Tint", notes)
         layer = dict(ior=1.5, specular_tint=tint, multiscatter=distribution == "MULTI_GGX", shadowing="correlated",
                      layered=True)
     else:
