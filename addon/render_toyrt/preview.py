@@ -44,7 +44,7 @@ def render_preview(engine, depsgraph, toyrt, set_rect) -> None:
         return
     window = toyrt.camera_window(camera)
     width, height = window["x1"] - window["x0"], window["y1"] - window["y0"]
-    threads = 0 if scene.render.threads_mode == "AUTO" else scene.render.threads
+    threads = engine._threads(scene)  # Blender's render-threads setting, as F12 reads it
     cache.commit(builder="sah", threads=threads, should_cancel=engine.test_break)
     if engine.test_break():
         return

@@ -33,37 +33,29 @@ Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng) {
   return Ray{origin, 0.0f, to_end, 1.0f};
 }
 
-Vec3 transmittance_walk(const Scene& scene, Ray ray, int budget, bool casters_only) {
-  const std::vector<MaterialTransparency>& table = scene.transparency();
+Vec3 transmittance_walk(const Scene& scene, const Ray& ray, int budget, bool casters_only) {
+  // Light arrives when the walk ends without meeting an opaque surface (or one cut-out too many).
   Vec3 tr(1.0f);
-  for (int crossed = 0;; ++crossed) {
-    if (ray.tnear > ray.tfar) return tr;
-    const Hit hit = casters_only ? scene.intersect_shadow_casters(ray) : scene.intersect(ray);
-    if (!hit.found()) return tr;
-    const CrossedSurface s = crossed_surface(scene, hit);
-    if (s.material < 0 || size_t(s.material) >= table.size()) return Vec3(0.0f);
-    const MaterialTransparency& t = table[size_t(s.material)];
-    // An opaque surface, or one transparent surface more than the budget: blocked (Cycles).
-    if (!t.transparent() || crossed >= budget) return Vec3(0.0f);
-    tr *= (1.0f - t.opacity_at(scene.textures(), s.uv)) * t.color;
-    if (tr == Vec3(0.0f)) return tr;
-    ray = continue_through(ray, s.p, s.ng);
-  }
+  return walk_to_opaque(scene, ray, budget, tr, casters_only).found() ? Vec3(0.0f) : tr;
 }
 
-Hit walk_to_opaque(const Scene& scene, Ray ray, int budget, Vec3& tr) {
+Hit walk_to_opaque(const Scene& scene, Ray ray, int budget, Vec3& tr, bool casters_only) {
   const std::vector<MaterialTransparency>& table = scene.transparency();
   for (int crossed = 0;; ++crossed) {
-    const Hit hit = ray.tnear > ray.tfar ? Hit{} : scene.intersect(ray);
+    if (ray.tnear > ray.tfar) return Hit{};
+    const Hit hit = casters_only ? scene.intersect_shadow_casters(ray) : scene.intersect(ray);
     if (!hit.found()) return hit;
     const CrossedSurface s = crossed_surface(scene, hit);
     if (s.material < 0 || size_t(s.material) >= table.size() || !table[size_t(s.material)].transparent()) return hit;
+    // One transparent surface more than the budget blocks, as in Cycles; so does one that lets
+    // nothing through.
+    const MaterialTransparency& t = table[size_t(s.material)];
     if (crossed >= budget) {
       tr = Vec3(0.0f);
       return hit;
     }
-    const MaterialTransparency& t = table[size_t(s.material)];
     tr *= (1.0f - t.opacity_at(scene.textures(), s.uv)) * t.color;
+    if (tr == Vec3(0.0f)) return hit;
     ray = continue_through(ray, s.p, s.ng);
   }
 }

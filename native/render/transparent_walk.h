@@ -36,7 +36,7 @@ Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng);
 // The product of the transparent weights along `ray`, or 0 when it is blocked; at most `budget`
 // transparent surfaces pass. casters_only: a shadow ray (instances that cast shadows), else a
 // path ray (every instance).
-[[gnu::noinline]] Vec3 transmittance_walk(const Scene& scene, Ray ray, int budget, bool casters_only);
+[[gnu::noinline]] Vec3 transmittance_walk(const Scene& scene, const Ray& ray, int budget, bool casters_only);
 
 // At a surface with a transparent part: whether the path passes through. The transparent
 // closure is drawn on the uniform number u with probability its share of the weights, as Cycles
@@ -46,9 +46,10 @@ Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng);
                                       Vec3& throughput);
 
 // The nearest hit along `ray` on a surface that is not cut out, multiplying `tr` by what the cut-
-// outs before it let through (0 past `budget` of them: then the hit is the one that blocked);
-// scene.intersect(ray) when the scene has no transparent material.
-[[gnu::noinline]] Hit walk_to_opaque(const Scene& scene, Ray ray, int budget, Vec3& tr);
+// outs before it let through (0 past `budget` of them, or at one that lets nothing through: then
+// the hit is the one that blocked); nearest_past_cut_outs is scene.intersect(ray) when the scene
+// has no transparent material. casters_only: among the instances that cast shadows.
+[[gnu::noinline]] Hit walk_to_opaque(const Scene& scene, Ray ray, int budget, Vec3& tr, bool casters_only = false);
 inline Hit nearest_past_cut_outs(const Scene& scene, const Ray& ray, int budget, Vec3& tr) {
   if (!scene.any_transparency()) return scene.intersect(ray);
   return walk_to_opaque(scene, ray, budget, tr);
