@@ -171,6 +171,40 @@ def cut_out(name, color, image, kind="mix"):
     return mat
 
 
+def normal_map(mat, image, strength=1.0, space="TANGENT", uv_map="", shader=None):
+    """Wire an Image Texture of `image` (Non-Color data) through a Normal Map node (`space`,
+    `strength`, `uv_map`: '' for the render-active UV map) into the Normal input of `shader` (the
+    node linked to the material's output when None). Returns the Normal Map node."""
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    if shader is None:
+        out = next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
+        shader = out.inputs["Surface"].links[0].from_node
+    tex = nodes.new("ShaderNodeTexImage")
+    tex.image = image
+    tex.interpolation, tex.extension = "Linear", "REPEAT"
+    node = nodes.new("ShaderNodeNormalMap")
+    node.space, node.uv_map = space, uv_map
+    node.inputs["Strength"].default_value = strength
+    links.new(tex.outputs["Color"], node.inputs["Color"])
+    links.new(node.outputs["Normal"], shader.inputs["Normal"])
+    return node
+
+
+def bump_normal_image(name, size=64, cycles=3, slope=0.5):
+    """A float, Non-Color tangent-space normal map of the height h = a sin(2 pi c u) sin(2 pi c v)
+    over the unit UV square (c = `cycles`, tileable), with the largest slope `slope`: each texel
+    (n + 1) / 2 of n = normalize(-dh/du, -dh/dv, 1)."""
+    u = (np.arange(size) + 0.5) / size
+    su, sv = np.meshgrid(u, u)                      # rows: v, from the bottom (Blender's order)
+    w = 2 * np.pi * cycles
+    dhdu = slope * np.cos(w * su) * np.sin(w * sv)
+    dhdv = slope * np.sin(w * su) * np.cos(w * sv)
+    n = np.stack([-dhdu, -dhdv, np.ones_like(su)], -1)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    rgba = np.concatenate([0.5 * (n + 1.0), np.ones((size, size, 1))], -1)
+    return image(name, rgba, float_buffer=True, colorspace="Non-Color")
+
+
 def principled(name, color):
     """Blender's default node material, a Principled BSDF, of base colour `color`: what most
     users' materials are (the add-on renders it as a diffuse of that colour)."""

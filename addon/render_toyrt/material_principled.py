@@ -35,9 +35,6 @@ def principled_spec(name, node, notes):
         sock = input_socket(node, *names)
         if sock is not None and (sock.is_linked or sock.default_value > 0.0):
             extras.append(label)
-    normal = input_socket(node, "Normal")
-    if normal is not None and normal.is_linked:
-        extras.append("normal input")
     emission = _emission(name, input_socket(node, "Emission Color", "Emission"),  # 4.0+ / 3.x
                          input_socket(node, "Emission Strength"), notes)
     base, image = _color_material(name, input_socket(node, "Base Color"), notes)

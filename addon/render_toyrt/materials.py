@@ -77,15 +77,18 @@ class MaterialSpec:
     opacity_channel: str = "alpha"
     opacity_invert: bool = False
     transparent_color: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    normal_map: object = None    # material_normal.NormalMapSpec: the Normal Map on the Normal input
 
     @property
     def transparent(self) -> bool:
         return self.opacity < 1.0 or self.opacity_texture is not None or self.opacity_invert
 
-    def arguments(self, texture_id: int = -1, opacity_texture_id: int = -1) -> dict:
+    def arguments(self, texture_id: int = -1, opacity_texture_id: int = -1, normal_texture_id: int = -1) -> dict:
         """Keyword arguments of toyrt.Scene.add_material / set_material, with the textures' ids."""
         args = dict(kind=self.kind, color=self.color, texture=texture_id, ior=self.ior, emission=self.emission,
                     emission_sampling=self.emission_sampling)
+        if self.normal_map is not None:
+            args.update(self.normal_map.arguments(normal_texture_id))
         if self.transparent:
             args.update(opacity=self.opacity, opacity_texture=opacity_texture_id, opacity_channel=self.opacity_channel,
                         opacity_invert=self.opacity_invert, transparent_color=self.transparent_color)
@@ -117,6 +120,7 @@ class ConvertedMaterial:
     notes: tuple[str, ...] = ()
     image: object = field(default=None, compare=False)
     opacity_image: object = field(default=None, compare=False)   # the image opacity_texture reads
+    normal_image: object = field(default=None, compare=False)    # the image the normal map reads
 
 
 def material_spec(mat) -> ConvertedMaterial:
@@ -128,7 +132,11 @@ def material_spec(mat) -> ConvertedMaterial:
     opacity_image = None
     if isinstance(image, OpacityImages):
         image, opacity_image = image.color, image.opacity
-    return ConvertedMaterial(spec, tuple(dict.fromkeys(notes)), image, opacity_image)
+    from .material_normal import normal_map  # it reads this module's node helpers
+    bent, normal_image = normal_map(mat.name if mat is not None else "", mat, notes)
+    if bent is not None:
+        spec = replace(spec, normal_map=bent)
+    return ConvertedMaterial(spec, tuple(dict.fromkeys(notes)), image, opacity_image, normal_image)
 
 
 @dataclass(frozen=True)
@@ -397,9 +405,6 @@ def _glossy(name, node, notes):
     aniso = input_socket(node, "Anisotropy")
     if aniso is not None and (aniso.is_linked or aniso.default_value != 0.0):
         notes.append(f"material '{name}': anisotropic glossy (isotropic)")
-    normal = input_socket(node, "Normal")
-    if normal is not None and normal.is_linked:
-        notes.append(f"material '{name}': glossy normal input (the surface normal)")
     spec = _glossy_spec(name, input_socket(node, "Color"), rough, notes)
     if distribution == "MULTI_GGX" and _blender_version() >= (4, 0, 0):
         spec = replace(spec, multiscatter=True)

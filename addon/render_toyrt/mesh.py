@@ -46,6 +46,7 @@ class MeshGeometry:
     uvs: np.ndarray | None          # (M, 3, 2) per corner
     slots: np.ndarray               # (M,) int32 material slot of each triangle, clipped to `materials`
     materials: tuple                # Blender material or None, one per slot (at least one)
+    tangents: np.ndarray | None = None   # (M, 3, 4) per corner: for a tangent-space normal map
 
 
 def to_array(matrix) -> np.ndarray:
@@ -113,9 +114,13 @@ def fingerprint(obj, bake: np.ndarray | None = None) -> bytes | None:
     return h.digest()
 
 
-def evaluated_geometry(obj, depsgraph, poll: Poll = None, bake: np.ndarray | None = None) -> MeshGeometry | None:
+def evaluated_geometry(obj, depsgraph, poll: Poll = None, bake: np.ndarray | None = None,
+                       tangents_for: Callable[[tuple], str | None] | None = None) -> MeshGeometry | None:
     """An evaluated object's geometry, or None when it has no triangles. poll(): asked between
     stages; when it answers true, ExportCancelled is raised.
+
+    tangents_for(materials): the UV map whose tangents the slots' materials read ('': the
+    render-active one), or None for no tangents; only then are they computed (mesh_tangents.py).
 
     bake: a matrix the core cannot place (singular() is true): it is applied to the vertices
     here, for an instance with the identity. Scaled to zero, every triangle degenerates to a
@@ -139,13 +144,28 @@ def evaluated_geometry(obj, depsgraph, poll: Poll = None, bake: np.ndarray | Non
         if len(tris) == 0:
             return None
         materials = _slot_materials(obj, data)
+        uv_name = tangents_for(materials) if tangents_for is not None and bake is None else None
+        tangents = _tangents(data, uv_name, normals, len(tris)) if uv_name is not None else None
     finally:
         obj.to_mesh_clear()
     if bake is not None:
         verts = (verts.astype(np.float64) @ bake[:3, :3].T + bake[:3, 3]).astype(np.float32)
         normals = None
     slots = np.clip(slots, 0, len(materials) - 1).astype(np.int32, copy=False)
-    return MeshGeometry(verts, tris, normals, uvs, slots, materials)
+    return MeshGeometry(verts, tris, normals, uvs, slots, materials, tangents)
+
+
+def _tangents(data, uv_name: str, normals, exported: int) -> np.ndarray | None:
+    """The corner tangents of `data`'s loop triangles (mesh_tangents.py); None when the UV map is
+    missing or triangles were dropped (mesh_arrays' non-finite vertices: the order no longer
+    matches), and the normal map then keeps the surface normal, as Cycles without tangents."""
+    from .mesh_tangents import corner_tangents
+    nt = len(data.loop_triangles)
+    if nt != exported:
+        return None
+    loops = np.empty(nt * 3, np.uint32)
+    data.loop_triangles.foreach_get("loops", loops)
+    return corner_tangents(data, uv_name, loops, normals)
 
 
 def _slot_materials(obj, data) -> tuple:

@@ -318,7 +318,7 @@ class SceneSync(MaterialSync):
         # A mesh's conversion can take a few hundred ms: Esc is asked between its stages
         # (mesh.evaluated_geometry) and once more before the copy into the native scene.
         poll = self._should_cancel
-        geometry = evaluated_geometry(obj, depsgraph, poll=poll, bake=bake)
+        geometry = evaluated_geometry(obj, depsgraph, poll=poll, bake=bake, tangents_for=self._tangent_uv_map)
         stop_if(poll)
         self.counters["meshes_exported"] += 1
         old_id = entry[0] if entry is not None else -1
@@ -329,13 +329,17 @@ class SceneSync(MaterialSync):
         slot_ids = np.array([self._material_id(m) for m in geometry.materials], np.int32)
         mat_ids = slot_ids[geometry.slots]
         g = geometry
+        if g.tangents is None and (uv_map := self._tangent_uv_map(g.materials)) is not None:
+            self._note((f"object '{obj.name}': no UV map {uv_map or '(render-active)'} for its normal map "
+                        "(the surface normal)",))
         mid = old_id if old_id >= 0 else (self.free_ids.pop() if self.free_ids else -1)
         if mid >= 0:
-            self.scene.replace_mesh(mid, g.vertices, g.triangles, normals=g.normals, uvs=g.uvs, material_ids=mat_ids)
+            self.scene.replace_mesh(mid, g.vertices, g.triangles, normals=g.normals, uvs=g.uvs, material_ids=mat_ids,
+                                    tangents=g.tangents)
         else:
             # Stored only: _place() puts its instances where the walk found them.
             mid = self.scene.add_mesh(g.vertices, g.triangles, normals=g.normals, uvs=g.uvs, material_ids=mat_ids,
-                                      instance=False)
+                                      instance=False, tangents=g.tangents)
         return [mid, len(g.triangles), fingerprint]
 
     def _empty(self, mid: int) -> None:

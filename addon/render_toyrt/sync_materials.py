@@ -24,6 +24,21 @@ class MaterialSync:
         self._converted_now.add(name)
         return mid
 
+    def _tangent_uv_map(self, slot_materials: tuple) -> str | None:
+        """The UV map whose tangents a mesh with these slot materials needs ('': the render-active
+        one), from their converted specs; None when none has a tangent-space normal map. One
+        tangent set per mesh: slots reading different UV maps get the first one's, noted."""
+        wanted = []
+        for mat in slot_materials:
+            self._material_id(mat)
+            bent = self.materials[mat.name_full if mat is not None else ""][1].normal_map
+            if bent is not None and bent.space == "TANGENT" and bent.uv_map not in wanted:
+                wanted.append(bent.uv_map)
+        if len(wanted) > 1:
+            self._note((f"normal maps of one mesh read UV maps {', '.join(repr(w) for w in wanted)} "
+                        f"(tangents of {wanted[0]!r} for all)",))
+        return wanted[0] if wanted else None
+
     def _reconvert(self, mat) -> int:
         """Convert `mat` again; send it into the id it has if it changed. Returns 1, or 0 if it
         has no id yet (no mesh uses it)."""
@@ -41,8 +56,10 @@ class MaterialSync:
         self._note(converted.notes)
         spec = converted.spec
         texture, opacity = spec.texture, spec.opacity_texture
+        bent = spec.normal_map.texture if spec.normal_map is not None else None
         return spec.arguments(self._texture_id(texture, converted.image) if texture is not None else -1,
-                              self._texture_id(opacity, converted.opacity_image) if opacity is not None else -1)
+                              self._texture_id(opacity, converted.opacity_image) if opacity is not None else -1,
+                              self._texture_id(bent, converted.normal_image) if bent is not None else -1)
 
     def _texture_id(self, key: ImageKey, image) -> int:
         tid = self.textures.get(key)
@@ -92,9 +109,10 @@ class MaterialSync:
             if tid == placeholder:
                 tid = self.textures[key] = self.scene.add_texture(pixels, srgb=key.srgb)
                 for mid, spec in self.materials.values():
-                    if key in (spec.texture, spec.opacity_texture):
+                    bent = spec.normal_map.texture if spec.normal_map is not None else None
+                    if key in (spec.texture, spec.opacity_texture, bent):
                         ids = [self.textures.get(k, -1) if k is not None else -1
-                               for k in (spec.texture, spec.opacity_texture)]
+                               for k in (spec.texture, spec.opacity_texture, bent)]
                         self.scene.set_material(mid, **spec.arguments(*ids))
             else:
                 self.scene.set_texture(tid, pixels, srgb=key.srgb)

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace toyrt {
@@ -38,10 +39,14 @@ struct MaterialTransparency {
            texture == o.texture && channel == o.channel && invert == o.invert;
   }
 
-  // Throws std::invalid_argument for a non-finite or negative colour.
-  void check() const {
+  // Throws std::invalid_argument for a non-finite or negative colour, or a texture id that is
+  // not -1 or below `textures` (the scene's count).
+  void check(size_t textures) const {
     if (!is_finite(color) || glm::any(glm::lessThan(color, Vec3(0.0f))))
       throw std::invalid_argument("transparent_color must be finite and >= 0");
+    if (texture < -1 || texture >= int64_t(textures))
+      throw std::invalid_argument("unknown opacity_texture id " + std::to_string(texture) + " (the scene has " +
+                                  std::to_string(textures) + " textures)");
   }
 
   // The BSDF's weight o at texture coordinates uv, in [0, 1].

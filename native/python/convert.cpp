@@ -147,7 +147,7 @@ PerRay per_ray(py::handle obj, size_t count, const char* name) {
 }
 
 MeshShading to_shading(size_t vertex_count, const std::vector<Triangle>& tris, py::handle normals, py::handle uvs,
-                       py::handle material_ids) {
+                       py::handle material_ids, py::handle tangents) {
   MeshShading sh;
   const size_t m = tris.size();
   // Writes 3 m k floats to `out` (the shading vector's storage: one copy from numpy).
@@ -177,9 +177,11 @@ MeshShading to_shading(size_t vertex_count, const std::vector<Triangle>& tris, p
                             ") per vertex, got " + shape_of(a));
     }
   };
-  static_assert(sizeof(Vec3) == 3 * sizeof(float) && sizeof(Vec2) == 2 * sizeof(float));
+  static_assert(sizeof(Vec3) == 3 * sizeof(float) && sizeof(Vec2) == 2 * sizeof(float) &&
+                sizeof(glm::vec4) == 4 * sizeof(float));
   if (!normals.is_none()) corners(normals, 3, "normals", sh.corner_normals);
   if (!uvs.is_none()) corners(uvs, 2, "uvs", sh.corner_uvs);
+  if (!tangents.is_none()) corners(tangents, 4, "tangents", sh.corner_tangents);
   if (!material_ids.is_none()) {
     if (py::isinstance<py::int_>(material_ids)) {
       const int64_t id = material_ids.cast<int64_t>();

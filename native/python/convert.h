@@ -55,9 +55,9 @@ struct PerRay {
 PerRay per_ray(py::handle obj, size_t count, const char* name);
 
 // Shading attributes from their Python forms: per corner (M, 3, k) or per vertex (N, k); material
-// ids one int or (M,) ints. None: the mesh does not have the attribute.
+// ids one int or (M,) ints; tangents (M, 3, 4) or (N, 4). None: the mesh does not have the attribute.
 MeshShading to_shading(size_t vertex_count, const std::vector<Triangle>& tris, py::handle normals, py::handle uvs,
-                       py::handle material_ids);
+                       py::handle material_ids, py::handle tangents = py::none());
 // (height, width, 3 or 4) float 0..1 or uint8 pixels, rows from the bottom.
 Texture to_texture(py::handle pixels, bool srgb);
 CameraParams to_camera(const py::dict& camera);

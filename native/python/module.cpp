@@ -178,13 +178,16 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       "kind's default, grey for the diffuse kinds, white for glass and refraction). Every kind also\n"
       "emits: emission (linear RGB radiance, Blender's colour x strength, both sides; (0, 0, 0): none) and\n"
       "emission_sampling ('AUTO', 'FRONT_AND_BACK', 'FRONT', 'BACK': sampled as a light towards those sides;\n"
-      "'NONE': only seen by rays that hit it).";
+      "'NONE': only seen by rays that hit it). And every kind takes a Normal Map: normal_map (a texture id,\n"
+      "-1: none; its RGB is the normal, 2 c - 1), normal_strength (1), normal_space ('TANGENT': needs the\n"
+      "mesh's tangents, see add_mesh; 'OBJECT', 'WORLD', 'BLENDER_OBJECT', 'BLENDER_WORLD'), normal_convention\n"
+      "('OPENGL'; 'DIRECTX' negates green) and normal_strength_mode ('tangent': Blender 4.x+; 'blend': 3.x).";
 
   py::class_<PyScene>(m, "Scene", "A two-level scene: meshes stored once, placed by instances.")
       .def(py::init<>())
       .def("add_mesh", &PyScene::add_mesh, py::arg("vertices"), py::arg("triangles"), py::arg("transform") = py::none(),
            py::arg("normals") = py::none(), py::arg("uvs") = py::none(), py::arg("material_ids") = py::none(),
-           py::arg("instance") = true,
+           py::arg("instance") = true, py::arg("tangents") = py::none(),
            "Adds a mesh and one instance of it; returns the mesh id.\n"
            "instance: False stores the mesh without placing it (transform must then be None); place it\n"
            "with add_instance(mesh, transform), as often as needed.\n"
@@ -192,7 +195,9 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
            "indices. transform: None (identity) or a (4, 4) row-major affine world matrix.\n"
            "Degenerate (zero-area) triangles are kept but can never be hit.\n"
            "For rendering: normals (M, 3, 3) per corner or (N, 3) per vertex (smooth shading; None: flat),\n"
-           "uvs (M, 3, 2) or (N, 2), material_ids: one int or (M,) ints into the scene's materials.")
+           "uvs (M, 3, 2) or (N, 2), material_ids: one int or (M,) ints into the scene's materials,\n"
+           "tangents (M, 3, 4) or (N, 4): object-space unit tangent xyz and bitangent sign w (+-1) of the UV\n"
+           "map a tangent-space normal map reads (MikkTSpace, as Blender's Mesh.calc_tangents gives them).")
       .def(
           "add_material",
           [](PyScene& self, const std::string& kind, py::handle color, int64_t texture, float ior,
@@ -307,6 +312,7 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       .def("clear_lights", &PyScene::clear_lights, "Removes every light (to send them again after an edit).")
       .def("replace_mesh", &PyScene::replace_mesh, py::arg("mesh"), py::arg("vertices"), py::arg("triangles"),
            py::arg("normals") = py::none(), py::arg("uvs") = py::none(), py::arg("material_ids") = py::none(),
+           py::arg("tangents") = py::none(),
            "Replaces mesh `mesh`'s geometry and shading (arguments as add_mesh, without a transform); its\n"
            "instances stay, the next commit rebuilds its BVH. Empty arrays free a mesh no longer used.")
       .def("set_instance_transform", &PyScene::set_instance_transform, py::arg("instance"), py::arg("transform"),

@@ -9,13 +9,13 @@
 namespace toyrt::binding {
 
 uint32_t PyScene::add_mesh(py::handle vertices, py::handle triangles, py::handle transform, py::handle normals,
-                           py::handle uvs, py::handle material_ids, bool instance) {
+                           py::handle uvs, py::handle material_ids, bool instance, py::handle tangents) {
   std::vector<Vec3> verts = to_vec3s(as_points(vertices, "vertices"));
   std::vector<Triangle> tris = to_triangles(triangles);
   if (!instance && !transform.is_none())
     throw py::value_error("transform places the mesh's instance: pass None with instance=False");
   const Mat4 m = transform.is_none() ? Mat4(1.0f) : to_matrix(transform, "transform");
-  MeshShading shading = to_shading(verts.size(), tris, normals, uvs, material_ids);
+  MeshShading shading = to_shading(verts.size(), tris, normals, uvs, material_ids, tangents);
   return write([&] {
     if (instance) Scene::checked_inverse(m);  // before the mesh is added: a refused call changes nothing
     const uint32_t id = scene_.add_mesh(std::move(verts), std::move(tris), std::move(shading));
@@ -25,10 +25,10 @@ uint32_t PyScene::add_mesh(py::handle vertices, py::handle triangles, py::handle
 }
 
 void PyScene::replace_mesh(int64_t mesh, py::handle vertices, py::handle triangles, py::handle normals, py::handle uvs,
-                           py::handle material_ids) {
+                           py::handle material_ids, py::handle tangents) {
   std::vector<Vec3> verts = to_vec3s(as_points(vertices, "vertices"));
   std::vector<Triangle> tris = to_triangles(triangles);
-  MeshShading shading = to_shading(verts.size(), tris, normals, uvs, material_ids);
+  MeshShading shading = to_shading(verts.size(), tris, normals, uvs, material_ids, tangents);
   write([&] { scene_.replace_mesh(mesh, std::move(verts), std::move(tris), std::move(shading)); });
 }
 
@@ -89,15 +89,17 @@ MaterialTransparency transparency_of(const Params& params) {
 uint32_t PyScene::add_material(const std::string& kind, const Params& params) {
   const MaterialEmission emission = emission_of(params);
   const MaterialTransparency transparency = transparency_of(params);
+  const MaterialNormalMap normal_map = MaterialNormalMap::from_params(params);
   const Material material = make_material(kind, params);
-  return write([&] { return scene_.add_material(material, emission, transparency); });
+  return write([&] { return scene_.add_material(material, emission, transparency, normal_map); });
 }
 
 void PyScene::set_material(int64_t id, const std::string& kind, const Params& params) {
   const MaterialEmission emission = emission_of(params);
   const MaterialTransparency transparency = transparency_of(params);
+  const MaterialNormalMap normal_map = MaterialNormalMap::from_params(params);
   const Material material = make_material(kind, params);
-  write([&] { scene_.set_material(id, material, emission, transparency); });
+  write([&] { scene_.set_material(id, material, emission, transparency, normal_map); });
 }
 
 uint32_t PyScene::add_texture(py::handle pixels, bool srgb) {

@@ -21,9 +21,9 @@ namespace py = pybind11;
 class PyScene {
  public:
   uint32_t add_mesh(py::handle vertices, py::handle triangles, py::handle transform, py::handle normals, py::handle uvs,
-                    py::handle material_ids, bool instance);
+                    py::handle material_ids, bool instance, py::handle tangents);
   void replace_mesh(int64_t mesh, py::handle vertices, py::handle triangles, py::handle normals, py::handle uvs,
-                    py::handle material_ids);
+                    py::handle material_ids, py::handle tangents);
   uint32_t add_instance(int64_t mesh, py::handle transform, bool visible_shadow);
   void set_instance_transform(int64_t instance, py::handle transform);
   void clear_instances();

@@ -5,6 +5,7 @@
 #include "render/dielectric_lighting.h"
 #include "render/glossy_color.h"
 #include "render/glossy_lighting.h"
+#include "render/normal_mapping.h"
 #include "render/transparent_walk.h"
 #include "sampling/frame.h"
 #include "sampling/sobol_owen.h"
@@ -315,8 +316,10 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
       if (first) first->environment = seen;  // Cycles' Environment pass: the world seen directly
       break;
     }
-    const SurfaceHit s = surface_at(scene, hit);
+    SurfaceHit s = surface_at(scene, hit);
     const Vec3 wo = -glm::normalize(ray.dir);
+    if (scene.any_normal_map() && s.material >= 0 && size_t(s.material) < materials.size())
+      s.ns = normal_mapped(scene, hit, s.material, wo, s.ng, s.ns, s.uv);  // render/normal_mapping.h
     // The geometric normal decides the side; the shading normal is turned to that side.
     const bool front = glm::dot(s.ng, wo) > 0.0f;
     const Vec3 ng = front ? s.ng : -s.ng;

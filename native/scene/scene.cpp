@@ -100,22 +100,18 @@ void check_texture_id(const Material& m, size_t textures) {
 }
 }  // namespace
 
-void check_transparency(const MaterialTransparency& t, size_t textures) {
-  t.check();
-  if (t.texture < -1 || t.texture >= int64_t(textures))
-    throw std::invalid_argument("unknown opacity_texture id " + std::to_string(t.texture) + " (the scene has " +
-                                std::to_string(textures) + " textures)");
-}
-
 uint32_t Scene::add_material(const Material& material, const MaterialEmission& emission,
-                             const MaterialTransparency& transparency) {
+                             const MaterialTransparency& transparency, const MaterialNormalMap& normal_map) {
   check_texture_id(material, textures_.size());
   emission.check();
-  check_transparency(transparency, textures_.size());
+  transparency.check(textures_.size());
+  normal_map.check(textures_.size());
   materials_.push_back(material);
   emission_.push_back(emission);
   transparency_.push_back(transparency);
+  normal_maps_.push_back(normal_map);
   any_transparency_ = any_transparency_ || transparency.transparent();
+  any_normal_map_ = any_normal_map_ || normal_map.active();
   if (emission.emits()) {
     any_emission_ = true;
     committed_ = false;
@@ -124,14 +120,18 @@ uint32_t Scene::add_material(const Material& material, const MaterialEmission& e
 }
 
 void Scene::set_material(int64_t material, const Material& replacement, const MaterialEmission& emission,
-                         const MaterialTransparency& transparency) {
+                         const MaterialTransparency& transparency, const MaterialNormalMap& normal_map) {
   if (material < 0 || size_t(material) >= materials_.size())
     throw std::invalid_argument("unknown material id " + std::to_string(material));
   check_texture_id(replacement, textures_.size());
   emission.check();
-  check_transparency(transparency, textures_.size());
+  transparency.check(textures_.size());
+  normal_map.check(textures_.size());
   materials_[size_t(material)] = replacement;
   transparency_[size_t(material)] = transparency;
+  normal_maps_[size_t(material)] = normal_map;
+  any_normal_map_ =
+      std::any_of(normal_maps_.begin(), normal_maps_.end(), [](const MaterialNormalMap& n) { return n.active(); });
   any_transparency_ = std::any_of(transparency_.begin(), transparency_.end(),
                                   [](const MaterialTransparency& t) { return t.transparent(); });
   if (!(emission_[size_t(material)] == emission)) {
@@ -431,7 +431,7 @@ size_t Scene::memory_bytes() const {
                  top_.prim_ids.capacity() * sizeof(uint32_t);
   for (const MeshShading& sh : shading_)
     bytes += sh.corner_normals.capacity() * sizeof(Vec3) + sh.corner_uvs.capacity() * sizeof(Vec2) +
-             sh.material_ids.capacity() * sizeof(int32_t);
+             sh.corner_tangents.capacity() * sizeof(glm::vec4) + sh.material_ids.capacity() * sizeof(int32_t);
   for (const auto& m : meshes_) bytes += m->memory_bytes();
   // Shading and lighting data the render reads: textures (the environment's image among them),
   // the environment's sampling grid, the emissive triangles and their CDF, materials and lamps.
@@ -440,6 +440,7 @@ size_t Scene::memory_bytes() const {
   bytes += (grid.conditional.capacity() + grid.marginal.capacity() + grid.density.capacity()) * sizeof(float);
   bytes += emitters_.triangles.capacity() * sizeof(EmissiveTriangle) + emitters_.cdf.capacity() * sizeof(float);
   bytes += materials_.capacity() * sizeof(Material) + emission_.capacity() * sizeof(MaterialEmission) +
+           normal_maps_.capacity() * sizeof(MaterialNormalMap) +
            transparency_.capacity() * sizeof(MaterialTransparency) + world_.lights.capacity() * sizeof(Light);
   return bytes + light_tree_.memory_bytes();
 }

@@ -18,6 +18,7 @@
 #include "lights/mesh_emitters.h"
 #include "materials/emission.h"
 #include "materials/material.h"
+#include "materials/normal_map.h"
 #include "materials/texture.h"
 #include "materials/transparency.h"
 #include "scene/instance.h"
@@ -114,11 +115,12 @@ class Scene {
   // `emission`: what the material emits beside its BSDF (materials/emission.h); a change of it
   // leaves the scene uncommitted, since commit() gathers the emissive triangles. `transparency`:
   // the part of the surface rays pass through (materials/transparency.h); its texture id is checked
-  // as the material's.
+  // as the material's. `normal_map`: the Normal Map node on its Normal input (materials/normal_map.h),
+  // read where a mesh using it has tangents (MeshShading::corner_tangents) for tangent space.
   uint32_t add_material(const Material& material, const MaterialEmission& emission = {},
-                        const MaterialTransparency& transparency = {});
+                        const MaterialTransparency& transparency = {}, const MaterialNormalMap& normal_map = {});
   void set_material(int64_t material, const Material& replacement, const MaterialEmission& emission = {},
-                    const MaterialTransparency& transparency = {});
+                    const MaterialTransparency& transparency = {}, const MaterialNormalMap& normal_map = {});
   uint32_t add_texture(Texture texture);
   void set_texture(int64_t texture, Texture replacement);
   uint32_t add_light(const Light& light, LightVisibility visibility = {});
@@ -175,6 +177,10 @@ class Scene {
   // Whether some material lets rays through: the render walks shadow rays through surfaces
   // (render/transparent_walk.h) only then; otherwise they stay occluded()'s any-hit query.
   bool any_transparency() const { return any_transparency_; }
+  const std::vector<MaterialNormalMap>& normal_maps() const { return normal_maps_; }  // parallel to materials()
+  // Whether some material has a normal map: only then does a hit look one up
+  // (render/normal_mapping.h), so other scenes run the code they ran before.
+  bool any_normal_map() const { return any_normal_map_; }
   // The nearest hit on an instance that casts shadows (the shadow walk's step).
   Hit intersect_shadow_casters(const Ray& ray) const;
   const MeshEmitters& emitters() const { return emitters_; }  // the sampled emissive triangles, by commit()
@@ -209,6 +215,8 @@ class Scene {
   bool any_emission_ = false;
   std::vector<MaterialTransparency> transparency_;  // parallel to materials_
   bool any_transparency_ = false;
+  std::vector<MaterialNormalMap> normal_maps_;  // parallel to materials_
+  bool any_normal_map_ = false;
   MeshEmitters emitters_;
   std::vector<Texture> textures_;
   World world_;

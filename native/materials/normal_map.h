@@ -1,0 +1,84 @@
+// Blender's Normal Map node on a material's Normal input: the shading normal bent by an image's
+// texel, as Cycles' node computes it. Kept beside the material, as emission and transparency
+// are (materials/emission.h, transparency.h), because every BSDF has a Normal socket.
+//
+// A texel c (linear, Non-Color) encodes n = 2 c - 1. In tangent space n is read in the frame of
+// the interpolated MikkTSpace tangent T, the bitangent B = sign cross(N, T) and the interpolated
+// (unnormalised) smooth normal N, all in object space: N' = normalize(n.x T + n.y B + n.z N),
+// then carried to world space by the normal matrix. The DirectX convention stores -y. Object and
+// world space read n directly (Blender's own "Blender Object/World" spaces flip y and z).
+//
+// Strength, per Blender version (Cycles' kernel, read in each): 3.x blends the world normals,
+// N' = normalize(Ns + s (N' - Ns)) with s = max(strength, 0); since 4.x tangent space scales the
+// texel instead, n.xy *= s and n.z = mix(1, n.z, clamp(s, 0, 1)) (object and world space keep
+// the blend). A zero or non-finite result falls back to the smooth normal Ns.
+//
+// Below the surface: a bent normal can reflect the view direction under the geometric surface
+// (a black or leaking pixel). valid_reflection_normal() turns it towards Ng just enough that the
+// mirror direction of wo leaves the surface at a small positive elevation, as Cycles does for
+// every closure normal (ensure_valid_reflection in 3.x, ensure_valid_specular_reflection in 4.x+).
+#pragma once
+
+#include "core/math.h"
+#include "core/params.h"
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+namespace toyrt {
+
+enum class NormalMapSpace : uint8_t { Tangent, Object, World, BlenderObject, BlenderWorld };
+enum class NormalStrength : uint8_t { Blend, Tangent };  // 3.x / 4.x+ (see above)
+
+struct MaterialNormalMap {
+  int32_t texture = -1;  // index into the scene's textures; -1: no normal map
+  float strength = 1.0f;
+  NormalMapSpace space = NormalMapSpace::Tangent;
+  bool directx = false;  // the green channel stores -y (Blender 5.x's convention DirectX)
+  NormalStrength strength_mode = NormalStrength::Tangent;
+
+  // From add_material's keywords, which every material kind accepts: normal_map (a texture id,
+  // -1: none), normal_strength (1), normal_space ('TANGENT', 'OBJECT', 'WORLD', 'BLENDER_OBJECT',
+  // 'BLENDER_WORLD'), normal_convention ('OPENGL', 'DIRECTX'), normal_strength_mode ('tangent':
+  // Blender 4.x+, 'blend': 3.x). Throws std::invalid_argument for an unknown name.
+  static MaterialNormalMap from_params(const Params& params);
+
+  bool active() const { return texture >= 0; }
+  bool operator==(const MaterialNormalMap& o) const {
+    return texture == o.texture && strength == o.strength && space == o.space && directx == o.directx &&
+           strength_mode == o.strength_mode;
+  }
+  // Throws std::invalid_argument for a non-finite strength or a texture id that is not -1 or
+  // below `textures` (the scene's count).
+  void check(size_t textures) const {
+    if (!std::isfinite(strength)) throw std::invalid_argument("normal_strength must be finite");
+    if (texture < -1 || texture >= int64_t(textures))
+      throw std::invalid_argument("unknown normal_map texture id " + std::to_string(texture) + " (the scene has " +
+                                  std::to_string(textures) + " textures)");
+  }
+};
+
+// The texel's vector n = 2 c - 1 in the map's own convention (DirectX: y negated; Blender's
+// object and world spaces: y and z negated).
+Vec3 normal_map_vector(const MaterialNormalMap& map, const Vec3& texel);
+
+// Tangent space, object space: the bent normal from n (normal_map_vector), the interpolated
+// tangent t with its bitangent sign, and the interpolated smooth normal n_smooth (all
+// unnormalised). With NormalStrength::Tangent the strength scales n first. Zero when degenerate.
+Vec3 tangent_space_normal(const MaterialNormalMap& map, Vec3 n, const Vec3& t, float sign, const Vec3& n_smooth);
+
+// The bent world normal (any length) normalised, blended by strength with the smooth world
+// normal ns (3.x's rule, and 4.x+'s in object and world space); ns for a zero or non-finite
+// result. Unit out.
+Vec3 blend_normal_strength(const MaterialNormalMap& map, const Vec3& bent, const Vec3& ns);
+
+// n turned towards ng, in the plane of both, until the mirror reflection of wo about it is at
+// least min(0.9 dot(ng, wo), 0.01) above the surface (cosine to ng); n itself when it already
+// is (-n if n is under the surface: the same mirror). ng, wo and n unit, wo on ng's side. Never
+// NaN: ng when the equation has no usable root. The result is on ng's side.
+Vec3 valid_reflection_normal(const Vec3& ng, const Vec3& wo, const Vec3& n);
+
+}  // namespace toyrt

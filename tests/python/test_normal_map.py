@@ -1,0 +1,120 @@
+"""The Normal Map through the Python API (add_material's normal_* keywords, add_mesh's tangents),
+against closed forms: a Lambert floor under a sun, lit as albedo / pi x E x max(0, N'.L) with N'
+the normal a constant texel encodes (tangent frame T = x, B = sign y, N = z); a flat texel, a
+mesh without tangents and strength 0 render as no normal map; DirectX negates green; 3.x's and
+4.x+'s strength rules; a normal bent below the surface never gives NaN."""
+import numpy as np
+import pytest
+import toyrt
+from test_render import camera_above
+from test_sun_spot import aimed
+
+ALBEDO, SUN = 0.8, 3.0
+
+
+def normal_texture(s, n):
+    """A 2 x 2 float texture of the constant texel encoding unit vector n."""
+    n = np.asarray(n, np.float32) / np.linalg.norm(n)
+    return s.add_texture(np.tile((0.5 * (n + 1.0)).astype(np.float32), (2, 2, 1)), srgb=False)
+
+
+def floor(s, material, tangents=True, sign=1.0, half=2.0):
+    v = np.array([[-half, -half, 0], [half, -half, 0], [half, half, 0], [-half, half, 0]], np.float32)
+    uvs = np.array([[[0, 0], [1, 0], [1, 1]], [[0, 0], [1, 1], [0, 1]]], np.float32)
+    t = np.tile(np.array([1.0, 0.0, 0.0, sign], np.float32), (2, 3, 1)) if tangents else None
+    s.add_mesh(v, [[0, 1, 2], [0, 2, 3]], uvs=uvs, material_ids=material, tangents=t)
+
+
+def render(light_dir, n=None, tangents=True, sign=1.0, **normal):
+    """The floor's radiance (one value: every pixel must agree) under a sun shining towards
+    -light_dir, its material bent by the texel of n (None: no normal map)."""
+    s = toyrt.Scene()
+    args = {}
+    if n is not None:
+        args = dict(normal_map=normal_texture(s, n), **normal)
+    s.add_material("diffuse", color=(ALBEDO,) * 3, **args)
+    floor(s, 0, tangents, sign)
+    s.add_light("SUN", matrix=aimed(-np.asarray(light_dir, float)), strength=SUN, angle=0.0)
+    s.commit()
+    img = s.render(camera_above(size=2.0, resolution=8), samples=2)[..., :3]
+    assert np.isfinite(img).all()
+    np.testing.assert_allclose(img, img[0, 0, 0], rtol=1e-5, atol=1e-7)
+    return float(img[0, 0, 0])
+
+
+def lambert(normal, light_dir):
+    normal = np.asarray(normal, float) / np.linalg.norm(normal)
+    light_dir = np.asarray(light_dir, float) / np.linalg.norm(light_dir)
+    return ALBEDO / np.pi * SUN * max(0.0, float(normal @ light_dir))
+
+
+LIGHT = (np.sin(0.7), 0.0, np.cos(0.7))
+
+
+def test_flat_texel_renders_as_no_normal_map():
+    assert render(LIGHT, (0, 0, 1)) == render(LIGHT)
+
+
+def test_tilted_texel_lights_the_floor_as_its_normal():
+    n = (np.sin(0.5), 0.0, np.cos(0.5))
+    assert render(LIGHT, n) == pytest.approx(lambert(n, LIGHT), rel=1e-5)
+    # Tilted away from the light: darker, by the same law.
+    away = (-np.sin(0.5), 0.0, np.cos(0.5))
+    assert render(LIGHT, away) == pytest.approx(lambert(away, LIGHT), rel=1e-5)
+
+
+def test_bitangent_sign_and_directx_negate_green():
+    n = (0.0, np.sin(0.5), np.cos(0.5))
+    light = (0.0, np.sin(0.6), np.cos(0.6))
+    mirrored = (0.0, -np.sin(0.5), np.cos(0.5))
+    assert render(light, n) == pytest.approx(lambert(n, light), rel=1e-5)
+    assert render(light, n, sign=-1.0) == pytest.approx(lambert(mirrored, light), rel=1e-5)
+    assert render(light, n, normal_convention="DIRECTX") == pytest.approx(lambert(mirrored, light), rel=1e-5)
+
+
+def test_strength_rules_of_blender_3_and_4():
+    n = np.array([np.sin(0.5), 0.0, np.cos(0.5)])
+    # 4.x+ (tangent): n.x * s, n.z = 1 + (n.z - 1) min(s, 1).
+    scaled = (0.5 * n[0], 0.0, 1.0 + (n[2] - 1.0) * 0.5)
+    assert render(LIGHT, n, normal_strength=0.5) == pytest.approx(lambert(scaled, LIGHT), rel=1e-5)
+    # 3.x (blend): normalize(z + 0.5 (n - z)).
+    blended = np.array([0.0, 0.0, 1.0]) + 0.5 * (n - np.array([0.0, 0.0, 1.0]))
+    assert render(LIGHT, n, normal_strength=0.5, normal_strength_mode="blend") == pytest.approx(
+        lambert(blended, LIGHT), rel=1e-5)
+    assert render(LIGHT, n, normal_strength=0.0) == render(LIGHT)
+
+
+def test_mesh_without_tangents_keeps_the_surface_normal():
+    assert render(LIGHT, (np.sin(0.5), 0.0, np.cos(0.5)), tangents=False) == render(LIGHT)
+
+
+def test_object_and_world_space_read_the_texel_as_the_normal():
+    n = (np.sin(0.4), 0.0, np.cos(0.4))
+    for space in ("OBJECT", "WORLD"):
+        assert render(LIGHT, n, tangents=False, normal_space=space) == pytest.approx(lambert(n, LIGHT), rel=1e-5)
+
+
+def test_normal_bent_below_the_surface_is_lifted_not_nan():
+    # Bent 85 degrees: the view straight down would reflect under the floor; the normal is turned
+    # towards the floor's until the reflection is 0.01 above it (cos 2 theta = 0.01), which a
+    # light at that normal's angle lights as max(0, N'.L).
+    n = (np.sin(1.48), 0.0, np.cos(1.48))
+    theta = 0.5 * np.arccos(0.01)
+    lifted = (np.sin(theta), 0.0, np.cos(theta))
+    assert render(LIGHT, n) == pytest.approx(lambert(lifted, LIGHT), rel=1e-4)
+
+
+def test_bad_normal_map_arguments_are_refused_by_name():
+    s = toyrt.Scene()
+    with pytest.raises(ValueError, match="normal_map"):
+        s.add_material("diffuse", normal_map=0)
+    t = normal_texture(s, (0, 0, 1))
+    with pytest.raises(ValueError, match="normal_space"):
+        s.add_material("diffuse", normal_map=t, normal_space="UV")
+    with pytest.raises(ValueError, match="normal_convention"):
+        s.add_material("diffuse", normal_map=t, normal_convention="D3D")
+    v = np.zeros((3, 3), np.float32)
+    with pytest.raises(ValueError, match="tangents"):
+        s.add_mesh(v, [[0, 1, 2]], tangents=np.zeros((2, 3, 4), np.float32))
+    with pytest.raises(ValueError, match="tangents"):
+        s.add_mesh(v, [[0, 1, 2]], tangents=np.full((1, 3, 4), np.nan, np.float32))
