@@ -33,11 +33,18 @@ class NormalMapSpec:
     # How Strength mixes (Cycles' kernels read in 3.4 and 5.0): 3.x blends the bent normal with
     # the smooth one; 4.x+ scales the texel's tangent-space vector.
     strength_mode: str = "tangent"
+    # Cycles' shadowing of bent diffuse normals: 3.x Chiang et al.'s term, 4.x+ Conty Estevez et
+    # al.'s (the material's Bump Map Correction, on by default; 'none' when off).
+    shadowing: str = "conty"
+    # Lift the bent normal so the view's mirror stays above the surface: Cycles 3.x for every
+    # closure, 4.x+ for glossy ones only (materials.material_spec clears it for a diffuse kind).
+    lift: bool = True
 
     def arguments(self, texture_id: int) -> dict:
         """add_material's keywords for the core's MaterialNormalMap."""
         return dict(normal_map=texture_id, normal_strength=self.strength, normal_space=self.space,
-                    normal_convention=self.convention, normal_strength_mode=self.strength_mode)
+                    normal_convention=self.convention, normal_strength_mode=self.strength_mode,
+                    normal_shadowing=self.shadowing, normal_lift=self.lift)
 
 
 def surface_shader(mat):
@@ -53,11 +60,12 @@ def normal_map(name: str, mat, notes: list) -> tuple[NormalMapSpec | None, objec
     node = surface_shader(mat)
     if node is None:
         return None, None
+    correction = bool(getattr(getattr(mat, "cycles", None), "use_bump_map_correction", True))
     if node.type in BSDFS:
-        return _from_socket(name, input_socket(node, "Normal"), notes)
+        return _from_socket(name, input_socket(node, "Normal"), notes, correction)
     if node.type in ("MIX_SHADER", "ADD_SHADER"):
         shaders = [linked_node(s) for s in node.inputs if s.type == "SHADER"]
-        maps = [_from_socket(name, input_socket(s, "Normal"), notes) for s in shaders
+        maps = [_from_socket(name, input_socket(s, "Normal"), notes, correction) for s in shaders
                 if s is not None and s.type in BSDFS]
         specs = {spec for spec, _ in maps if spec is not None}
         if len(specs) == 1 and all(spec is not None for spec, _ in maps):
@@ -68,7 +76,7 @@ def normal_map(name: str, mat, notes: list) -> tuple[NormalMapSpec | None, objec
     return None, None
 
 
-def _from_socket(name, socket, notes):
+def _from_socket(name, socket, notes, correction=True):
     if socket is None or not socket.is_linked:
         return None, None
     src = linked_node(socket)
@@ -103,8 +111,11 @@ def _from_socket(name, socket, notes):
     convention = str(getattr(src, "convention", "OPENGL")).upper()   # 5.x+ where present
     if convention not in ("OPENGL", "DIRECTX"):
         convention = "OPENGL"
-    mode = "tangent" if _blender_version() >= (4, 0, 0) else "blend"
-    return NormalMapSpec(key, strength, space, convention, str(getattr(src, "uv_map", "") or ""), mode), image
+    modern = _blender_version() >= (4, 0, 0)
+    mode = "tangent" if modern else "blend"
+    shadowing = ("conty" if correction else "none") if modern else "chiang"
+    return NormalMapSpec(key, strength, space, convention, str(getattr(src, "uv_map", "") or ""), mode,
+                         shadowing), image
 
 
 def _has_pixels(image) -> bool:

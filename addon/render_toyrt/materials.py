@@ -135,7 +135,8 @@ def material_spec(mat) -> ConvertedMaterial:
     from .material_normal import normal_map  # it reads this module's node helpers
     bent, normal_image = normal_map(mat.name if mat is not None else "", mat, notes)
     if bent is not None:
-        spec = replace(spec, normal_map=bent)
+        lift = spec.kind != "diffuse" or _blender_version() < (4, 0, 0)   # 4.x+ lifts glossy normals only
+        spec = replace(spec, normal_map=replace(bent, lift=lift))
     return ConvertedMaterial(spec, tuple(dict.fromkeys(notes)), image, opacity_image, normal_image)
 
 

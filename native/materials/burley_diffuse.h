@@ -11,9 +11,12 @@
 // The factor is symmetric in wi and wo (reciprocal), and it is what the integrator multiplies a
 // diffuse point's constant f by, per light direction, when a material hands it one
 // (Scatter::burley): the direction is sampled as Lambert's (cosine), as Cycles 3.x samples it.
+// A normal-mapped diffuse point (any material) rides the same path with Cycles' bump shadowing
+// term (materials/bump_shadowing.h) as a further factor, Burley's terms on or off.
 #pragma once
 
 #include "core/math.h"
+#include "materials/bump_shadowing.h"
 
 #include <algorithm>
 
@@ -23,6 +26,9 @@ struct BurleyDiffuse {
   Vec3 n{0.0f, 0.0f, 1.0f};  // the shading normal on wo's side (the integrator's ns)
   Vec3 wo{0.0f, 0.0f, 1.0f};
   float roughness = 0.0f;  // the Principled Roughness, [0, 1]
+  bool burley = true;      // false: Lambert, only the bump term below
+  BumpShadowing bump = BumpShadowing::None;
+  Vec3 smooth{0.0f, 0.0f, 1.0f};  // the normal before the normal map, on n's side (for `bump`)
 };
 
 // Schlick's weight (1 - c)^5, c clamped to [0, 1] (a cosine below 0 counts as grazing).
@@ -35,11 +41,16 @@ inline float schlick_weight(float c) {
 // The factor on albedo / pi for light arriving along wi (world, unit; the caller checks wi is
 // above the shading normal).
 inline float burley_factor(const BurleyDiffuse& b, const Vec3& wi) {
-  const float fl = schlick_weight(glm::dot(b.n, wi));
-  const float fv = schlick_weight(glm::dot(b.n, b.wo));
-  const float lambert = (1.0f - 0.5f * fl) * (1.0f - 0.5f * fv);
-  const float r = b.roughness * (1.0f + glm::dot(wi, b.wo));
-  return lambert + r * (fl + fv + fl * fv * (r - 1.0f));
+  float factor = 1.0f;
+  if (b.burley) {
+    const float fl = schlick_weight(glm::dot(b.n, wi));
+    const float fv = schlick_weight(glm::dot(b.n, b.wo));
+    const float lambert = (1.0f - 0.5f * fl) * (1.0f - 0.5f * fv);
+    const float r = b.roughness * (1.0f + glm::dot(wi, b.wo));
+    factor = lambert + r * (fl + fv + fl * fv * (r - 1.0f));
+  }
+  if (b.bump != BumpShadowing::None) factor *= bump_shadowing(b.bump, b.smooth, b.n, wi);
+  return factor;
 }
 
 }  // namespace toyrt

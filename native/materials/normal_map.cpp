@@ -42,6 +42,13 @@ MaterialNormalMap MaterialNormalMap::from_params(const Params& params) {
   if (mode != "tangent" && mode != "blend")
     throw std::invalid_argument("normal_strength_mode must be 'tangent' or 'blend', got '" + mode + "'");
   n.strength_mode = mode == "blend" ? NormalStrength::Blend : NormalStrength::Tangent;
+  const std::string shadowing = params.text("normal_shadowing", "conty");
+  if (shadowing != "conty" && shadowing != "chiang" && shadowing != "none")
+    throw std::invalid_argument("normal_shadowing must be 'conty', 'chiang' or 'none', got '" + shadowing + "'");
+  n.shadowing = shadowing == "conty"    ? BumpShadowing::Conty
+                : shadowing == "chiang" ? BumpShadowing::Chiang
+                                        : BumpShadowing::None;
+  n.lift = params.flag("normal_lift", n.lift);
   return n;
 }
 

@@ -21,6 +21,7 @@
 
 #include "core/math.h"
 #include "core/params.h"
+#include "materials/bump_shadowing.h"
 
 #include <cmath>
 #include <cstddef>
@@ -39,17 +40,23 @@ struct MaterialNormalMap {
   NormalMapSpace space = NormalMapSpace::Tangent;
   bool directx = false;  // the green channel stores -y (Blender 5.x's convention DirectX)
   NormalStrength strength_mode = NormalStrength::Tangent;
+  BumpShadowing shadowing = BumpShadowing::Conty;  // of diffuse closures: 3.x Chiang, 4.x+ Conty
+  // Lift the bent normal so the view's mirror stays above the surface (valid_reflection_normal):
+  // Cycles 3.x does for every closure, 4.x+ only for glossy ones (not a Diffuse BSDF's).
+  bool lift = true;
 
   // From add_material's keywords, which every material kind accepts: normal_map (a texture id,
   // -1: none), normal_strength (1), normal_space ('TANGENT', 'OBJECT', 'WORLD', 'BLENDER_OBJECT',
   // 'BLENDER_WORLD'), normal_convention ('OPENGL', 'DIRECTX'), normal_strength_mode ('tangent':
-  // Blender 4.x+, 'blend': 3.x). Throws std::invalid_argument for an unknown name.
+  // Blender 4.x+, 'blend': 3.x), normal_shadowing ('conty': 4.x+, 'chiang': 3.x, 'none'),
+  // normal_lift (True).
+  // Throws std::invalid_argument for an unknown name.
   static MaterialNormalMap from_params(const Params& params);
 
   bool active() const { return texture >= 0; }
   bool operator==(const MaterialNormalMap& o) const {
     return texture == o.texture && strength == o.strength && space == o.space && directx == o.directx &&
-           strength_mode == o.strength_mode;
+           strength_mode == o.strength_mode && shadowing == o.shadowing && lift == o.lift;
   }
   // Throws std::invalid_argument for a non-finite strength or a texture id that is not -1 or
   // below `textures` (the scene's count).

@@ -7,6 +7,7 @@
 #include "render/glossy_lighting.h"
 #include "render/normal_mapping.h"
 #include "render/transparent_walk.h"
+#include "render/visible_lights.h"
 #include "sampling/frame.h"
 #include "sampling/sobol_owen.h"
 #include "sampling/warp.h"
@@ -256,32 +257,12 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
              : direct_lighting<true, false>(scene, s, ng, ns, f, &retro, depth, pixel, sample, settings);
 }
 
-// The radiance of the lights a camera (depth 0) or specular ray passes before distance `limit`
-// (in units of the unit direction), of those visible to that kind of ray. Lights are not
-// surfaces: as in Cycles, a ray that sees one goes on, so what is behind a light (another light,
-// a surface, the world) adds to it. A light at infinity (a sun, at FLT_MAX) is part of the world:
-// seen by a ray that leaves the scene (`escaped`), whatever the camera's clip end. bsdf_pdf > 0:
-// the ray was drawn by a glossy lobe with that density, and each lamp takes its power-heuristic
-// weight against the lamp sample glossy_direct_lighting took there.
-Vec3 visible_lights(const World& world, const Vec3& org, const Vec3& unit_dir, float from, float limit, bool escaped,
-                    bool camera, AreaSampling area_sampling, float bsdf_pdf) {
-  constexpr float kAtInfinity = std::numeric_limits<float>::max();
-  Vec3 radiance(0.0f);
-  for (size_t j = 0; j < world.lights.size(); ++j) {
-    const LightVisibility v = world.light_visibility[j];
-    if (!(camera ? v.camera : v.specular)) continue;
-    const LightEval e = evaluate_light(world.lights[j], org, unit_dir, area_sampling);
-    if (!e.hit()) continue;
-    if (!(e.distance == kAtInfinity ? escaped : (e.distance >= from && e.distance < limit))) continue;
-    radiance += bsdf_pdf > 0.0f ? e.radiance * power_heuristic(bsdf_pdf, e.pdf) : e.radiance;
-  }
-  return radiance;
-}
-
 // The radiance arriving along `ray`, whose first vertex is path vertex `depth` (0: the camera
 // ray), after `first_crossed` transparent surfaces. Recursive only where a Fresnel surface is
 // split, so at most split_depth levels deep.
-template <bool kCutOuts>
+// kNormalMaps: some material has a normal map (Scene::any_normal_map); false compiles the loop
+// without them, so other scenes run the code they ran before normal maps existed.
+template <bool kCutOuts, bool kNormalMaps>
 Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, uint32_t sample,
                 const IntegratorSettings& path_settings, FirstHit* first = nullptr, int first_crossed = 0) {
   static const Material kDefault = Lambert{};
@@ -318,8 +299,8 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     }
     SurfaceHit s = surface_at(scene, hit);
     const Vec3 wo = -glm::normalize(ray.dir);
-    if (scene.any_normal_map() && s.material >= 0 && size_t(s.material) < materials.size())
-      s.ns = normal_mapped(scene, hit, s.material, wo, s.ng, s.ns, s.uv);  // render/normal_mapping.h
+    [[maybe_unused]] const Vec3 smooth = s.ns;  // before a normal map bends it (render/normal_mapping.h)
+    if constexpr (kNormalMaps) s.ns = normal_mapped(scene, hit, s.material, wo, s.ng, s.ns, s.uv);
     // The geometric normal decides the side; the shading normal is turned to that side.
     const bool front = glm::dot(s.ng, wo) > 0.0f;
     const Vec3 ng = front ? s.ng : -s.ng;
@@ -362,7 +343,9 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
                               vertex_dimension(depth, kDimsPerVertex - 6)};
     const bool go_on = std::visit(
         [&](const auto& material) __attribute__((always_inline)) {
-          const Scatter sc = scatter(material, ShadingPoint{wo, s.ng, s.ns, s.uv}, ctx);
+          Scatter sc = scatter(material, ShadingPoint{wo, s.ng, s.ns, s.uv}, ctx);
+          if constexpr (kNormalMaps)
+            shadow_bumps(scene, s.material, sc, glm::dot(smooth, ng) >= 0 ? smooth : -smooth, ns, wo);
           if (sc.kind == Scatter::Kind::Diffuse) {
             if (first) first->diffuse = sc.f * kPi;  // f = albedo / pi
             // f by value: a reference into sc would make the whole answer (its glossy lobe and
@@ -419,7 +402,8 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
               const SpecularSample& branch = sc.branches[b];
               const Ray next{offset_ray_origin(s.p, branch.offset_normal), 0.0f, branch.wi, kInfinity};
               radiance += throughput * branch.weight * branch.probability *
-                          trace_from<kCutOuts>(scene, next, depth + 1, pixel, sample, settings, nullptr, cut.crossed());
+                          trace_from<kCutOuts, kNormalMaps>(scene, next, depth + 1, pixel, sample, settings, nullptr,
+                                                            cut.crossed());
             }
             return false;
           }
@@ -438,9 +422,13 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
 
 Vec3 trace_path(const Scene& scene, const Ray& camera_ray, uint32_t pixel, uint32_t sample,
                 const IntegratorSettings& settings, FirstHit* first) {
-  const Vec3 radiance = scene.any_transparency()
-                            ? trace_from<true>(scene, camera_ray, 0, pixel, sample, settings, first)
-                            : trace_from<false>(scene, camera_ray, 0, pixel, sample, settings, first);
+  const bool cut_outs = scene.any_transparency();
+  const Vec3 radiance =
+      scene.any_normal_map()
+          ? (cut_outs ? trace_from<true, true>(scene, camera_ray, 0, pixel, sample, settings, first)
+                      : trace_from<false, true>(scene, camera_ray, 0, pixel, sample, settings, first))
+          : (cut_outs ? trace_from<true, false>(scene, camera_ray, 0, pixel, sample, settings, first)
+                      : trace_from<false, false>(scene, camera_ray, 0, pixel, sample, settings, first));
   // A numerical failure anywhere (it should not happen) must not poison the pixel.
   if (!is_finite(radiance)) return Vec3(0.0f);
   return glm::max(radiance, Vec3(0.0f));

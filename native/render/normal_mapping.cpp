@@ -4,6 +4,7 @@ namespace toyrt {
 
 Vec3 normal_mapped(const Scene& scene, const Hit& hit, int32_t material, const Vec3& wo, const Vec3& ng, const Vec3& ns,
                    const Vec2& uv) {
+  if (material < 0 || size_t(material) >= scene.normal_maps().size()) return ns;
   const MaterialNormalMap& map = scene.normal_maps()[size_t(material)];
   if (!map.active()) return ns;
   const Instance& inst = scene.instance(uint32_t(hit.instance));
@@ -35,6 +36,7 @@ Vec3 normal_mapped(const Scene& scene, const Hit& hit, int32_t material, const V
     bent = normal_matrix * n;
   }
   const Vec3 unit = blend_normal_strength(map, bent, ns);
+  if (!map.lift) return glm::dot(unit, ng) >= 0.0f ? unit : -unit;  // the same normal, on ng's side
   // The reflection test on the side the ray arrives from, as Cycles' normals are turned there.
   const float side = glm::dot(ng, wo) >= 0.0f ? 1.0f : -1.0f;
   return side * valid_reflection_normal(side * ng, wo, side * unit);

@@ -2,7 +2,8 @@
 against closed forms: a Lambert floor under a sun, lit as albedo / pi x E x max(0, N'.L) with N'
 the normal a constant texel encodes (tangent frame T = x, B = sign y, N = z); a flat texel, a
 mesh without tangents and strength 0 render as no normal map; DirectX negates green; 3.x's and
-4.x+'s strength rules; a normal bent below the surface never gives NaN."""
+4.x+'s strength rules; a normal bent below the surface never gives NaN; Cycles' bump shadowing
+terms of 3.x (Chiang et al.) and 4.x+ (Conty Estevez et al.) as factors on that law."""
 import numpy as np
 import pytest
 import toyrt
@@ -31,7 +32,8 @@ def render(light_dir, n=None, tangents=True, sign=1.0, **normal):
     s = toyrt.Scene()
     args = {}
     if n is not None:
-        args = dict(normal_map=normal_texture(s, n), **normal)
+        args = dict(normal_map=normal_texture(s, n), normal_shadowing="none")
+        args.update(normal)
     s.add_material("diffuse", color=(ALBEDO,) * 3, **args)
     floor(s, 0, tangents, sign)
     s.add_light("SUN", matrix=aimed(-np.asarray(light_dir, float)), strength=SUN, angle=0.0)
@@ -104,6 +106,24 @@ def test_normal_bent_below_the_surface_is_lifted_not_nan():
     assert render(LIGHT, n) == pytest.approx(lambert(lifted, LIGHT), rel=1e-4)
 
 
+def test_bump_shadowing_terms_of_blender_3_and_4():
+    theta = 0.5
+    n = np.array([np.sin(theta), 0.0, np.cos(theta)])    # tilted towards the light: g < 1
+    z = np.array([0.0, 0.0, 1.0])
+    light = np.array(LIGHT)
+    plain = lambert(n, light)
+    # 3.x: g = (Ns.L) / ((N.L)(Ns.N)), factor -g^3 + g^2 + g below 1.
+    g = (z @ light) / ((n @ light) * (z @ n))
+    assert 0.0 < g < 1.0
+    assert render(LIGHT, n, normal_shadowing="chiang") == pytest.approx(plain * (g + g * g - g ** 3), rel=1e-5)
+    # 4.x+: GGX G1 at cos_i = Ns.L with alpha^2 = tan^2(theta) / 8.
+    a2, ci = np.tan(theta) ** 2 / 8.0, z @ light
+    g1 = 1.0 / (1.0 + 0.5 * (np.sqrt(1.0 + a2 * (1.0 / ci ** 2 - 1.0)) - 1.0))
+    assert render(LIGHT, n, normal_shadowing="conty") == pytest.approx(plain * g1, rel=1e-5)
+    # Flat texel: the normal is the smooth one, no factor.
+    assert render(LIGHT, (0, 0, 1), normal_shadowing="conty") == render(LIGHT)
+
+
 def test_bad_normal_map_arguments_are_refused_by_name():
     s = toyrt.Scene()
     with pytest.raises(ValueError, match="normal_map"):
@@ -113,6 +133,8 @@ def test_bad_normal_map_arguments_are_refused_by_name():
         s.add_material("diffuse", normal_map=t, normal_space="UV")
     with pytest.raises(ValueError, match="normal_convention"):
         s.add_material("diffuse", normal_map=t, normal_convention="D3D")
+    with pytest.raises(ValueError, match="normal_shadowing"):
+        s.add_material("diffuse", normal_map=t, normal_shadowing="soft")
     v = np.zeros((3, 3), np.float32)
     with pytest.raises(ValueError, match="tangents"):
         s.add_mesh(v, [[0, 1, 2]], tangents=np.zeros((2, 3, 4), np.float32))
