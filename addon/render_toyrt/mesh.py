@@ -107,8 +107,11 @@ def fingerprint(obj, bake: np.ndarray | None = None) -> bytes | None:
     data.vertices.foreach_get("co", co)
     h = hashlib.blake2b(co.tobytes(), digest_size=16)
     h.update(np.array([len(data.vertices), len(data.loops), len(data.polygons)], np.int64).tobytes())
-    # The materials are part of what is stored (material ids per triangle).
-    h.update("|".join(s.material.name_full if s.material else "" for s in obj.material_slots).encode())
+    # The materials are part of what is stored (material ids per triangle), and so are the tangents
+    # a material's normal map asks for (a Normal Map added since the last frame needs them).
+    from .material_normal import tangent_uv_map
+    h.update("|".join(f"{s.material.name_full}:{tangent_uv_map(s.material)}" if s.material else ""
+                      for s in obj.material_slots).encode())
     if bake is not None:
         h.update(np.ascontiguousarray(bake, np.float64).tobytes())
     return h.digest()

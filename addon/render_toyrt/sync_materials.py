@@ -6,6 +6,7 @@ id tables): it is here only to keep each file one concern. Nothing else uses it.
 from __future__ import annotations
 
 from . import materials
+from .material_normal import tangent_uv_map
 from .materials import PLACEHOLDER, PLACEHOLDER_PIXELS, ImageKey
 
 
@@ -26,14 +27,14 @@ class MaterialSync:
 
     def _tangent_uv_map(self, slot_materials: tuple) -> str | None:
         """The UV map whose tangents a mesh with these slot materials needs ('': the render-active
-        one), from their converted specs; None when none has a tangent-space normal map. One
-        tangent set per mesh: slots reading different UV maps get the first one's, noted."""
+        one), read from their node trees as they are now (a final render converts its materials
+        again after the meshes); None when none has a tangent-space normal map. One tangent set
+        per mesh: slots reading different UV maps get the first one's, noted."""
         wanted = []
         for mat in slot_materials:
-            self._material_id(mat)
-            bent = self.materials[mat.name_full if mat is not None else ""][1].normal_map
-            if bent is not None and bent.space == "TANGENT" and bent.uv_map not in wanted:
-                wanted.append(bent.uv_map)
+            uv_map = tangent_uv_map(mat)
+            if uv_map is not None and uv_map not in wanted:
+                wanted.append(uv_map)
         if len(wanted) > 1:
             self._note((f"normal maps of one mesh read UV maps {', '.join(repr(w) for w in wanted)} "
                         f"(tangents of {wanted[0]!r} for all)",))

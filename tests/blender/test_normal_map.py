@@ -171,6 +171,31 @@ def test_bad_input_keeps_the_surface_normal_with_a_note_and_renders():
           f"a missing UV map is noted per object: {notes}")
 
 
+def test_a_normal_map_added_between_renders_is_seen_by_the_next():
+    # F12 keeps its scene between renders and reuses a mesh whose fingerprint did not change: the
+    # tangents a new Normal Map needs are part of that fingerprint.
+    scene = kit.clear_scene()
+    kit.standard_view(scene)
+    kit.toyrt(scene, seed=0, samples=2)
+    mat = kit.diffuse("later", (0.7, 0.7, 0.7))
+    kit.plane("floor", 4.0, mat)
+    kit.sun_light("sun", 3.0, (-0.8, 0.3, -0.6))
+    kit.camera((0, -3, 3), (0, 0, 0))
+    kit.output(scene, 32, 24)
+    kit.float_exr(scene)
+    images = []
+    for i in range(2):
+        if i == 1:
+            kit.normal_map(mat, kit.bump_normal_image("late_bumps", slope=0.8))
+        path = os.path.join(TMP, f"later{i}.exr")
+        result, _ = render_still(path)
+        images.append(kit.read_image(path)[..., :3])
+    flat, bumpy = images
+    changed = float(np.abs(bumpy - flat).mean() / max(flat.mean(), 1e-6))
+    check(changed > 0.05, f"the second F12 shows the normal map added after the first (mean change {changed:.1%})")
+
+
 run_script([test_tangents_equal_calc_tangents_on_a_quad_mesh, test_tangents_of_a_mesh_with_an_ngon_are_the_closed_form,
-            test_normal_map_node_becomes_the_spec, test_bad_input_keeps_the_surface_normal_with_a_note_and_renders],
+            test_normal_map_node_becomes_the_spec, test_bad_input_keeps_the_surface_normal_with_a_note_and_renders,
+            test_a_normal_map_added_between_renders_is_seen_by_the_next],
            "normal_map", TMP)
