@@ -140,3 +140,36 @@ def test_bad_normal_map_arguments_are_refused_by_name():
         s.add_mesh(v, [[0, 1, 2]], tangents=np.zeros((2, 3, 4), np.float32))
     with pytest.raises(ValueError, match="tangents"):
         s.add_mesh(v, [[0, 1, 2]], tangents=np.full((1, 3, 4), np.nan, np.float32))
+
+
+@pytest.mark.parametrize("kind", ["diffuse", "principled", "glossy", "glass"])
+def test_strongly_bent_normals_on_a_sphere_give_no_nan_and_no_black_pixel(kind):
+    # A sphere seen whole (grazing rims included) under a uniform world, every texel bending the
+    # normal 80 degrees: the lift keeps each view's mirror above the surface, so every pixel of
+    # the sphere is finite and lit (a uniform world lights any direction above the surface).
+    s = toyrt.Scene()
+    s.background = (1.0, 1.0, 1.0)
+    extra = dict(roughness=0.3) if kind in ("principled", "glossy") else {}
+    s.add_material(kind, color=(0.8, 0.8, 0.8), normal_map=normal_texture(s, (np.sin(1.4), 0.0, np.cos(1.4))),
+                   normal_shadowing="conty", **extra)
+    rings, segs, centre = 16, 32, np.array([0.0, 0.0, 1.0])
+    th, ph = np.meshgrid(np.linspace(0, np.pi, rings + 1), np.linspace(0, 2 * np.pi, segs, endpoint=False),
+                         indexing="ij")
+    n = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1).reshape(-1, 3)
+    east = np.stack([-np.sin(ph), np.cos(ph), np.zeros_like(ph)], -1).reshape(-1, 3)
+    idx = lambda i, j: i * segs + j % segs  # noqa: E731
+    tris = [(idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)) for i in range(rings) for j in range(segs)]
+    tris += [(idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)) for i in range(rings) for j in range(segs)]
+    uv = np.stack([ph / (2 * np.pi), 1.0 - th / np.pi], -1).reshape(-1, 2)
+    tangents = np.concatenate([east, np.ones((len(east), 1))], 1)
+    s.add_mesh((0.8 * n + centre).astype(np.float32), tris, normals=n.astype(np.float32), uvs=uv.astype(np.float32),
+               tangents=tangents.astype(np.float32), material_ids=0)
+    s.commit()
+    m = np.eye(4)
+    m[:3, 3] = (0.0, 0.0, 6.0)   # looking down -Z at the sphere from above
+    img = s.render(dict(type="ORTHO", ortho_scale=2.0, resolution_x=24, resolution_y=24, matrix_world=m,
+                        clip_start=0.1, clip_end=100.0), samples=16, max_specular_depth=4)[..., :3]
+    assert np.isfinite(img).all()
+    y, x = np.mgrid[0:24, 0:24]
+    on_sphere = ((x + 0.5 - 12) ** 2 + (y + 0.5 - 12) ** 2) < (0.8 * 12 * 0.97) ** 2
+    assert (img[on_sphere].max(axis=1) > 0.0).all(), f"black pixels: {np.count_nonzero(img[on_sphere].max(axis=1) == 0)}"
