@@ -186,7 +186,6 @@ class SceneSync(MaterialSync):
         self.counters["walks"] += 1
         placed, seen, exported_now, light_specs = [], set(), set(), []
         links = read_links(depsgraph)  # Blender 4.0+'s light linking (empty without it)
-        self._note(links.notes)
         tables = passes.PassTables(depsgraph.view_layer if fingerprints else None, self.pass_tables.hashes)
         used_materials = {}
         tri_instanced = 0
@@ -203,6 +202,7 @@ class SceneSync(MaterialSync):
             for k, e in pool.items():
                 if e[2] is not None:  # identical copies (objects with the same modifiers) share a list
                     by_fingerprint.setdefault(e[2], []).append(k)
+        self._note(links.notes)  # after the final render's reset of the notes above
         poll = self._should_cancel
         for n, inst in enumerate(depsgraph.object_instances):
             if poll is not None and n % _POLL_EVERY == 0 and poll():
