@@ -28,10 +28,15 @@ class Visibility:
     visible_specular: bool = True
     visible_diffuse: bool = True
     cast_shadow: bool = True
+    # Light linking (4.0+, light_linking.py): masks of the receiver sets it lights and of the
+    # blocker sets that shadow it; all bits: not linked.
+    receiver_sets: int = (1 << 64) - 1
+    blocker_sets: int = (1 << 64) - 1
 
     def arguments(self) -> dict:
+        linked = {k: getattr(self, k) for k in ("receiver_sets", "blocker_sets") if getattr(self, k) != (1 << 64) - 1}
         return dict(visible_camera=self.visible_camera, visible_specular=self.visible_specular,
-                    visible_diffuse=self.visible_diffuse, cast_shadow=self.cast_shadow)
+                    visible_diffuse=self.visible_diffuse, cast_shadow=self.cast_shadow, **linked)
 
 
 @dataclass(frozen=True)

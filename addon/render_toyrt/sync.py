@@ -35,6 +35,7 @@ import numpy as np
 
 from . import materials, passes
 from .camera import export_camera
+from .light_linking import linked_light, read_links
 from .lights import LightSpec, light_spec
 from .materials import ImageKey
 from .mesh import (
@@ -184,6 +185,7 @@ class SceneSync(MaterialSync):
         t0 = time.perf_counter()
         self.counters["walks"] += 1
         placed, seen, exported_now, light_specs = [], set(), set(), []
+        links = read_links(depsgraph)  # Blender 4.0+'s light linking (empty without it)
         tables = passes.PassTables(depsgraph.view_layer if fingerprints else None, self.pass_tables.hashes)
         used_materials = {}
         tri_instanced = 0
@@ -200,6 +202,7 @@ class SceneSync(MaterialSync):
             for k, e in pool.items():
                 if e[2] is not None:  # identical copies (objects with the same modifiers) share a list
                     by_fingerprint.setdefault(e[2], []).append(k)
+        self._note(links.notes)  # after the final render's reset of the notes above
         poll = self._should_cancel
         for n, inst in enumerate(depsgraph.object_instances):
             if poll is not None and n % _POLL_EVERY == 0 and poll():
@@ -212,6 +215,8 @@ class SceneSync(MaterialSync):
                 spec, notes = light_spec(obj, to_array(inst.matrix_world))
                 self._note(notes)
                 if spec is not None:
+                    if not links.empty and obj.name in links.receiver_sets.keys() | links.blocker_sets.keys():
+                        spec = linked_light(spec, links, obj.name)
                     light_specs.append(spec)
                 continue
             if otype not in RENDERABLE:
@@ -255,7 +260,9 @@ class SceneSync(MaterialSync):
             if entry[0] >= 0:
                 if owner is not None and bake is None:
                     owners.setdefault(owner, []).append(len(placed))
-                placed.append((entry[0], _IDENTITY if bake is not None else matrix, casts_shadow(inst, obj)))
+                flags = casts_shadow(inst, obj) if links.empty else (casts_shadow(inst, obj),
+                                                                     *links.instance_sets(obj.name))
+                placed.append((entry[0], _IDENTITY if bake is not None else matrix, flags))
                 tables.add(obj)
                 tri_instanced += entry[1]
 
@@ -366,8 +373,13 @@ class SceneSync(MaterialSync):
                     self.counters["transforms_set"] += 1
         else:
             self.scene.clear_instances()
-            for mid, matrix, shadow in placed:
-                self.scene.add_instance(mid, matrix, visible_shadow=shadow)
+            for mid, matrix, flags in placed:
+                # flags: visible_shadow, or with light linking (visible_shadow, receiver set, blocker set)
+                if isinstance(flags, tuple):
+                    self.scene.add_instance(mid, matrix, visible_shadow=flags[0], receiver_set=flags[1],
+                                            blocker_set=flags[2])
+                else:
+                    self.scene.add_instance(mid, matrix, visible_shadow=flags)
             self.counters["instance_resets"] += 1
         self.placed = [(mid, matrix.tobytes(), shadow) for mid, matrix, shadow in placed]
 
@@ -393,6 +405,8 @@ class SceneSync(MaterialSync):
             if spec.background_lighting is not None:
                 self.scene.background_lighting = spec.background_lighting
             self.scene.background_visible_camera = spec.visible_camera
+            self.scene.background_visible_glossy = spec.visible_glossy
+            self.scene.background_visible_transmission = spec.visible_transmission
             if spec.environment is None:
                 self.scene.set_environment(-1)
             else:

@@ -31,6 +31,8 @@ class WorldSpec:
     notes: tuple[str, ...] = ()
     environment: EnvironmentSpec | None = None
     visible_camera: bool = True              # camera rays see it (world.cycles_visibility.camera)
+    visible_glossy: bool = True              # reflections see it (.glossy)
+    visible_transmission: bool = True        # rays through glass see it (.transmission)
 
 
 def world_spec(bl_scene) -> WorldSpec:
@@ -44,9 +46,12 @@ def world_spec(bl_scene) -> WorldSpec:
     # Cycles lights diffuse surfaces with the world unless its diffuse ray visibility is off.
     visibility = getattr(world, "cycles_visibility", None)
     lighting = bool(getattr(visibility, "diffuse", True))
-    camera = bool(getattr(visibility, "camera", True))
+    # Camera, glossy and transmission: which rays leaving the scene see it (black otherwise).
+    seen = dict(visible_camera=bool(getattr(visibility, "camera", True)),
+                visible_glossy=bool(getattr(visibility, "glossy", True)),
+                visible_transmission=bool(getattr(visibility, "transmission", True)))
     if not getattr(world, "use_nodes", False) or world.node_tree is None:
-        return WorldSpec(rgb(world.color), lighting, visible_camera=camera)
+        return WorldSpec(rgb(world.color), lighting, **seen)
     out = output_node(world.node_tree, "OUTPUT_WORLD")
     node = linked_node(input_socket(out, "Surface")) if out is not None else None
     if node is not None and node.type == "BACKGROUND":
@@ -54,7 +59,7 @@ def world_spec(bl_scene) -> WorldSpec:
         if not strength.is_linked:
             s = float(strength.default_value)
             if not color.is_linked:
-                return WorldSpec(tuple(c * s for c in rgb(color.default_value)), lighting, visible_camera=camera)
+                return WorldSpec(tuple(c * s for c in rgb(color.default_value)), lighting, **seen)
             source = linked_node(color)
             kind = source.type if source is not None else None
             if kind in ("TEX_ENVIRONMENT", "TEX_SKY"):
@@ -62,9 +67,9 @@ def world_spec(bl_scene) -> WorldSpec:
 
                 notes: list[str] = []
                 env = (_environment if kind == "TEX_ENVIRONMENT" else sky_environment)(world.name, source, s, notes)
-                return WorldSpec((0.0, 0.0, 0.0), lighting, tuple(notes), env, visible_camera=camera)
+                return WorldSpec((0.0, 0.0, 0.0), lighting, tuple(notes), env, **seen)
     return WorldSpec((0.0, 0.0, 0.0), lighting, (f"world '{world.name}': not a plain colour (black)",),
-                     visible_camera=camera)
+                     **seen)
 
 
 def _environment(name, node, strength, notes) -> EnvironmentSpec:

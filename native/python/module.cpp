@@ -169,6 +169,8 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       type_docs<Light>() +
       "visible_camera / visible_specular: whether camera rays / rays through glass see the light itself;\n"
       "visible_diffuse: whether it lights diffuse surfaces; cast_shadow: whether surfaces shadow it.\n"
+      "receiver_sets / blocker_sets: light linking, 64-bit masks of the instances' receiver_set / blocker_set\n"
+      "it lights / whose instances shadow it (all bits set: no linking; add_instance).\n"
       "An unknown type or keyword raises ValueError naming it; None leaves a parameter at its default.";
   static const std::string material_doc =
       "Adds a material; returns its id. kind and its parameters (other keywords than color, texture and ior\n"
@@ -212,14 +214,15 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       .def(
           "add_light",
           [](PyScene& self, const std::string& type, bool visible_camera, bool visible_specular, bool visible_diffuse,
-             bool cast_shadow, const py::kwargs& params) {
-            return self.add_light(type, to_params(params),
-                                  {visible_camera, visible_specular, visible_diffuse, cast_shadow});
+             bool cast_shadow, uint64_t receiver_sets, uint64_t blocker_sets, const py::kwargs& params) {
+            return self.add_light(
+                type, to_params(params),
+                {visible_camera, visible_specular, visible_diffuse, cast_shadow, receiver_sets, blocker_sets});
           },
           py::arg("type"), py::arg("visible_camera") = LightVisibility{}.camera,
           py::arg("visible_specular") = LightVisibility{}.specular,
           py::arg("visible_diffuse") = LightVisibility{}.diffuse, py::arg("cast_shadow") = LightVisibility{}.shadow,
-          light_doc.c_str())
+          py::arg("receiver_sets") = kAllLightSets, py::arg("blocker_sets") = kAllLightSets, light_doc.c_str())
       .def(
           "add_point_light",
           [](PyScene& self, py::handle position, float power, py::handle color, float radius, bool visible_camera,
@@ -273,6 +276,14 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
                     "Whether camera rays that leave the scene see the background (default True; Blender's\n"
                     "world.cycles_visibility.camera). Off, they see black, still opaque, as in Cycles; rays through\n"
                     "glass or off glossy surfaces, and the lighting, are unchanged.")
+      .def_property("background_visible_glossy", &PyScene::background_visible_glossy,
+                    &PyScene::set_background_visible_glossy,
+                    "Whether rays reflected by glossy and mirror surfaces see the background (default True;\n"
+                    "world.cycles_visibility.glossy). Off, reflections of the world are black, as in Cycles.")
+      .def_property("background_visible_transmission", &PyScene::background_visible_transmission,
+                    &PyScene::set_background_visible_transmission,
+                    "Whether rays refracted through glass see the background (default True;\n"
+                    "world.cycles_visibility.transmission). Off, the world seen through glass is black.")
       .def("render", &PyScene::render, py::arg("camera"), py::arg("samples") = RenderSettings{}.samples,
            py::arg("seed") = IntegratorSettings{}.seed,
            py::arg("max_specular_depth") = IntegratorSettings{}.max_specular_depth,
@@ -321,11 +332,14 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       .def("clear_instances", &PyScene::clear_instances,
            "Removes every instance (meshes stay, with their BVHs), to place them again.")
       .def("add_instance", &PyScene::add_instance, py::arg("mesh"), py::arg("transform"),
-           py::arg("visible_shadow") = Instance{}.visible_shadow,
+           py::arg("visible_shadow") = Instance{}.visible_shadow, py::arg("receiver_set") = 0,
+           py::arg("blocker_set") = 0,
            "Places mesh `mesh` again with a (4, 4) row-major affine world matrix; returns the instance id.\n"
            "visible_shadow: Blender's Object.visible_shadow; False, the instance casts no shadow in a render\n"
            "(its light-sampled shadow rays pass it), while camera, glossy and glass rays and the ray queries\n"
-           "(intersect, occluded, ...) still see it.")
+           "(intersect, occluded, ...) still see it. receiver_set / blocker_set (0-63): its light-linking sets:\n"
+           "lamps light it when their receiver_sets has bit receiver_set, and it shadows lamps whose\n"
+           "blocker_sets has bit blocker_set (add_light).")
       .def("commit", &PyScene::commit, py::arg("builder") = builder_name(CommitOptions{}.builder),
            py::arg("threads") = CommitOptions{}.threads, py::arg("expected_rays") = py::none(),
            py::arg("should_cancel") = py::none(),

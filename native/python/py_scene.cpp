@@ -32,9 +32,10 @@ void PyScene::replace_mesh(int64_t mesh, py::handle vertices, py::handle triangl
   write([&] { scene_.replace_mesh(mesh, std::move(verts), std::move(tris), std::move(shading)); });
 }
 
-uint32_t PyScene::add_instance(int64_t mesh, py::handle transform, bool visible_shadow) {
+uint32_t PyScene::add_instance(int64_t mesh, py::handle transform, bool visible_shadow, int receiver_set,
+                               int blocker_set) {
   const Mat4 m = to_matrix(transform, "transform");
-  return write([&] { return scene_.add_instance(mesh, m, visible_shadow); });
+  return write([&] { return scene_.add_instance(mesh, m, visible_shadow, receiver_set, blocker_set); });
 }
 
 void PyScene::set_instance_transform(int64_t instance, py::handle transform) {
@@ -161,6 +162,22 @@ void PyScene::set_background_visible_camera(bool on) {
 
 bool PyScene::background_visible_camera() {
   return read([&] { return scene_.world().background_visible_camera; });
+}
+
+void PyScene::set_background_visible_glossy(bool on) {
+  write([&] { scene_.set_background_visible_glossy(on); });
+}
+
+bool PyScene::background_visible_glossy() {
+  return read([&] { return scene_.world().background_visible_glossy; });
+}
+
+void PyScene::set_background_visible_transmission(bool on) {
+  write([&] { scene_.set_background_visible_transmission(on); });
+}
+
+bool PyScene::background_visible_transmission() {
+  return read([&] { return scene_.world().background_visible_transmission; });
 }
 
 bool PyScene::commit(const std::string& builder, int threads, py::handle expected_rays, py::object should_cancel) {

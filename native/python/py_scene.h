@@ -24,7 +24,7 @@ class PyScene {
                     py::handle material_ids, bool instance, py::handle tangents);
   void replace_mesh(int64_t mesh, py::handle vertices, py::handle triangles, py::handle normals, py::handle uvs,
                     py::handle material_ids, py::handle tangents);
-  uint32_t add_instance(int64_t mesh, py::handle transform, bool visible_shadow);
+  uint32_t add_instance(int64_t mesh, py::handle transform, bool visible_shadow, int receiver_set, int blocker_set);
   void set_instance_transform(int64_t instance, py::handle transform);
   void clear_instances();
 
@@ -42,6 +42,10 @@ class PyScene {
   bool background_lighting();
   void set_background_visible_camera(bool on);
   bool background_visible_camera();
+  void set_background_visible_glossy(bool on);
+  bool background_visible_glossy();
+  void set_background_visible_transmission(bool on);
+  bool background_visible_transmission();
   void set_environment(int64_t texture, py::handle strength, py::handle matrix);
 
   bool commit(const std::string& builder, int threads, py::handle expected_rays, py::object should_cancel);

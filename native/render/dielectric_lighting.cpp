@@ -11,7 +11,7 @@ namespace toyrt {
 
 DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& ng, const DielectricLobe& lobe,
                                  uint32_t pixel, uint32_t sample, uint32_t light_dim, uint32_t lobe_dim,
-                                 uint32_t side_dim, const IntegratorSettings& settings) {
+                                 uint32_t side_dim, const IntegratorSettings& settings, uint8_t receiver_set) {
   DielectricStep step;
   const Vec3 above = offset_ray_origin(p, ng), below = offset_ray_origin(p, -ng);
   const World& world = scene.world();
@@ -19,7 +19,8 @@ DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& 
     // Lamps seen through or in glass are those visible to specular rays (Cycles' glossy and
     // transmission visibility, one flag here), for their light as for their image.
     const LightVisibility v = world.light_visibility[j];
-    if (!v.specular) continue;
+    // Light linking: a lamp that does not light this object adds nothing (lights/light_linking.h).
+    if (!v.specular || !in_light_sets(v.receiver_sets, receiver_set)) continue;
     const LightSample ls =
         sample_light(world.lights[j], p, sobol_owen_2d(pixel, sample, light_dim + uint32_t(j), settings.seed),
                      settings.area_sampling);
@@ -34,7 +35,7 @@ DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& 
     if (v.shadow) {
       const Ray shadow =
           std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
-      if (!shadow_passes(scene, shadow, settings.transparent_max_bounces, tr)) continue;
+      if (!shadow_passes(scene, shadow, settings.transparent_max_bounces, tr, v.blocker_sets)) continue;
     }
     const float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, e.pdf);
     step.radiance += e.f * ls.radiance * tr * (std::abs(cos_i) * w / ls.pdf);

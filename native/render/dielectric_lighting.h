@@ -29,6 +29,6 @@ struct DielectricStep {
 [[gnu::noinline]] DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& ng,
                                                    const DielectricLobe& lobe, uint32_t pixel, uint32_t sample,
                                                    uint32_t light_dim, uint32_t lobe_dim, uint32_t side_dim,
-                                                   const IntegratorSettings& settings);
+                                                   const IntegratorSettings& settings, uint8_t receiver_set = 0);
 
 }  // namespace toyrt

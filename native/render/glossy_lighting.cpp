@@ -9,14 +9,15 @@ namespace toyrt {
 
 Vec3 glossy_direct_lighting(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng,
                             const GlossyLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t first_dim,
-                            const IntegratorSettings& settings) {
+                            const IntegratorSettings& settings, uint8_t receiver_set) {
   const World& world = scene.world();
   Vec3 sum(0.0f);
   for (size_t j = 0; j < world.lights.size(); ++j) {
     // The lamps a glossy reflection shows are those visible to specular rays (Cycles' glossy
     // ray visibility), for their light as for their image.
     const LightVisibility v = world.light_visibility[j];
-    if (!v.specular) continue;
+    // Light linking: a lamp that does not light this object adds nothing (lights/light_linking.h).
+    if (!v.specular || !in_light_sets(v.receiver_sets, receiver_set)) continue;
     const LightSample ls =
         sample_light(world.lights[j], p, sobol_owen_2d(pixel, sample, first_dim + uint32_t(j), settings.seed),
                      settings.area_sampling);
@@ -28,7 +29,7 @@ Vec3 glossy_direct_lighting(const Scene& scene, const Vec3& p, const Vec3& origi
     if (v.shadow) {
       const Ray shadow =
           std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
-      if (!shadow_passes(scene, shadow, settings.transparent_max_bounces, tr)) continue;
+      if (!shadow_passes(scene, shadow, settings.transparent_max_bounces, tr, v.blocker_sets)) continue;
     }
     // A delta lamp cannot be hit by the continuation ray: its sample is the only strategy.
     const float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, e.pdf);
@@ -39,9 +40,9 @@ Vec3 glossy_direct_lighting(const Scene& scene, const Vec3& p, const Vec3& origi
 
 GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng, const GlossyLobe& lobe,
                          uint32_t pixel, uint32_t sample, uint32_t light_dim, uint32_t lobe_dim,
-                         const IntegratorSettings& settings) {
+                         const IntegratorSettings& settings, uint8_t receiver_set) {
   GlossyStep step;
-  step.radiance = glossy_direct_lighting(scene, p, origin, ng, lobe, pixel, sample, light_dim, settings);
+  step.radiance = glossy_direct_lighting(scene, p, origin, ng, lobe, pixel, sample, light_dim, settings, receiver_set);
   const BsdfSample g = sample_lobe(lobe, sobol_owen_2d(pixel, sample, lobe_dim, settings.seed));
   if (!(g.pdf > 0.0f) || glm::dot(g.wi, ng) <= 0.0f) return step;
   step.wi = g.wi;

@@ -26,7 +26,7 @@ inline float power_heuristic(float pdf, float other) {
 // wo's side. Lamp j draws its sample from Sobol-Owen dimension first_dim + j.
 Vec3 glossy_direct_lighting(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng,
                             const GlossyLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t first_dim,
-                            const IntegratorSettings& settings);
+                            const IntegratorSettings& settings, uint8_t receiver_set = 0);
 
 // A glossy vertex's whole work: its lamps' light (glossy_direct_lighting, lamp j from dimension
 // light_dim + j) and the continuation the lobe draws from dimension lobe_dim: direction, weight
@@ -40,6 +40,7 @@ struct GlossyStep {
 };
 [[gnu::noinline]] GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng,
                                            const GlossyLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t light_dim,
-                                           uint32_t lobe_dim, const IntegratorSettings& settings);
+                                           uint32_t lobe_dim, const IntegratorSettings& settings,
+                                           uint8_t receiver_set = 0);
 
 }  // namespace toyrt

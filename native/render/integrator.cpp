@@ -29,6 +29,7 @@ struct SurfaceHit {
   Vec3 ns;  // unit shading normal, world space
   Vec2 uv{0.0f};
   int32_t material = -1;
+  uint8_t receiver_set = 0;  // the instance's light-linking receiver set (lights/light_linking.h)
 };
 
 // Out of line on purpose: inlined into trace_from (as GCC chose once nothing else called it) it
@@ -55,6 +56,7 @@ struct SurfaceHit {
   }
   if (!sh.corner_uvs.empty()) s.uv = w * sh.corner_uvs[c] + hit.u * sh.corner_uvs[c + 1] + hit.v * sh.corner_uvs[c + 2];
   if (!sh.material_ids.empty()) s.material = sh.material_ids[size_t(hit.prim)];
+  s.receiver_set = inst.receiver_set;
   return s;
 }
 
@@ -203,7 +205,10 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
   Vec3 sum(0.0f);
   auto add = [&](size_t index, float select_probability, uint32_t dim) {
     const LightVisibility v = world.light_visibility[index];
-    if (!v.diffuse) return;
+    // Light linking: a light that does not light this object adds nothing. Zeroed here rather
+    // than left out of the selection: the same mean as Cycles, which leaves it out
+    // (docs/lights.md); unlinked scenes have full masks and always pass.
+    if (!v.diffuse || !in_light_sets(v.receiver_sets, s.receiver_set)) return;
     const LightSample ls =
         sample_light(world.lights[index], s.p,
                      sobol_owen_2d(pixel, sample, vertex_dimension(depth, dim), settings.seed), settings.area_sampling);
@@ -216,7 +221,8 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
       // light at infinity (the sun) leaves the scene along wi.
       const Ray shadow =
           std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
-      if (kCutOuts ? !shadow_passes(scene, shadow, settings.transparent_max_bounces, tr) : scene.shadowed(shadow))
+      if (kCutOuts ? !shadow_passes(scene, shadow, settings.transparent_max_bounces, tr, v.blocker_sets)
+                   : scene.shadowed(shadow, v.blocker_sets))
         return;
     }
     sum += diffuse_f<kBurley>(at, retro, ls.wi) * ls.radiance * tr * (cos_s / (ls.pdf * select_probability));
@@ -257,14 +263,22 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
              : direct_lighting<true, false>(scene, s, ng, ns, f, &retro, depth, pixel, sample, settings);
 }
 
+// The kind of ray that leaves a surface along wi, on the side of ng the path came from: a
+// reflection (glossy, as Cycles' path flags) or a refraction (transmission).
+RayKind kind_towards(const Vec3& wi, const Vec3& ng) {
+  return glm::dot(wi, ng) > 0.0f ? RayKind::Glossy : RayKind::Transmission;
+}
+
 // The radiance arriving along `ray`, whose first vertex is path vertex `depth` (0: the camera
-// ray), after `first_crossed` transparent surfaces. Recursive only where a Fresnel surface is
-// split, so at most split_depth levels deep.
+// ray), after `first_crossed` transparent surfaces; `first_kind` is the ray's kind for the
+// world's visibility. Recursive only where a Fresnel surface is split, so at most split_depth
+// levels deep.
 // kNormalMaps: some material has a normal map (Scene::any_normal_map); false compiles the loop
 // without them, so other scenes run the code they ran before normal maps existed.
 template <bool kCutOuts, bool kNormalMaps>
 Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, uint32_t sample,
-                const IntegratorSettings& path_settings, FirstHit* first = nullptr, int first_crossed = 0) {
+                const IntegratorSettings& path_settings, FirstHit* first = nullptr, int first_crossed = 0,
+                RayKind first_kind = RayKind::Camera, uint8_t first_receiver = 0) {
   static const Material kDefault = Lambert{};
   const World& world = scene.world();
   const std::vector<Material>& materials = scene.materials();
@@ -274,6 +288,8 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
   // for the emission it finds and shades nothing there).
   float bsdf_pdf = 0.0f;
   bool light_only = false;
+  RayKind kind = first_kind;
+  uint8_t receiver = first_receiver;             // the light-linking receiver set of the ray's last vertex (0: camera)
   CutOutPath cut(path_settings, first_crossed);  // kCutOuts only (render/transparent_walk.h)
   for (int depth = first_depth;; ++depth) {
     const IntegratorSettings& settings = kCutOuts ? cut.settings() : path_settings;
@@ -283,12 +299,12 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     if (!world.lights.empty()) {
       const float length = glm::length(ray.dir);
       lamps = visible_lights(world, ray.org, ray.dir / length, ray.tnear * length, std::min(hit.t, ray.tfar) * length,
-                             !hit.found(), bounce == 0, settings.area_sampling, bsdf_pdf);
+                             !hit.found(), bounce == 0, settings.area_sampling, bsdf_pdf, receiver);
       radiance += throughput * lamps;
     }
     if (!hit.found()) {
       if (first) first->emission = lamps;
-      if (bounce == 0 && !world.background_visible_camera) break;
+      if (!background_visible(world, kind)) break;
       const Environment& env = world.environment;
       const Vec3 seen = env.active()
                             ? environment_radiance(env, scene.textures()[size_t(env.texture)], glm::normalize(ray.dir))
@@ -372,26 +388,31 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             const Vec3 origin = offset_ray_origin(s.p, ng);
             const GlossyStep g =
                 glossy_vertex(scene, s.p, origin, ng, sc.glossy, pixel, sample, vertex_dimension(depth, 1),
-                              vertex_dimension(depth, kDimsPerVertex - 5), settings);
+                              vertex_dimension(depth, kDimsPerVertex - 5), settings, s.receiver_set);
             radiance += throughput * g.radiance;
             if (!(g.pdf > 0.0f)) return false;
             throughput *= g.weight;
             bsdf_pdf = g.pdf;
             light_only = bounce >= settings.max_specular_depth;
+            kind = RayKind::Glossy;
+            receiver = s.receiver_set;
             ray = Ray{origin, 0.0f, g.wi, kInfinity};
             return true;
           }
           if (sc.kind == Scatter::Kind::Dielectric) {
             // Lamps on both sides, then a reflection or a transmission: as a glossy vertex, with
             // the side chosen on the lobe-choice dimension.
-            const DielectricStep g = dielectric_vertex(
-                scene, s.p, ng, sc.dielectric, pixel, sample, vertex_dimension(depth, 1),
-                vertex_dimension(depth, kDimsPerVertex - 5), vertex_dimension(depth, kDimsPerVertex - 6), settings);
+            const DielectricStep g =
+                dielectric_vertex(scene, s.p, ng, sc.dielectric, pixel, sample, vertex_dimension(depth, 1),
+                                  vertex_dimension(depth, kDimsPerVertex - 5),
+                                  vertex_dimension(depth, kDimsPerVertex - 6), settings, s.receiver_set);
             radiance += throughput * g.radiance;
             if (!(g.pdf > 0.0f)) return false;
             throughput *= g.weight;
             bsdf_pdf = g.pdf;
             light_only = bounce >= settings.max_specular_depth;
+            kind = kind_towards(g.wi, ng);
+            receiver = s.receiver_set;
             ray = Ray{g.origin, 0.0f, g.wi, kInfinity};
             return true;
           }
@@ -403,11 +424,13 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
               const Ray next{offset_ray_origin(s.p, branch.offset_normal), 0.0f, branch.wi, kInfinity};
               radiance += throughput * branch.weight * branch.probability *
                           trace_from<kCutOuts, kNormalMaps>(scene, next, depth + 1, pixel, sample, settings, nullptr,
-                                                            cut.crossed());
+                                                            cut.crossed(), kind_towards(branch.wi, ng), s.receiver_set);
             }
             return false;
           }
           throughput *= sc.branches[0].weight;
+          kind = kind_towards(sc.branches[0].wi, ng);
+          receiver = s.receiver_set;
           ray = Ray{offset_ray_origin(s.p, sc.branches[0].offset_normal), 0.0f, sc.branches[0].wi, kInfinity};
           return true;
         },

@@ -34,9 +34,10 @@ CrossedSurface crossed_surface(const Scene& scene, const Hit& hit);
 Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng);
 
 // The product of the transparent weights along `ray`, or 0 when it is blocked; at most `budget`
-// transparent surfaces pass. casters_only: a shadow ray (instances that cast shadows), else a
-// path ray (every instance).
-[[gnu::noinline]] Vec3 transmittance_walk(const Scene& scene, const Ray& ray, int budget, bool casters_only);
+// transparent surfaces pass. casters_only: a shadow ray (instances that cast shadows, among the
+// blocker sets `blockers` of light linking), else a path ray (every instance).
+[[gnu::noinline]] Vec3 transmittance_walk(const Scene& scene, const Ray& ray, int budget, bool casters_only,
+                                          uint64_t blockers = kAllLightSets);
 
 // At a surface with a transparent part: whether the path passes through. The transparent
 // closure is drawn on the uniform number u with probability its share of the weights, as Cycles
@@ -48,8 +49,9 @@ Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng);
 // The nearest hit along `ray` on a surface that is not cut out, multiplying `tr` by what the cut-
 // outs before it let through (0 past `budget` of them, or at one that lets nothing through: then
 // the hit is the one that blocked); nearest_past_cut_outs is scene.intersect(ray) when the scene
-// has no transparent material. casters_only: among the instances that cast shadows.
-[[gnu::noinline]] Hit walk_to_opaque(const Scene& scene, Ray ray, int budget, Vec3& tr, bool casters_only = false);
+// has no transparent material. casters_only: among the instances that cast shadows (in `blockers`).
+[[gnu::noinline]] Hit walk_to_opaque(const Scene& scene, Ray ray, int budget, Vec3& tr, bool casters_only = false,
+                                     uint64_t blockers = kAllLightSets);
 inline Hit nearest_past_cut_outs(const Scene& scene, const Ray& ray, int budget, Vec3& tr) {
   if (!scene.any_transparency()) return scene.intersect(ray);
   return walk_to_opaque(scene, ray, budget, tr);
@@ -91,10 +93,11 @@ class CutOutPath {
 };
 
 // The render's shadow query: whether light arrives along `ray`, multiplying `tr` by what the
-// surfaces passed let through (left alone without transparency in the scene).
-inline bool shadow_passes(const Scene& scene, const Ray& ray, int budget, Vec3& tr) {
-  if (!scene.any_transparency()) return !scene.shadowed(ray);
-  tr *= transmittance_walk(scene, ray, budget, true);
+// surfaces passed let through (left alone without transparency in the scene). `blockers`: the
+// light's blocker sets (light linking; all by default).
+inline bool shadow_passes(const Scene& scene, const Ray& ray, int budget, Vec3& tr, uint64_t blockers = kAllLightSets) {
+  if (!scene.any_transparency()) return !scene.shadowed(ray, blockers);
+  tr *= transmittance_walk(scene, ray, budget, true, blockers);
   return tr != Vec3(0.0f);
 }
 

@@ -4,6 +4,8 @@
 
 #include "core/bbox.h"
 
+#include <cstdint>
+
 namespace toyrt {
 
 struct Instance {
@@ -15,6 +17,10 @@ struct Instance {
   // Blender's Object.visible_shadow: whether the instance blocks the render's shadow rays
   // (Scene::shadowed). Camera, glossy and glass rays and the ray API's queries see it regardless.
   bool visible_shadow = true;
+  // Light linking (lights/light_linking.h): the receiver set whose lights light it and the blocker
+  // set whose lights it shadows; 0 for an object no light's collection names.
+  uint8_t receiver_set = 0;
+  uint8_t blocker_set = 0;
 };
 
 }  // namespace toyrt

@@ -48,8 +48,12 @@ Mat4 Scene::checked_inverse(const Mat4& to_world) {
   return to_object;
 }
 
-uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world, bool visible_shadow) {
+uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world, bool visible_shadow, int receiver_set,
+                             int blocker_set) {
   check_mesh_id(mesh);
+  if (receiver_set < 0 || receiver_set >= kLightSets || blocker_set < 0 || blocker_set >= kLightSets)
+    throw std::invalid_argument("light-linking set must be in [0, 64): receiver_set " + std::to_string(receiver_set) +
+                                ", blocker_set " + std::to_string(blocker_set));
   const Mat4 to_object = checked_inverse(to_world);
   Instance inst;
   inst.mesh = uint32_t(mesh);
@@ -57,6 +61,8 @@ uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world, bool visible_sh
   inst.to_object = to_object;
   inst.identity = to_world == Mat4(1.0f);
   inst.visible_shadow = visible_shadow;
+  inst.receiver_set = uint8_t(receiver_set);
+  inst.blocker_set = uint8_t(blocker_set);
   instances_.push_back(inst);
   committed_ = false;
   return uint32_t(instances_.size() - 1);
@@ -313,7 +319,7 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
 }
 
 template <bool AnyHit, bool ShadowCastersOnly>
-bool Scene::trace(const Ray& ray, Hit& hit) const {
+bool Scene::trace(const Ray& ray, Hit& hit, uint64_t blockers) const {
   if (!is_finite(ray.org) || !is_finite(ray.dir) || ray.dir == Vec3(0.0f) || std::isnan(ray.tnear) ||
       std::isnan(ray.tfar) || !(ray.tnear <= ray.tfar))
     return false;
@@ -321,7 +327,7 @@ bool Scene::trace(const Ray& ray, Hit& hit) const {
   auto trace_instance = [&](uint32_t id, float& t_max) {
     const Instance& inst = instances_[id];
     if constexpr (ShadowCastersOnly) {
-      if (!inst.visible_shadow) return false;
+      if (!inst.visible_shadow || !in_light_sets(blockers, inst.blocker_set)) return false;
     }
     const Mesh& mesh = *meshes_[inst.mesh];
     Vec3 org = ray.org, dir = ray.dir;
@@ -369,14 +375,15 @@ bool Scene::occluded(const Ray& ray) const {
   return trace<true>(ray, unused);
 }
 
-bool Scene::occluded_by_shadow_casters(const Ray& ray) const {
+bool Scene::occluded_by_shadow_casters(const Ray& ray, uint64_t blockers) const {
   Hit unused;
-  return trace<true, true>(ray, unused);
+  return trace<true, true>(ray, unused, blockers);
 }
 
-Hit Scene::intersect_shadow_casters(const Ray& ray) const {
+Hit Scene::intersect_shadow_casters(const Ray& ray, uint64_t blockers) const {
   Hit hit;
-  if (!(all_cast_shadows_ ? trace<false>(ray, hit) : trace<false, true>(ray, hit))) hit = Hit{};
+  const bool all = all_cast_shadows_ && blockers == kAllLightSets;
+  if (!(all ? trace<false>(ray, hit) : trace<false, true>(ray, hit, blockers))) hit = Hit{};
   return hit;
 }
 

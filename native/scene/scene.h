@@ -97,7 +97,10 @@ class Scene {
   // id. Throws std::invalid_argument for an unknown mesh, a non-finite, non-affine (last row not
   // 0 0 0 1) or singular matrix.
   // `visible_shadow` false: the instance casts no shadow in a render (Instance::visible_shadow).
-  uint32_t add_instance(int64_t mesh, const Mat4& to_world, bool visible_shadow = true);
+  // receiver_set / blocker_set: its light-linking sets (Instance; < kLightSets, else
+  // std::invalid_argument).
+  uint32_t add_instance(int64_t mesh, const Mat4& to_world, bool visible_shadow = true, int receiver_set = 0,
+                        int blocker_set = 0);
   // Edits for interactive updates (the viewport), each leaving the scene uncommitted; ids stay
   // valid. replace_mesh swaps a mesh's geometry and shading (its BVH is rebuilt by the next
   // commit, the instances placing it stay); set_instance_transform moves one instance (the next
@@ -128,6 +131,8 @@ class Scene {
   void set_background(const Vec3& radiance);  // finite and >= 0
   void set_background_lighting(bool on) { world_.background_lights_surfaces = on; }
   void set_background_visible_camera(bool on) { world_.background_visible_camera = on; }
+  void set_background_visible_glossy(bool on) { world_.background_visible_glossy = on; }
+  void set_background_visible_transmission(bool on) { world_.background_visible_transmission = on; }
   // The world's Environment Texture: texture `texture` (an equirectangular image) times strength,
   // looked up along to_map * direction (scene/environment.h); it replaces the background colour
   // for rays that leave the scene. texture -1 removes it. Throws std::invalid_argument for an
@@ -152,6 +157,11 @@ class Scene {
   // The render's shadow rays: occluded() by the instances that cast shadows. Inline, so that a
   // scene where every instance casts shadows calls occluded() as before (a flag test more).
   bool shadowed(const Ray& ray) const { return all_cast_shadows_ ? occluded(ray) : occluded_by_shadow_casters(ray); }
+  // The shadow ray of a light whose blocker sets are `blockers` (light linking): occluded by the
+  // casters in those sets; shadowed(ray) for a light that links no blockers.
+  bool shadowed(const Ray& ray, uint64_t blockers) const {
+    return blockers == kAllLightSets ? shadowed(ray) : occluded_by_shadow_casters(ray, blockers);
+  }
 
   // Throws std::logic_error (naming commit()) unless the scene is committed.
   void check_committed() const;
@@ -181,8 +191,9 @@ class Scene {
   // Whether some material has a normal map: only then does a hit look one up
   // (render/normal_mapping.h), so other scenes run the code they ran before.
   bool any_normal_map() const { return any_normal_map_; }
-  // The nearest hit on an instance that casts shadows (the shadow walk's step).
-  Hit intersect_shadow_casters(const Ray& ray) const;
+  // The nearest hit on an instance that casts shadows (the shadow walk's step), among those in the
+  // blocker sets `blockers` (light linking).
+  Hit intersect_shadow_casters(const Ray& ray, uint64_t blockers = kAllLightSets) const;
   const MeshEmitters& emitters() const { return emitters_; }  // the sampled emissive triangles, by commit()
   const World& world() const { return world_; }
   // The tree the render selects lights with: built by commit() over more than kLightTreeFrom
@@ -200,8 +211,8 @@ class Scene {
 
  private:
   template <bool AnyHit, bool ShadowCastersOnly = false>
-  bool trace(const Ray& ray, Hit& hit) const;
-  bool occluded_by_shadow_casters(const Ray& ray) const;
+  bool trace(const Ray& ray, Hit& hit, uint64_t blockers = kAllLightSets) const;
+  bool occluded_by_shadow_casters(const Ray& ray, uint64_t blockers = kAllLightSets) const;
   // commit()'s work; throws BuildCancelled when *cancel turns true.
   void build(const CommitOptions& options, const std::atomic<bool>* cancel);
   void check_mesh_id(int64_t mesh) const;

@@ -3,8 +3,10 @@
 #pragma once
 
 #include "lights/light.h"
+#include "lights/light_linking.h"
 #include "scene/environment.h"
 
+#include <cstdint>
 #include <vector>
 
 namespace toyrt {
@@ -14,11 +16,15 @@ namespace toyrt {
 // and spot lights of radius 0 and suns of angle 0 can never be seen); whether it lights diffuse
 // surfaces at all (the object's diffuse ray visibility); whether surfaces between it and a
 // point shadow it (Cycles 3.x light.cycles.cast_shadow, 4.x+ light.use_shadow).
+// Light linking (lights/light_linking.h): the receiver sets the light lights and the blocker sets
+// that shadow it; full masks (the default) link nothing.
 struct LightVisibility {
   bool camera = true;
   bool specular = true;
   bool diffuse = true;
   bool shadow = true;
+  uint64_t receiver_sets = kAllLightSets;
+  uint64_t blocker_sets = kAllLightSets;
 };
 
 struct World {
@@ -29,10 +35,29 @@ struct World {
   // Whether the background also lights diffuse surfaces (Cycles samples the world as a light;
   // Blender's world ray visibility for diffuse rays turns it off).
   bool background_lights_surfaces = true;
-  // Whether camera rays that leave the scene see it (Blender's world ray visibility for camera
-  // rays, world.cycles_visibility.camera): off, they see black, still opaque, as in Cycles
-  // (transparency is the film's setting). Rays through glass and off glossy surfaces see it.
+  // Whether rays that leave the scene see it, by the kind of their last vertex (Blender's world
+  // ray visibility, world.cycles_visibility.camera / .glossy / .transmission): off, they see
+  // black, still opaque, as in Cycles (transparency is the film's setting). As Cycles' path
+  // flags: a ray reflected by a glossy or mirror surface is a glossy ray, one refracted through
+  // glass a transmission ray; a ray that passed a cut-out keeps the kind it had.
   bool background_visible_camera = true;
+  bool background_visible_glossy = true;
+  bool background_visible_transmission = true;
 };
+
+// The kind of a ray a path traces, for the world's visibility above.
+enum class RayKind : uint8_t { Camera, Glossy, Transmission };
+
+inline bool background_visible(const World& world, RayKind kind) {
+  switch (kind) {
+    case RayKind::Camera:
+      return world.background_visible_camera;
+    case RayKind::Glossy:
+      return world.background_visible_glossy;
+    case RayKind::Transmission:
+      return world.background_visible_transmission;
+  }
+  return true;
+}
 
 }  // namespace toyrt

@@ -9,6 +9,8 @@
 #                                  is the magenta placeholder; inf and NaN texels: a note, a finite
 #                                  image; a 1 x 1 image: a uniform world (the floor's albedo x L)
 #   a Principled BSDF's emission   seen by the camera as colour x strength (3.x and 4.x socket names)
+#   light linking (4.0+)           a lamp whose receiver collection excludes the floor adds nothing
+#                                  to it; an emissive mesh's linking is noted
 import math
 import os
 import sys
@@ -160,9 +162,35 @@ def test_principled_emission_is_seen_as_colour_times_strength():
           f"a Principled BSDF's emission, no lights: the camera sees {np.round(got, 4)} (0.6 1.5 3)")
 
 
+def test_a_lamp_whose_receiver_collection_excludes_the_floor_does_not_light_it():
+    """Light linking (4.0+): a second lamp whose receiver collection EXCLUDEs the floor leaves the
+    image as the first lamp's alone (both radius 0: no noise), and an emissive plane with a
+    receiver collection is noted (not linked). Blender 3.x has no light linking: nothing to test."""
+    if "light_linking" not in bpy.types.Object.bl_rna.properties.keys():
+        check(True, "no light linking in this Blender (3.x): nothing is read")
+        return
+    scene_with_floor(0.5)
+    kit.point_light("key", (0.5, 0.0, 3.0), 300.0)
+    result_alone, alone, _ = render("linking_alone")
+    other = kit.point_light("other", (-1.0, 0.5, 2.0), 500.0)
+    receivers = bpy.data.collections.new("other_receivers")
+    receivers.objects.link(bpy.data.objects["floor"])
+    receivers.collection_objects[0].light_linking.link_state = "EXCLUDE"
+    other.light_linking.receiver_collection = receivers
+    result, linked, _ = render("linking_linked")
+    glow = kit.plane("glow", 0.5, kit.emission("glow", (1.0, 1.0, 1.0), 1.0), (3.0, 3.0, 1.0))
+    glow.light_linking.receiver_collection = receivers
+    _, notes = notes_of_export()
+    same = alone is not None and linked is not None and np.allclose(linked, alone, rtol=1e-6, atol=0)
+    check(result_alone == result == {"FINISHED"} and same and "glow" in notes and "light linking" in notes,
+          f"the excluded lamp adds nothing to the floor ({same}); the emissive plane's linking is noted "
+          f"({'glow' in notes})")
+
+
 PARTS = [test_sun_over_a_floor_gives_strength_cos_over_pi, test_portal_is_not_a_light,
          test_shadow_switch_removes_the_shadow, test_missing_environment_image_is_magenta_with_one_note,
          test_non_finite_texels_are_noted_and_the_image_stays_finite, test_one_pixel_environment_is_a_uniform_world,
          test_a_world_hidden_from_the_camera_still_lights_the_floor,
-         test_principled_emission_is_seen_as_colour_times_strength]
+         test_principled_emission_is_seen_as_colour_times_strength,
+         test_a_lamp_whose_receiver_collection_excludes_the_floor_does_not_light_it]
 run_script(PARTS, "lights and world", TMP)

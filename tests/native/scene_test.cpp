@@ -121,6 +121,27 @@ TEST(Scene, ShadowRaysPassInstancesWithoutShadowsThatEveryOtherQuerySees) {
   for (const Ray& r : random_rays(5000, 1.5f, 4)) EXPECT_EQ(all.shadowed(r), all.occluded(r));
 }
 
+TEST(Scene, ALinkedLightsShadowRaysStopOnlyAtItsBlockerSets) {
+  // Light linking: two triangles on the shadow ray, in blocker sets 1 and 2. A lamp whose blocker
+  // mask holds set 2 alone is shadowed by the farther one only; one without sets 1 and 2 by none;
+  // an unlinked lamp (all sets) by both, as shadowed(ray).
+  Scene scene;
+  const uint32_t id = scene.add_mesh({{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}}, {{0, 1, 2}});
+  scene.add_instance(id, glm::translate(Mat4(1.0f), Vec3(0, 0, 1)), true, /*receiver_set=*/0, /*blocker_set=*/1);
+  scene.add_instance(id, glm::translate(Mat4(1.0f), Vec3(0, 0, 2)), true, 0, 2);
+  scene.commit();
+  const Ray to_both{Vec3(0.0f), 0.0f, Vec3(0, 0, 1), 3.0f};
+  const Ray to_first{Vec3(0.0f), 0.0f, Vec3(0, 0, 1), 1.5f};
+  EXPECT_FALSE(scene.shadowed(to_first, uint64_t(1) << 2));
+  EXPECT_TRUE(scene.shadowed(to_both, uint64_t(1) << 2));
+  EXPECT_EQ(scene.intersect_shadow_casters(to_both, uint64_t(1) << 2).instance, 1);
+  EXPECT_FALSE(scene.shadowed(to_both, kAllLightSets & ~uint64_t(6)));
+  EXPECT_TRUE(scene.shadowed(to_first, kAllLightSets));
+  EXPECT_EQ(scene.shadowed(to_first, kAllLightSets), scene.shadowed(to_first));
+  EXPECT_THROW(scene.add_instance(id, Mat4(1.0f), true, 64, 0), std::invalid_argument);
+  EXPECT_THROW(scene.add_instance(id, Mat4(1.0f), true, 0, -1), std::invalid_argument);
+}
+
 TEST(Scene, TenThousandInstancesStoreTheMeshOnce) {
   const MeshData m = uv_sphere(100, 200);  // 39,600 triangles
   Scene scene;

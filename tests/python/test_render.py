@@ -281,6 +281,48 @@ def test_a_world_hidden_from_the_camera_is_black_behind_objects_but_still_lights
                                rtol=1e-6)
 
 
+def test_a_world_hidden_from_glossy_rays_is_black_in_reflections_and_from_transmission_rays_black_through_glass():
+    """background_visible_glossy / _transmission (world.cycles_visibility.glossy / .transmission),
+    as Cycles' path flags: a ray reflected by a mirror or a glossy lobe is a glossy ray, one
+    refracted through glass a transmission ray. Under a constant world L, a mirror (Glossy BSDF,
+    roughness 0) of colour c shows c L, exactly; hidden from glossy rays it shows black, and so does
+    a rough glossy floor (no other light). The world through a refracting slab is exactly L (as
+    above), black when hidden from transmission rays; each flag leaves the other kind alone."""
+    L = np.array([0.5, 1.0, 2.0])
+    cam = camera_above(size=1.0, resolution=4)
+    for roughness in (0.0, 0.4):
+        s = toyrt.Scene()
+        s.add_material("glossy", color=(0.9, 0.6, 0.3), roughness=roughness)
+        s.add_mesh(np.float32([[-50, -50, 0], [50, -50, 0], [50, 50, 0], [-50, 50, 0]]), [[0, 1, 2], [0, 2, 3]],
+                   material_ids=0)
+        s.background = tuple(L)
+        s.commit()
+        shown = s.render(cam, samples=16)[..., :3]
+        if roughness == 0.0:
+            np.testing.assert_allclose(shown, np.broadcast_to([0.45, 0.6, 0.6], shown.shape), rtol=1e-6)
+        assert (shown > 0.1).all()
+        s.background_visible_transmission = False
+        np.testing.assert_array_equal(s.render(cam, samples=16)[..., :3], shown)
+        assert s.background_visible_glossy
+        s.background_visible_glossy = False
+        assert (s.render(cam, samples=16)[..., :3] == 0).all()
+
+    s = toyrt.Scene()
+    s.add_material("refraction", ior=1.5)
+    v = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (0.1, 0.4)], np.float32)
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    s.add_mesh(v, [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))], material_ids=0)
+    s.background = tuple(L)
+    s.commit()
+    through = s.render(cam, samples=16)[..., :3]
+    np.testing.assert_allclose(through, np.broadcast_to(L, through.shape), rtol=1e-6)
+    s.background_visible_glossy = False
+    np.testing.assert_array_equal(s.render(cam, samples=16)[..., :3], through)
+    s.background_visible_glossy = True
+    s.background_visible_transmission = False
+    assert (s.render(cam, samples=16)[..., :3] == 0).all()
+
+
 def glass_plane_under_a_light(split_depth_scene_power=40.0, size=20.0):
     """A glass (Fresnel) plane at z = 0 seen straight down by an ortho camera at z = 5, and a large
     area light at z = 3 facing down, which camera rays pass (visible_camera=False) but the
