@@ -119,15 +119,28 @@ template <bool AnyHit, class OnHit>
       splat(3.0f) * (splat(gamma(3)) * max_e * max_z + delta_e * max_z + splat(gamma(3)) * max_z * max_e);
   const vint clear_of_start = signed_t - splat(tnear) * abs_det > error;
 
-  // Lanes the vector test decides, and lanes that need the scalar test's double precision.
+  // Lanes the vector test decides; lanes inside the triangle whose distance is too close to tnear
+  // for float (mostly the surface a ray leaves), whose crossing is decided in double directly,
+  // as the scalar test would after repeating the same float arithmetic; and lanes with an exact
+  // zero edge function, which take the whole scalar test.
   const uint32_t accepted = mask_of(candidate & ~exact_zero & clear_of_start);
-  const uint32_t scalar = mask_of(used & (exact_zero | (candidate & ~clear_of_start)));
+  const uint32_t near_start = mask_of(candidate & ~exact_zero & ~clear_of_start);
+  const uint32_t scalar = mask_of(used & exact_zero);
   bool any = false;
   if (accepted) {
     const vfloat t = scaled_t * (splat(1.0f) / det);  // as the scalar test: times the reciprocal
     for (uint32_t m = accepted; m; m &= m - 1) {
       const int lane = __builtin_ctz(m);
       hit(lane, t[lane]);
+      any = true;
+      if constexpr (AnyHit) return true;
+    }
+  }
+  for (uint32_t m = near_start; m; m &= m - 1) {
+    const int lane = __builtin_ctz(m);
+    float t, u, v;
+    if (near_start_in_double(r, b.vertex(lane, 0), b.vertex(lane, 1), b.vertex(lane, 2), tnear, tfar, t, u, v)) {
+      hit(lane, t);
       any = true;
       if constexpr (AnyHit) return true;
     }
