@@ -4,11 +4,16 @@
 // the distances, so an A/B of two builds also shows that both found the same hits.
 //
 //   trace_only [primary|diffuse|shadow] [rings] [repeats]   (rings 708: the 1M-triangle sphere)
+//   trace_only commit [rings] [repeats]   the whole single-thread SAH commit of a fresh scene, in
+//                                         CPU milliseconds (the process's CPU clock: one thread,
+//                                         so other work on the machine does not inflate it)
 #include "scene/scene.h"
 #include "test_scenes.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <string>
 #include <vector>
 
@@ -20,6 +25,28 @@ int main(int argc, char** argv) {
   const int rings = argc > 2 ? std::atoi(argv[2]) : 224;
   const int repeats = argc > 3 ? std::atoi(argv[3]) : 1;
   const MeshData mesh = uv_sphere(rings, rings, 1.0f, 0.15f);
+  if (kind == "commit") {
+    auto cpu_ms = [] {
+      timespec ts;
+      clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+      return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+    };
+    std::vector<double> ms;
+    for (int k = 0; k <= repeats; ++k) {  // the first is a warm-up
+      Scene s;
+      s.add_instance(s.add_mesh(mesh.vertices, mesh.triangles), Mat4(1.0f));
+      CommitOptions options;
+      options.builder = BuilderKind::Sah;
+      options.threads = 1;
+      const double start = cpu_ms();
+      s.commit(options);
+      if (k) ms.push_back(cpu_ms() - start);
+    }
+    std::sort(ms.begin(), ms.end());
+    std::printf("commit: %zu triangles, median %.1f ms CPU (%d runs)\n", mesh.triangles.size(), ms[ms.size() / 2],
+                repeats);
+    return 0;
+  }
   Scene scene;
   scene.add_instance(scene.add_mesh(mesh.vertices, mesh.triangles), Mat4(1.0f));
   scene.commit();

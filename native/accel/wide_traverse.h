@@ -56,7 +56,8 @@ inline uint32_t mask_of(V lanes) {
 }  // namespace simd
 
 template <bool AnyHit, class LeafFn>
-[[gnu::always_inline]] inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear, float& tfar, LeafFn&& leaf) {
+[[gnu::always_inline]] inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear, float& tfar,
+                                                 LeafFn&& leaf) {
   using namespace simd;
   if (bvh.nodes.empty()) return bvh.root_leaf_count && leaf(bvh.root_leaf_first, bvh.root_leaf_count, tfar);
 
