@@ -11,6 +11,7 @@
 #endif
 
 #include <cstring>
+#include <utility>
 
 namespace toyrt {
 
@@ -23,7 +24,12 @@ inline vfloat load(const float* p) {
   std::memcpy(&v, p, sizeof v);  // the rows are aligned; this compiles to one aligned load
   return v;
 }
-inline vfloat splat(float x) { return vfloat{} + x; }
+// A broadcast. (Written as `vfloat{} + x` it was an addition and then a broadcast: 0 + x is not x
+// for x = -0, so the compiler must add.)
+inline vfloat splat(float x) {
+  static_assert(kWidth == 8);
+  return vfloat{x, x, x, x, x, x, x, x};
+}
 // Lane-wise max / min that keep `acc` where `candidate` is NaN (see safe_max in core/math.h).
 inline vfloat max_keep(vfloat acc, vfloat candidate) { return candidate > acc ? candidate : acc; }
 inline vfloat min_keep(vfloat acc, vfloat candidate) { return candidate < acc ? candidate : acc; }
@@ -50,7 +56,8 @@ inline uint32_t mask_of(V lanes) {
 }  // namespace simd
 
 template <bool AnyHit, class LeafFn>
-inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear, float& tfar, LeafFn&& leaf) {
+[[gnu::always_inline]] inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear, float& tfar,
+                                                 LeafFn&& leaf) {
   using namespace simd;
   if (bvh.nodes.empty()) return bvh.root_leaf_count && leaf(bvh.root_leaf_first, bvh.root_leaf_count, tfar);
 
@@ -101,7 +108,23 @@ inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear
         continue;
       }
       if (mask != 0) {
-        // Children hit, sorted by entry distance (insertion sort: usually one to three).
+        // One or two children hit is the common case: no sort, no array.
+        const int first = __builtin_ctz(mask);
+        const uint32_t rest = mask & (mask - 1);
+        if (rest == 0) {
+          current = Entry{n.child[first], n.count[first], tmin[first]};
+          continue;
+        }
+        if ((rest & (rest - 1)) == 0) {
+          const int second = __builtin_ctz(rest);
+          Entry near{n.child[first], n.count[first], tmin[first]}, far{n.child[second], n.count[second], tmin[second]};
+          if (far.tentry < near.tentry) std::swap(near, far);  // ties keep slot order, as the sort below
+          stack[sp++] = far;
+          if (far.count == 0) __builtin_prefetch(&bvh.nodes[far.child]);
+          current = near;
+          continue;
+        }
+        // Three or more: sorted by entry distance (insertion sort, stable).
         Entry hits[kWidth];
         int count = 0;
         while (mask) {

@@ -131,15 +131,16 @@ bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, flo
   const float segment_end = tfar;
   const RayBoxData box_ray = make_ray_box_data(org, dir);
   const WatertightRay tri_ray = make_watertight_ray(org, dir);
+  const BlockRay block_ray = make_block_ray(tri_ray);
   const TriangleBlock* blocks = blocks_.data();
   uint32_t found_block = 0;
   int found_lane = 0;
-  const bool found =
-      traverse_wide<AnyHit>(wide_, box_ray, tnear, tfar, [&](uint32_t first, uint32_t count, float& t_max) {
+  const bool found = traverse_wide<AnyHit>(
+      wide_, box_ray, tnear, tfar, [&](uint32_t first, uint32_t count, float& t_max) __attribute__((always_inline)) {
         bool hit = false;
         const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
         for (uint32_t k = first; k < end; ++k) {
-          hit |= intersect_block<AnyHit>(tri_ray, blocks[k], tnear, t_max, [&](int lane, float t) {
+          hit |= intersect_block<AnyHit>(tri_ray, block_ray, blocks[k], tnear, t_max, [&](int lane, float t) {
             if (t < t_max) {
               t_max = t;
               found_block = k;

@@ -34,7 +34,7 @@ inline vfloat load(const float* p) {
   std::memcpy(&v, p, sizeof v);
   return v;
 }
-inline vfloat splat(float x) { return vfloat{} + x; }
+using simd::splat;
 inline vfloat abs(vfloat x) {
   vint bits;
   std::memcpy(&bits, &x, sizeof bits);
@@ -51,21 +51,36 @@ inline vint bits_of(vfloat x) {
 using simd::mask_of;
 }  // namespace simdb
 
+// The ray's constants of the block test, broadcast once per ray: the leaf test runs at every leaf
+// a ray reaches, and rebuilding them there (an axis picked through a switch, then a broadcast)
+// cost about as much as a third of a block test.
+struct BlockRay {
+  simdb::vfloat ox, oy, oz;  // the origin's coordinates along kx, ky, kz
+  simdb::vfloat sx, sy, sz;
+  int kx, ky, kz;
+};
+
+inline BlockRay make_block_ray(const WatertightRay& r) {
+  using simdb::splat;
+  const float* org = &r.org.x;
+  return {
+      splat(org[r.kx]), splat(org[r.ky]), splat(org[r.kz]), splat(r.sx), splat(r.sy), splat(r.sz), r.kx, r.ky, r.kz};
+}
+
 // Tests the block's triangles against [tnear, tfar). For each lane hit, hit(lane, t) is called
 // (nearest lanes are not sorted; the caller keeps the minimum); with AnyHit the first ends it.
 // Returns whether any lane was hit.
 template <bool AnyHit, class OnHit>
-[[gnu::always_inline]] inline bool intersect_block(const WatertightRay& r, const TriangleBlock& b, float tnear,
-                                                   float tfar, OnHit&& hit) {
+[[gnu::always_inline]] inline bool intersect_block(const WatertightRay& r, const BlockRay& br, const TriangleBlock& b,
+                                                   float tnear, float tfar, OnHit&& hit) {
   using namespace simdb;
-  const vfloat ox = splat(r.org[r.kx]), oy = splat(r.org[r.ky]), oz = splat(r.org[r.kz]);
-  const vfloat sx = splat(r.sx), sy = splat(r.sy), sz = splat(r.sz);
+  const vfloat ox = br.ox, oy = br.oy, oz = br.oz, sx = br.sx, sy = br.sy, sz = br.sz;
   // Translated and sheared vertices, exactly as intersect_triangle computes them.
   vfloat x[3], y[3], vz[3];
   for (int k = 0; k < 3; ++k) {
-    vz[k] = load(b.p[k][r.kz]) - oz;
-    x[k] = (load(b.p[k][r.kx]) - ox) - sx * vz[k];
-    y[k] = (load(b.p[k][r.ky]) - oy) - sy * vz[k];
+    vz[k] = load(b.p[k][br.kz]) - oz;
+    x[k] = (load(b.p[k][br.kx]) - ox) - sx * vz[k];
+    y[k] = (load(b.p[k][br.ky]) - oy) - sy * vz[k];
   }
   const vfloat eu = x[2] * y[1] - y[2] * x[1];
   const vfloat ev = x[0] * y[2] - y[0] * x[2];
@@ -104,15 +119,28 @@ template <bool AnyHit, class OnHit>
       splat(3.0f) * (splat(gamma(3)) * max_e * max_z + delta_e * max_z + splat(gamma(3)) * max_z * max_e);
   const vint clear_of_start = signed_t - splat(tnear) * abs_det > error;
 
-  // Lanes the vector test decides, and lanes that need the scalar test's double precision.
+  // Lanes the vector test decides; lanes inside the triangle whose distance is too close to tnear
+  // for float (mostly the surface a ray leaves), whose crossing is decided in double directly,
+  // as the scalar test would after repeating the same float arithmetic; and lanes with an exact
+  // zero edge function, which take the whole scalar test.
   const uint32_t accepted = mask_of(candidate & ~exact_zero & clear_of_start);
-  const uint32_t scalar = mask_of(used & (exact_zero | (candidate & ~clear_of_start)));
+  const uint32_t near_start = mask_of(candidate & ~exact_zero & ~clear_of_start);
+  const uint32_t scalar = mask_of(used & exact_zero);
   bool any = false;
   if (accepted) {
     const vfloat t = scaled_t * (splat(1.0f) / det);  // as the scalar test: times the reciprocal
     for (uint32_t m = accepted; m; m &= m - 1) {
       const int lane = __builtin_ctz(m);
       hit(lane, t[lane]);
+      any = true;
+      if constexpr (AnyHit) return true;
+    }
+  }
+  for (uint32_t m = near_start; m; m &= m - 1) {
+    const int lane = __builtin_ctz(m);
+    float t, u, v;
+    if (near_start_in_double(r, b.vertex(lane, 0), b.vertex(lane, 1), b.vertex(lane, 2), tnear, tfar, t, u, v)) {
+      hit(lane, t);
       any = true;
       if constexpr (AnyHit) return true;
     }

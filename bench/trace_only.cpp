@@ -1,0 +1,82 @@
+// TOYRT alone tracing one ray set on one thread, for profilers: `perf record`, or
+// `valgrind --tool=cachegrind`, whose instruction counts are the one measure this shared machine
+// does not blur (bench_trace gives the speed against Embree). Prints rays, hits and a checksum of
+// the distances, so an A/B of two builds also shows that both found the same hits.
+//
+//   trace_only [primary|diffuse|shadow] [rings] [repeats]   (rings 708: the 1M-triangle sphere)
+//   trace_only commit [rings] [repeats]   the whole single-thread SAH commit of a fresh scene, in
+//                                         CPU milliseconds (the process's CPU clock: one thread,
+//                                         so other work on the machine does not inflate it)
+#include "scene/scene.h"
+#include "test_scenes.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <string>
+#include <vector>
+
+using namespace toyrt;
+using namespace toyrt::testing;
+
+int main(int argc, char** argv) {
+  const std::string kind = argc > 1 ? argv[1] : "diffuse";
+  const int rings = argc > 2 ? std::atoi(argv[2]) : 224;
+  const int repeats = argc > 3 ? std::atoi(argv[3]) : 1;
+  const MeshData mesh = uv_sphere(rings, rings, 1.0f, 0.15f);
+  if (kind == "commit") {
+    auto cpu_ms = [] {
+      timespec ts;
+      clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+      return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+    };
+    std::vector<double> ms;
+    for (int k = 0; k <= repeats; ++k) {  // the first is a warm-up
+      Scene s;
+      s.add_instance(s.add_mesh(mesh.vertices, mesh.triangles), Mat4(1.0f));
+      CommitOptions options;
+      options.builder = BuilderKind::Sah;
+      options.threads = 1;
+      const double start = cpu_ms();
+      s.commit(options);
+      if (k) ms.push_back(cpu_ms() - start);
+    }
+    std::sort(ms.begin(), ms.end());
+    std::printf("commit: %zu triangles, median %.1f ms CPU (%d runs)\n", mesh.triangles.size(), ms[ms.size() / 2],
+                repeats);
+    return 0;
+  }
+  Scene scene;
+  scene.add_instance(scene.add_mesh(mesh.vertices, mesh.triangles), Mat4(1.0f));
+  scene.commit();
+  std::vector<Ray> primary;
+  std::vector<Hit> hits;
+  for (const Ray& r : primary_rays(bounds_of(mesh), 320, 240)) {
+    const Hit h = scene.intersect(r);
+    if (!h.found()) continue;
+    primary.push_back(r);
+    hits.push_back(h);
+  }
+  const BBox box = bounds_of(mesh);
+  const Vec3 light = box.center() + glm::length(box.extent()) * Vec3(-0.4f, -0.9f, 1.3f);
+  const std::vector<Ray> rays = kind == "primary"  ? primary
+                                : kind == "shadow" ? shadow_rays(mesh, primary, hits, light)
+                                                   : diffuse_rays(mesh, primary, hits, 17);
+  size_t found = 0;
+  double checksum = 0.0;
+  for (int k = 0; k < repeats; ++k)
+    for (const Ray& r : rays) {
+      if (kind == "shadow") {
+        found += scene.occluded(r);
+      } else {
+        const Hit h = scene.intersect(r);
+        if (h.found()) {
+          ++found;
+          checksum += h.t;
+        }
+      }
+    }
+  std::printf("%s: %zu rays x %d, %zu found, checksum %.9g\n", kind.c_str(), rays.size(), repeats, found, checksum);
+  return 0;
+}
