@@ -4,8 +4,8 @@
 #pragma once
 
 #include "core/math.h"
-#include "render/glossy_lighting.h"  // power_heuristic
 #include "lights/light_linking.h"
+#include "render/glossy_lighting.h"  // power_heuristic
 #include "scene/world.h"
 
 #include <cstddef>
