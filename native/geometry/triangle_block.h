@@ -136,24 +136,21 @@ template <bool AnyHit, class OnHit>
       if constexpr (AnyHit) return true;
     }
   }
-  for (uint32_t m = near_start; m; m &= m - 1) {
-    const int lane = __builtin_ctz(m);
-    float t, u, v;
-    if (near_start_in_double(r, b.vertex(lane, 0), b.vertex(lane, 1), b.vertex(lane, 2), tnear, tfar, t, u, v)) {
-      hit(lane, t);
-      any = true;
-      if constexpr (AnyHit) return true;
+  // The rare lanes, one at a time: `test` is the double-precision distance or the whole scalar
+  // test. Returns whether an any-hit query is over.
+  auto lane_by_lane = [&](uint32_t lanes, auto&& test) {
+    for (uint32_t m = lanes; m; m &= m - 1) {
+      const int lane = __builtin_ctz(m);
+      float t, u, v;
+      if (test(r, b.vertex(lane, 0), b.vertex(lane, 1), b.vertex(lane, 2), tnear, tfar, t, u, v)) {
+        hit(lane, t);
+        any = true;
+        if constexpr (AnyHit) return true;
+      }
     }
-  }
-  for (uint32_t m = scalar; m; m &= m - 1) {
-    const int lane = __builtin_ctz(m);
-    float t, u, v;
-    if (intersect_triangle(r, b.vertex(lane, 0), b.vertex(lane, 1), b.vertex(lane, 2), tnear, tfar, t, u, v)) {
-      hit(lane, t);
-      any = true;
-      if constexpr (AnyHit) return true;
-    }
-  }
+    return false;
+  };
+  if (lane_by_lane(near_start, near_start_in_double) || lane_by_lane(scalar, intersect_triangle)) return true;
   return any;
 }
 
