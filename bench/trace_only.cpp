@@ -3,10 +3,11 @@
 // does not blur (bench_trace gives the speed against Embree). Prints rays, hits and a checksum of
 // the distances, so an A/B of two builds also shows that both found the same hits.
 //
-//   trace_only [primary|diffuse|shadow] [rings] [repeats]   (rings 708: the 1M-triangle sphere)
+//   trace_only [primary|diffuse|shadow] [rings] [repeats] [embree]   (rings 708: the 1M-triangle sphere)
 //   trace_only commit [rings] [repeats]   the whole single-thread SAH commit of a fresh scene, in
 //                                         CPU milliseconds (the process's CPU clock: one thread,
 //                                         so other work on the machine does not inflate it)
+#include "embree_oracle.h"
 #include "scene/scene.h"
 #include "test_scenes.h"
 
@@ -63,14 +64,19 @@ int main(int argc, char** argv) {
   const std::vector<Ray> rays = kind == "primary"  ? primary
                                 : kind == "shadow" ? shadow_rays(mesh, primary, hits, light)
                                                    : diffuse_rays(mesh, primary, hits, 17);
+  // "embree" as the fourth argument: the same rays through Embree 3 in its default mode, for
+  // instruction counts side by side (under valgrind Embree runs its AVX2 kernels).
+  const bool embree = argc > 4 && std::string(argv[4]) == "embree";
+  const EmbreeScene peer(mesh.vertices, mesh.triangles, false, 1);
+  const bool shadow = kind == "shadow";  // compared once: a string compare per ray would be counted too
   size_t found = 0;
   double checksum = 0.0;
   for (int k = 0; k < repeats; ++k)
     for (const Ray& r : rays) {
-      if (kind == "shadow") {
-        found += scene.occluded(r);
+      if (shadow) {
+        found += embree ? peer.occluded(r) : scene.occluded(r);
       } else {
-        const Hit h = scene.intersect(r);
+        const Hit h = embree ? peer.intersect(r) : scene.intersect(r);
         if (h.found()) {
           ++found;
           checksum += h.t;

@@ -119,7 +119,11 @@ inline float near_start_error(float ax, float ay, float bx, float by, float cx, 
   const float abs_det = std::fabs(det);
   const float signed_t = det < 0.0f ? -scaled_t : scaled_t;
   if (!(signed_t < tfar * abs_det)) return false;
-  if (!(signed_t - tnear * abs_det > near_start_error(ax, ay, bx, by, cx, cy, az, bz, cz, eu, ev, ew))) {
+  const float past_start = signed_t - tnear * abs_det;
+  const float error = near_start_error(ax, ay, bx, by, cx, cy, az, bz, cz, eu, ev, ew);
+  if (!(past_start > error)) {
+    // As far before tnear as the bound: surely behind the start (the same bound as the accept).
+    if (past_start < -error) return false;
     // Too close to tnear for float to tell which side the triangle is on: a ray leaving a
     // sliver, or a grazing one. Decide in double, where the answer is reliable.
     return near_start_in_double(r, p0, p1, p2, tnear, tfar, t, u, v);

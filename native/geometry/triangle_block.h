@@ -117,14 +117,19 @@ template <bool AnyHit, class OnHit>
   const vfloat delta_e = splat(2.0f) * (splat(gamma(2)) * max_x * max_y + delta_y * max_x + delta_x * max_y);
   const vfloat error =
       splat(3.0f) * (splat(gamma(3)) * max_e * max_z + delta_e * max_z + splat(gamma(3)) * max_z * max_e);
-  const vint clear_of_start = signed_t - splat(tnear) * abs_det > error;
+  const vfloat past_start = signed_t - splat(tnear) * abs_det;
+  const vint clear_of_start = past_start > error;
+  // As far before the start as clear_of_start is after it (the same bound, so as sure): a miss in
+  // float. These are the surface a ray leaves and the far side of a closed mesh behind it, which
+  // would otherwise all be sent to the double-precision distance only to be rejected there.
+  const vint clear_before_start = past_start < -error;
 
   // Lanes the vector test decides; lanes inside the triangle whose distance is too close to tnear
   // for float (mostly the surface a ray leaves), whose crossing is decided in double directly,
   // as the scalar test would after repeating the same float arithmetic; and lanes with an exact
   // zero edge function, which take the whole scalar test.
   const uint32_t accepted = mask_of(candidate & ~exact_zero & clear_of_start);
-  const uint32_t near_start = mask_of(candidate & ~exact_zero & ~clear_of_start);
+  const uint32_t near_start = mask_of(candidate & ~exact_zero & ~clear_of_start & ~clear_before_start);
   const uint32_t scalar = mask_of(used & exact_zero);
   bool any = false;
   if (accepted) {
