@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <utility>
 
+#include <tbb/parallel_for.h>
+
 namespace toyrt {
 
 namespace {
@@ -28,27 +30,25 @@ std::vector<std::pair<uint32_t, uint32_t>> subtree_ranges(const Bvh& bvh) {
   }
   return range;
 }
-}  // namespace
 
-WideBvh collapse(const Bvh& bvh, uint32_t leaf_size) {
-  WideBvh wide;
-  if (bvh.nodes.empty()) return wide;
-  const auto range = subtree_ranges(bvh);
-  auto is_leaf = [&](uint32_t i) { return bvh.nodes[i].is_leaf() || range[i].second <= leaf_size; };
-  if (is_leaf(0)) {
-    wide.root_leaf_first = range[0].first;
-    wide.root_leaf_count = range[0].second;
-    return wide;
-  }
-  wide.nodes.reserve(bvh.nodes.size() / (kWidth - 1) + 1);
-  // (binary interior node, wide node it becomes), depth first so subtrees stay together.
-  std::vector<std::pair<uint32_t, uint32_t>> work{{0u, 0u}};
-  wide.nodes.emplace_back();
-  while (!work.empty()) {
-    const auto [binary, index] = work.back();
-    work.pop_back();
-    // Gather children: start from the binary node's two, open interior ones largest first.
-    uint32_t kids[kWidth] = {bvh.nodes[binary].first, bvh.nodes[binary].first + 1};
+// Subtrees of more primitives than this are collapsed as parallel tasks. Fixed, not derived from
+// the thread count, so the layout (and every traversal result) is the same on any machine.
+constexpr uint32_t kParallelPrimitives = 32768;
+
+struct Collapser {
+  using Nodes = std::vector<WideNode, HugePageAllocator<WideNode>>;
+  const Bvh& bvh;
+  const std::vector<std::pair<uint32_t, uint32_t>>& range;
+  uint32_t leaf_size;
+
+  bool is_leaf(uint32_t i) const { return bvh.nodes[i].is_leaf() || range[i].second <= leaf_size; }
+
+  // The wide node for binary interior node `binary`: its children are the binary node's two, then
+  // the largest (by surface area) interior one is opened until kWidth are held. Leaf slots are
+  // final; an interior slot's child field holds its binary node until the caller places it.
+  int gather(uint32_t binary, WideNode& node, uint32_t kids[kWidth]) const {
+    kids[0] = bvh.nodes[binary].first;
+    kids[1] = bvh.nodes[binary].first + 1;
     int n = 2;
     while (n < kWidth) {
       int best = -1;
@@ -68,8 +68,7 @@ WideBvh collapse(const Bvh& bvh, uint32_t leaf_size) {
     // Children by decreasing surface area: the order an any-hit walk visits them in. A large box
     // is the likelier to block a shadow ray (a wall beside a dense model: found at once instead
     // of after the model's subtrees); the closest-hit walk sorts by distance and ignores it.
-    // An insertion sort: stable, and no allocation (std::stable_sort takes a temporary buffer,
-    // per node).
+    // An insertion sort: stable, and no allocation.
     for (int i = 1; i < n; ++i) {
       const uint32_t kid = kids[i];
       const float area = bvh.nodes[kid].bbox().half_area();
@@ -77,7 +76,6 @@ WideBvh collapse(const Bvh& bvh, uint32_t leaf_size) {
       for (; k > 0 && bvh.nodes[kids[k - 1]].bbox().half_area() < area; --k) kids[k] = kids[k - 1];
       kids[k] = kid;
     }
-    WideNode node;
     for (int a = 0; a < 3; ++a)
       for (int i = 0; i < kWidth; ++i) {
         node.bounds[a][i] = kInfinity;
@@ -90,14 +88,80 @@ WideBvh collapse(const Bvh& bvh, uint32_t leaf_size) {
       if (is_leaf(kids[i])) {
         node.child[i] = range[kids[i]].first;
         node.count[i] = range[kids[i]].second;
-      } else {
-        node.child[i] = uint32_t(wide.nodes.size());
-        wide.nodes.emplace_back();
-        work.push_back({kids[i], node.child[i]});
       }
     }
-    wide.nodes[index] = node;
+    return n;
   }
+
+  // Writes the wide node of `binary` at out[index] and its whole subtree after out's end: the
+  // interior children of a node side by side (one node's children are read together), each
+  // child's subtree after them, in slot order. Large children's subtrees are collapsed in
+  // parallel into their own arrays and appended in slot order, so the layout is the serial one's.
+  void expand(uint32_t binary, size_t index, Nodes& out) const {
+    WideNode node;
+    uint32_t kids[kWidth];
+    const int n = gather(binary, node, kids);
+    const size_t first = out.size();
+    int interior[kWidth], m = 0;
+    for (int i = 0; i < n; ++i)
+      if (!is_leaf(kids[i])) {
+        node.child[i] = uint32_t(first + size_t(m));
+        interior[m++] = i;
+      }
+    out.resize(first + size_t(m));
+    out[index] = node;
+    // Each large child's subtree below it (its own node is local[0]), built in parallel.
+    Nodes local[kWidth];
+    bool large[kWidth] = {};
+    int large_count = 0;
+    for (int j = 0; j < m; ++j) large_count += large[j] = range[kids[interior[j]]].second > kParallelPrimitives;
+    if (large_count > 1) {
+      tbb::parallel_for(0, m, [&](int j) {
+        if (large[j]) expand_alone(kids[interior[j]], local[j]);
+      });
+    } else if (large_count == 1) {
+      for (int j = 0; j < m; ++j)
+        if (large[j]) expand_alone(kids[interior[j]], local[j]);
+    }
+    for (int j = 0; j < m; ++j) {
+      if (!large[j]) {
+        expand(kids[interior[j]], first + size_t(j), out);
+        continue;
+      }
+      // local[j][0] takes its slot among its siblings; local[j][1..] goes to the end, its
+      // interior child indices moved by where it lands.
+      const Nodes& sub = local[j];
+      const size_t base = out.size();
+      auto moved = [&](WideNode w) {
+        for (int i = 0; i < kWidth; ++i)
+          if (w.count[i] == 0 && w.bounds[0][i] <= w.bounds[3][i]) w.child[i] = uint32_t(base + w.child[i] - 1);
+        return w;
+      };
+      out[first + size_t(j)] = moved(sub[0]);
+      out.resize(base + sub.size() - 1);
+      for (size_t k = 1; k < sub.size(); ++k) out[base + k - 1] = moved(sub[k]);
+    }
+  }
+
+  void expand_alone(uint32_t binary, Nodes& out) const {
+    out.resize(1);
+    expand(binary, 0, out);
+  }
+};
+}  // namespace
+
+WideBvh collapse(const Bvh& bvh, uint32_t leaf_size) {
+  WideBvh wide;
+  if (bvh.nodes.empty()) return wide;
+  const auto range = subtree_ranges(bvh);
+  const Collapser c{bvh, range, leaf_size};
+  if (c.is_leaf(0)) {
+    wide.root_leaf_first = range[0].first;
+    wide.root_leaf_count = range[0].second;
+    return wide;
+  }
+  wide.nodes.reserve(bvh.nodes.size() / (kWidth - 1) + 1);
+  c.expand_alone(0, wide.nodes);
   return wide;
 }
 

@@ -15,6 +15,8 @@
 #include <cstddef>
 #include <cstdlib>
 #include <new>
+#include <type_traits>
+#include <utility>
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -70,6 +72,18 @@ struct HugePageAllocator {
 #else
       std::free(p);
 #endif
+  }
+
+  // Elements made without arguments (resize, emplace_back()) are default-initialised, which for
+  // the trivial blocks and nodes stored here writes nothing: their builders write every field, and
+  // value-initialising first zeroed the 48 MB of blocks of a 1M-triangle mesh on one thread.
+  template <class U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
 
   template <class U>

@@ -91,33 +91,52 @@ void Mesh::finish(Bvh bvh, const std::vector<uint32_t>& valid) {
   bvh_ = std::move(bvh);
   for (uint32_t& id : bvh_.prim_ids) id = valid[id];  // builder slots -> triangle indices
   wide_ = collapse(bvh_, kBlockWidth);
-  // Copy every leaf's triangles into blocks and point the wide leaves at them.
+  // Copy every leaf's triangles into blocks and point the wide leaves at them. Each node's first
+  // block comes from a serial count in node order, so the blocks are laid out the same whatever
+  // the thread count; the copying (a random read of three vertices per triangle) runs in parallel.
+  auto blocks_of = [](uint32_t count) { return uint32_t((count + kBlockWidth - 1) / kBlockWidth); };
+  std::vector<uint32_t> first_block(wide_.nodes.size());
+  uint32_t block_count = blocks_of(wide_.root_leaf_count);
+  for (size_t i = 0; i < wide_.nodes.size(); ++i) {
+    first_block[i] = block_count;
+    for (int k = 0; k < kWidth; ++k) block_count += blocks_of(wide_.nodes[i].count[k]);
+  }
   blocks_.clear();
-  auto blocks_of = [](uint32_t count) { return size_t((count + kBlockWidth - 1) / kBlockWidth); };
-  size_t block_count = blocks_of(wide_.root_leaf_count);
-  for (const WideNode& n : wide_.nodes)
-    for (int i = 0; i < kWidth; ++i) block_count += blocks_of(n.count[i]);
-  blocks_.reserve(block_count);  // exactly: a block is 320 bytes, a guess would waste tens of MB
-  auto emit = [&](uint32_t first, uint32_t count) {
-    const uint32_t start = uint32_t(blocks_.size());
+  blocks_.shrink_to_fit();
+  blocks_.resize(block_count);  // exactly, and not zeroed (HugePageAllocator): every field is written below
+  auto emit = [&](uint32_t first, uint32_t count, uint32_t start) {
     for (uint32_t k = 0; k < count; k += kBlockWidth) {
-      TriangleBlock b{};
+      TriangleBlock& b = blocks_[start + k / kBlockWidth];
       for (int lane = 0; lane < kBlockWidth; ++lane) {
-        b.prim[lane] = kNoTriangle;
-        if (k + lane >= count) continue;
+        if (k + lane >= count) {  // an unused lane: no triangle, and coordinates that are not NaN garbage
+          b.prim[lane] = kNoTriangle;
+          for (int v = 0; v < 3; ++v)
+            for (int a = 0; a < 3; ++a) b.p[v][a][lane] = 0.0f;
+          continue;
+        }
         const uint32_t tri = bvh_.prim_ids[first + k + lane];
         b.prim[lane] = tri;
         for (int v = 0; v < 3; ++v)
           for (int a = 0; a < 3; ++a) b.p[v][a][lane] = vertices_[triangles_[tri][v]][a];
       }
-      blocks_.push_back(b);
     }
-    return start;
   };
-  if (wide_.root_leaf_count) wide_.root_leaf_first = emit(wide_.root_leaf_first, wide_.root_leaf_count);
-  for (WideNode& n : wide_.nodes)
-    for (int i = 0; i < kWidth; ++i)
-      if (n.count[i]) n.child[i] = emit(n.child[i], n.count[i]);
+  if (wide_.root_leaf_count) {
+    emit(wide_.root_leaf_first, wide_.root_leaf_count, 0);
+    wide_.root_leaf_first = 0;
+  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, wide_.nodes.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      WideNode& n = wide_.nodes[i];
+      uint32_t start = first_block[i];
+      for (int k = 0; k < kWidth; ++k) {
+        if (!n.count[k]) continue;
+        emit(n.child[k], n.count[k], start);
+        n.child[k] = start;
+        start += blocks_of(n.count[k]);
+      }
+    }
+  });
   built_ = true;
 }
 
