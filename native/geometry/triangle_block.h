@@ -29,11 +29,7 @@ static_assert(sizeof(TriangleBlock) == 320, "TriangleBlock: 9 coordinate rows an
 namespace simdb {  // vectors of one lane per triangle of a block
 using vfloat = float __attribute__((vector_size(kBlockWidth * sizeof(float))));
 using vint = int32_t __attribute__((vector_size(kBlockWidth * sizeof(float))));
-inline vfloat load(const float* p) {
-  vfloat v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
+using simd::load;
 using simd::splat;
 inline vfloat abs(vfloat x) {
   vint bits;
