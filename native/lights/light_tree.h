@@ -25,10 +25,9 @@
 
 namespace toyrt {
 
-// A cluster, 52 bytes. Its box enters importance only through the bounding sphere.
+// A cluster, 64 bytes. The box bounds the angle it subtends (theta_u) and the receiver's horizon.
 struct LightTreeNode {
-  Vec3 center{0.0f};
-  float radius = 0.0f;  // of the sphere around the box
+  Vec3 lo{0.0f}, hi{0.0f};  // the box, every emitting point of the cluster
   Vec3 axis{0.0f, 0.0f, 1.0f};
   float power = 0.0f;              // the lights' summed LightBounds::power
   float cos_o = -1.0f, sin_o = 0;  // theta_o: every emitting normal within it of axis

@@ -135,6 +135,43 @@ TEST(LightTree, WithoutAReceiverCosineEveryBranchCanBeTakenAndTheProbabilitiesSu
   }
 }
 
+TEST(LightTree, SpotsWhoseConesMissTheReceiverAreNeverEnteredAndTheProbabilitiesSumToOne) {
+  // 64 spots 2 m up over [-1, 1]^2, pointing down with a 1 rad cone (0.5 rad half-angle), and 64
+  // point lights 30 to 50 m away. A receiver 20 m aside is outside every cone (atan(19 / 2) is
+  // 1.47 rad): the spots' clusters, bounded by their cones, must weigh zero, so every pick lands
+  // on a point light and the probabilities sum to one. Bounded as point lights (the old bounds)
+  // the spots' clusters were entered, then found empty: a "no light" pick, a sum below one.
+  std::vector<Light> lights;
+  for (uint32_t i = 0; i < 64; ++i) {
+    SpotLight::Settings s;
+    s.matrix = glm::translate(
+        Mat4(1.0f), Vec3(2.0f * random_float(i, 0, 0, 9) - 1.0f, 2.0f * random_float(i, 0, 1, 9) - 1.0f, 2.0f));
+    s.spot_size = 1.0f;
+    s.power = 1000.0f;
+    s.radius = i % 2 == 0 ? 0.0f : 0.1f;
+    lights.emplace_back(SpotLight::make(s));
+  }
+  for (uint32_t i = 0; i < 64; ++i)
+    lights.emplace_back(PointLight::make(Vec3(30.0f + 20.0f * random_float(i, 1, 0, 9),
+                                              10.0f * random_float(i, 1, 1, 9), 1.0f + random_float(i, 1, 2, 9)),
+                                         10.0f, Vec3(1.0f)));
+  const LightTree tree(lights);
+  for (const Vec3& p : {Vec3(20.0f, 0.0f, 0.0f), Vec3(20.0f, 5.0f, 0.5f), Vec3(-20.0f, 0.0f, 0.0f)}) {
+    double sum = 0.0, spots = 0.0;
+    for (size_t i = 0; i < lights.size(); ++i) {
+      const float probability = tree.probability(lights.data(), p, Vec3(0, 0, 1), i);
+      sum += probability;
+      if (i < 64) spots += probability;
+    }
+    EXPECT_EQ(spots, 0.0) << p.x;
+    EXPECT_NEAR(sum, 1.0, 1e-5) << p.x;
+  }
+  // Under the spots, where their cones reach, they are picked (and the sum is one there too).
+  double under = 0.0;
+  for (size_t i = 0; i < 64; ++i) under += tree.probability(lights.data(), Vec3(0.0f), Vec3(0, 0, 1), i);
+  EXPECT_GT(under, 0.9);
+}
+
 TEST_P(LightTreeLeaves, EveryLightThatCanContributeHasAPositiveProbability) {
   const std::vector<Light> lights = mixed_lights(400, 6);
   const LightTree tree(lights, GetParam());
