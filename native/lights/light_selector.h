@@ -21,9 +21,9 @@ namespace toyrt {
 
 // Scenes with more lights than this select through the light tree, the others linearly: measured
 // in docs/lights.md ("Light selection"). The tree's pick is cheaper from 32 lights on, but the
-// linear weights are each light's own importance and the tree's cluster bounds are coarser (a
-// variance about 30x higher on an open floor), so at equal time the tree wins only from about
-// 1,000 lights (0.93x the linear error at 1,000, 1.6x better at 3,000, 2.5x at 10,000).
+// linear weights are each light's own importance and the tree's cluster estimates are coarser (a
+// variance 15 to 20x higher on an open floor), so at equal time the tree wins only from about
+// 1,000 lights (the same error at 1,000, 1.9x better at 3,000, 2.6x at 10,000).
 inline constexpr size_t kLightTreeFrom = 1000;
 
 struct LightSelector {

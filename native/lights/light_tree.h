@@ -8,11 +8,13 @@
 // probabilities along its root-to-leaf path, and probability() recomputes that product along the
 // stored path, so it equals what select() returned bit for bit.
 //
-// Unbiased because a cluster's importance is a bound: zero only where no light in it can reach
-// (p, n) (the whole cone faces away from p, or the whole box is below p's tangent plane). A leaf
+// Unbiased because a cluster's importance is zero only where no light in it can reach (p, n) (the
+// whole cone faces away from p, or the whole box is below p's tangent plane); elsewhere it is a
+// positive estimate of the cluster's contribution (not a bound: see cluster_importance). A leaf
 // holds up to kLeafSize lights and weighs them by the sum of their own importance(), exact where
-// a bound is coarsest (the nearest lights); the pick inside it is the linear selector's. Lights at infinity (suns) have
-// no box: they are chosen among themselves by importance(), against the tree's root.
+// an estimate is coarsest (the nearest lights); the pick inside it is the linear selector's.
+// Lights at infinity (suns) have no box: they are chosen among themselves by importance(),
+// against the tree's root.
 //
 // Built once per commit by the scene (Scene::light_tree). Flat arrays, no allocation per call.
 #pragma once
@@ -25,10 +27,9 @@
 
 namespace toyrt {
 
-// A cluster, 52 bytes. Its box enters importance only through the bounding sphere.
+// A cluster, 64 bytes. The box bounds the angle it subtends (theta_u) and the receiver's horizon.
 struct LightTreeNode {
-  Vec3 center{0.0f};
-  float radius = 0.0f;  // of the sphere around the box
+  Vec3 lo{0.0f}, hi{0.0f};  // the box, every emitting point of the cluster
   Vec3 axis{0.0f, 0.0f, 1.0f};
   float power = 0.0f;              // the lights' summed LightBounds::power
   float cos_o = -1.0f, sin_o = 0;  // theta_o: every emitting normal within it of axis

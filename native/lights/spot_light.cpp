@@ -137,7 +137,18 @@ float importance(const SpotLight& light, const Vec3& p, const Vec3& n) {
   return centre - cap > light.outer_angle ? 0.0f : base;
 }
 
-LightBounds bounds(const SpotLight& light) { return bounds(light.emitter); }
+// The point light's box and power, with the cone: every emitting direction within outer_angle of
+// the axis (theta_o = 0, theta_e = outer_angle). A round spot's disk lights p when a direction
+// from one of its points to p lies in the cone, and those points are in the box, whose theta_u
+// covers them: so a cluster's bound is zero only where importance() is.
+LightBounds bounds(const SpotLight& light) {
+  LightBounds b = bounds(light.emitter);
+  if (light.outer_angle >= kPi) return b;  // no useful cone: a point light's bounds
+  b.axis = light.direction;
+  b.theta_o = 0.0f;
+  b.theta_e = light.outer_angle;
+  return b;
+}
 
 SpotFalloff parse_spot_falloff(const std::string& name) {
   if (name == "SMOOTHSTEP") return SpotFalloff::Smoothstep;

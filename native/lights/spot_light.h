@@ -74,8 +74,8 @@ LightEval evaluate(const SpotLight& light, const Vec3& p, const Vec3& wi, const 
 // The point light's importance, times the cone's factor towards p (a delta spot) or 1 (a round
 // one, whose cone edge is blurred by its size: a bound, never zero where light can arrive).
 float importance(const SpotLight& light, const Vec3& p, const Vec3& n);
-// The emitter's bounds, as a point light's: the cone is not bounded, since the object's scale
-// makes it elliptical and a round spot's edge is blurred by its size (a bound, never too tight).
+// The emitter's bounds: the point light's box and power, and the cone of directions
+// attenuation() lets through (outer_angle around the axis, the elliptical cone's widest angle).
 LightBounds bounds(const SpotLight& light);
 
 SpotFalloff parse_spot_falloff(const std::string& name);  // throws std::invalid_argument

@@ -2,9 +2,10 @@
 // sum to one (less the mass of branches no light below can use, which select() reports as "no
 // light" just as often), select()'s frequencies equal to probability(), and probability() equal
 // to what select() returned bit for bit; a positive probability for every light that can
-// contribute and zero for clusters the bounds prove cannot; the one-sample estimate converging
-// to the closed-form irradiance of hundreds of lights; a variance far below uniform selection
-// near one bright light; and builds of degenerate light sets. The scene builds it at commit.
+// contribute and zero for clusters the bounds prove cannot (spots aimed away included); the
+// one-sample estimate converging to the closed-form irradiance of hundreds of lights, and of a
+// square split into 1,600 lamps; a variance far below uniform selection near one bright light;
+// and builds of degenerate light sets. The scene builds it at commit.
 #include "lights/light_tree.h"
 #include "lights/light.h"
 #include "lights/light_selector.h"
@@ -132,6 +133,85 @@ TEST(LightTree, WithoutAReceiverCosineEveryBranchCanBeTakenAndTheProbabilitiesSu
     double sum = 0.0;
     for (size_t i = 0; i < lights.size(); ++i) sum += tree.probability(lights.data(), p, Vec3(0.0f), i);
     EXPECT_NEAR(sum, 1.0, 1e-5);
+  }
+}
+
+TEST(LightTree, SpotsWhoseConesMissTheReceiverAreNeverEnteredAndTheProbabilitiesSumToOne) {
+  // 64 spots 2 m up over [-1, 1]^2, pointing down with a 1 rad cone (0.5 rad half-angle), and 64
+  // point lights 30 to 50 m away. A receiver 20 m aside is outside every cone (atan(19 / 2) is
+  // 1.47 rad): the spots' clusters, bounded by their cones, must weigh zero, so every pick lands
+  // on a point light and the probabilities sum to one. Bounded as point lights (the old bounds)
+  // the spots' clusters were entered, then found empty: a "no light" pick, a sum below one.
+  std::vector<Light> lights;
+  for (uint32_t i = 0; i < 64; ++i) {
+    SpotLight::Settings s;
+    s.matrix = glm::translate(
+        Mat4(1.0f), Vec3(2.0f * random_float(i, 0, 0, 9) - 1.0f, 2.0f * random_float(i, 0, 1, 9) - 1.0f, 2.0f));
+    s.spot_size = 1.0f;
+    s.power = 1000.0f;
+    s.radius = i % 2 == 0 ? 0.0f : 0.1f;
+    lights.emplace_back(SpotLight::make(s));
+  }
+  for (uint32_t i = 0; i < 64; ++i)
+    lights.emplace_back(PointLight::make(Vec3(30.0f + 20.0f * random_float(i, 1, 0, 9),
+                                              10.0f * random_float(i, 1, 1, 9), 1.0f + random_float(i, 1, 2, 9)),
+                                         10.0f, Vec3(1.0f)));
+  const LightTree tree(lights);
+  for (const Vec3& p : {Vec3(20.0f, 0.0f, 0.0f), Vec3(20.0f, 5.0f, 0.5f), Vec3(-20.0f, 0.0f, 0.0f)}) {
+    double sum = 0.0, spots = 0.0;
+    for (size_t i = 0; i < lights.size(); ++i) {
+      const float probability = tree.probability(lights.data(), p, Vec3(0, 0, 1), i);
+      sum += probability;
+      if (i < 64) spots += probability;
+    }
+    EXPECT_EQ(spots, 0.0) << p.x;
+    EXPECT_NEAR(sum, 1.0, 1e-5) << p.x;
+  }
+  // Under the spots, where their cones reach, they are picked (and the sum is one there too).
+  double under = 0.0;
+  for (size_t i = 0; i < 64; ++i) under += tree.probability(lights.data(), Vec3(0.0f), Vec3(0, 0, 1), i);
+  EXPECT_GT(under, 0.9);
+}
+
+// The irradiance at a point h below a corner of a w x l rectangle of radiance L facing it,
+// parallel to its plane: pi L times the form factor (Howell's catalogue, C-11).
+double corner_rectangle_irradiance(double L, double w, double l, double h) {
+  const double x = w / h, y = l / h;
+  return L / 2.0 *
+         (x / std::sqrt(1 + x * x) * std::atan(y / std::sqrt(1 + x * x)) +
+          y / std::sqrt(1 + y * y) * std::atan(x / std::sqrt(1 + y * y)));
+}
+
+TEST(LightTree, AUniformSquareSplitIntoSixteenHundredLampsHasTheWholeSquaresClosedFormIrradiance) {
+  // A 1 m square 0.5 m up, facing down, as 40 x 40 square lamps of one radiance: through the
+  // tree (1,600 lamps), the one-sample estimate at points under it converges to the closed form
+  // of the whole square (four corner rectangles around the point), and the probabilities of all
+  // lamps sum to one.
+  constexpr int kSide = 40;
+  constexpr float kCell = 1.0f / kSide, kHeight = 0.5f;
+  std::vector<Light> lights;
+  for (int i = 0; i < kSide; ++i)
+    for (int j = 0; j < kSide; ++j)
+      lights.emplace_back(AreaLight::make(AreaShape::Square, kCell, kCell,
+                                          glm::translate(Mat4(1.0f), Vec3(-0.5f + (float(i) + 0.5f) * kCell,
+                                                                          -0.5f + (float(j) + 0.5f) * kCell, kHeight)),
+                                          10.0f, Vec3(1.0f)));
+  const double L = std::get<AreaLight>(lights[0]).radiance.x;
+  const LightTree tree(lights);
+  const Vec3 up(0, 0, 1);
+  for (const Vec3& p : {Vec3(0.0f), Vec3(0.3f, -0.2f, 0.0f)}) {
+    double closed = 0.0;
+    for (double w : {0.5 - double(p.x), 0.5 + double(p.x)})
+      for (double l : {0.5 - double(p.y), 0.5 + double(p.y)}) closed += corner_rectangle_irradiance(L, w, l, kHeight);
+    double sum = 0.0;
+    for (size_t i = 0; i < lights.size(); ++i) sum += tree.probability(lights.data(), p, up, i);
+    EXPECT_NEAR(sum, 1.0, 1e-5);
+    const Estimate e = monte_carlo(40000, [&](uint32_t k) {
+      const LightSelection pick = tree.select(lights.data(), p, up, random_float(k, 0, 0, 11));
+      if (!pick.found()) return 0.0;
+      return irradiance_sample(lights[size_t(pick.index)], p, up, rand2(k, 12)) / pick.probability;
+    });
+    EXPECT_NEAR(e.mean, closed, 4.0 * e.standard_error + 1e-3 * closed) << p.x << " " << e.standard_error;
   }
 }
 
