@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from . import materials
 from .material_normal import tangent_uv_map
+from .material_mix import MixImages
 from .materials import PLACEHOLDER, PLACEHOLDER_PIXELS, ImageKey
 
 
@@ -20,7 +21,7 @@ class MaterialSync:
         if sent is not None:
             return sent[0]
         converted = materials.material_spec(mat)
-        mid = self.scene.add_material(**self._material_arguments(converted))
+        mid = self.scene.add_material(**self._material_arguments(converted, name))
         self.materials[name] = (mid, converted.spec)
         self._converted_now.add(name)
         return mid
@@ -47,20 +48,51 @@ class MaterialSync:
         if sent is None:
             return 0
         converted = materials.material_spec(mat)
-        arguments = self._material_arguments(converted)
         if converted.spec != sent[1]:
-            self.scene.set_material(sent[0], **arguments)
+            self.scene.set_material(sent[0], **self._material_arguments(converted, mat.name_full))
             self.materials[mat.name_full] = (sent[0], converted.spec)
         return 1
 
-    def _material_arguments(self, converted: materials.ConvertedMaterial) -> dict:
+    def _material_arguments(self, converted: materials.ConvertedMaterial, name: str) -> dict:
         self._note(converted.notes)
         spec = converted.spec
         texture, opacity = spec.texture, spec.opacity_texture
         bent = spec.normal_map.texture if spec.normal_map is not None else None
-        return spec.arguments(self._texture_id(texture, converted.image) if texture is not None else -1,
+        args = spec.arguments(self._texture_id(texture, converted.image) if texture is not None else -1,
                               self._texture_id(opacity, converted.opacity_image) if opacity is not None else -1,
                               self._texture_id(bent, converted.normal_image) if bent is not None else -1)
+        if spec.kind == "mix":
+            images = dict(converted.image.images) if isinstance(converted.image, MixImages) else {}
+            parts = iter(self.mix_parts.get(name, ()))
+            sent = []
+            args.update(self._mix_inputs(spec, images, parts, sent))
+            self.mix_parts[name] = sent
+        return args
+
+    def _mix_inputs(self, spec, images: dict, reuse, sent: list) -> dict:
+        """first, second (and fac_texture) of a 'mix' spec: its inputs sent as materials of their own
+        (nested mixes first), into the ids `reuse` yields while it has some (the material's inputs
+        sent before), else new ones; each id sent is appended to `sent`."""
+        ids = []
+        for part in spec.mix_inputs:
+            if part is None:
+                ids.append(-1)
+                continue
+            args = part.arguments(*(self._texture_id(k, images.get(k)) if k is not None else -1
+                                    for k in (part.texture, part.opacity_texture, None)))
+            if part.kind == "mix":
+                args.update(self._mix_inputs(part, images, reuse, sent))
+            mid = next(reuse, None)
+            if mid is None:
+                mid = self.scene.add_material(**args)
+            else:
+                self.scene.set_material(mid, **args)
+            sent.append(mid)
+            ids.append(mid)
+        out = dict(first=ids[0], second=ids[1])
+        if spec.mix_fac_texture is not None:
+            out["fac_texture"] = self._texture_id(spec.mix_fac_texture, images.get(spec.mix_fac_texture))
+        return out
 
     def _texture_id(self, key: ImageKey, image) -> int:
         tid = self.textures.get(key)

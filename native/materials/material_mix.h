@@ -44,9 +44,9 @@ struct MaterialMix {
   // for an unknown source or a texture source without a texture.
   static MaterialMix from_params(const Params& params);
 
-  // Throws std::invalid_argument for a child id that is not -1 or a material added before
-  // `self` (so mixes cannot form a cycle), or an unknown texture.
-  void check(int64_t self, size_t textures) const;
+  // Throws std::invalid_argument for a child id that is not -1 or another of the scene's
+  // `materials`, or an unknown texture (Scene::set_mix refuses cycles).
+  void check(int64_t self, size_t materials, size_t textures) const;
 
   bool operator==(const MaterialMix& o) const {
     return active == o.active && add == o.add && first == o.first && second == o.second && factor == o.factor &&

@@ -98,6 +98,7 @@ uint32_t PyScene::add_material(const std::string& kind, const Params& params) {
   const Material material = mix ? Material(Lambert{Vec3(0.0f)}) : make_material(kind, params);
   if (mix) params.check_all_read();
   return write([&] {
+    if (mix) scene_.check_mix(int64_t(scene_.materials().size()), mixed);  // before anything changes
     const uint32_t id = scene_.add_material(material, emission, transparency, normal_map);
     if (mix) scene_.set_mix(id, mixed);
     return id;
@@ -113,7 +114,7 @@ void PyScene::set_material(int64_t id, const std::string& kind, const Params& pa
   const Material material = mix ? Material(Lambert{Vec3(0.0f)}) : make_material(kind, params);
   if (mix) params.check_all_read();
   write([&] {
-    if (mix) mixed.check(id, scene_.textures().size());  // before anything changes
+    if (mix) scene_.check_mix(id, mixed);  // before anything changes
     scene_.set_material(id, material, emission, transparency, normal_map);
     if (mix) scene_.set_mix(id, mixed);
   });

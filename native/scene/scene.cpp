@@ -156,9 +156,26 @@ void Scene::set_material(int64_t material, const Material& replacement, const Ma
 void Scene::set_mix(int64_t material, const MaterialMix& mix) {
   if (material < 0 || size_t(material) >= materials_.size())
     throw std::invalid_argument("unknown material id " + std::to_string(material));
-  mix.check(material, textures_.size());
+  check_mix(material, mix);
   mixes_[size_t(material)] = mix;
   any_mix_ = std::any_of(mixes_.begin(), mixes_.end(), [](const MaterialMix& m) { return m.active; });
+}
+
+void Scene::check_mix(int64_t material, const MaterialMix& mix) const {
+  mix.check(material, materials_.size(), textures_.size());
+  // No cycles: nothing this mix reaches through other mixes may lead back to it (the render
+  // would draw forever; pick_mixed stops at a depth bound anyway).
+  std::vector<int32_t> todo{mix.first, mix.second};
+  for (size_t steps = 0; !todo.empty(); ++steps) {
+    const int32_t id = todo.back();
+    todo.pop_back();
+    if (id == material || steps > 4 * materials_.size())
+      throw std::invalid_argument("mix " + std::to_string(material) + " would contain itself");
+    if (id >= 0 && mixes_[size_t(id)].active) {
+      todo.push_back(mixes_[size_t(id)].first);
+      todo.push_back(mixes_[size_t(id)].second);
+    }
+  }
 }
 
 uint32_t Scene::add_texture(Texture texture) {

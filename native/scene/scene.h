@@ -196,6 +196,8 @@ class Scene {
   // becomes a mix of two materials added before it; set_material makes it a plain material
   // again. Throws std::invalid_argument for an unknown id or child.
   void set_mix(int64_t material, const MaterialMix& mix);
+  // set_mix's checks alone (material may be the id the next add_material returns).
+  void check_mix(int64_t material, const MaterialMix& mix) const;
   const std::vector<MaterialMix>& mixes() const { return mixes_; }  // parallel to materials()
   // Whether some material is a mix: only then does a hit look its slot up (pick_mixed).
   bool any_mix() const { return any_mix_; }

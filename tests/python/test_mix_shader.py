@@ -134,7 +134,7 @@ def test_a_plain_material_set_over_a_mix_is_no_longer_mixed():
 def test_bad_mixes_are_refused_by_name():
     s = toyrt.Scene()
     a = s.add_material("diffuse")
-    with pytest.raises(ValueError, match="mix input 5 must be -1 or a material added before"):
+    with pytest.raises(ValueError, match="mix input 5 must be -1 or another material id"):
         s.add_material("mix", first=a, second=5)
     with pytest.raises(ValueError, match="fac_source must be"):
         s.add_material("mix", first=a, fac_source="noise")
@@ -144,5 +144,9 @@ def test_bad_mixes_are_refused_by_name():
         s.add_material("mix", first=a, fac_source="gray", fac_texture=3)
     with pytest.raises(TypeError, match="unknown argument"):
         s.add_material("mix", first=a, roughness=0.5)
-    with pytest.raises(ValueError, match="must be -1 or a material added before the mix"):
-        s.set_material(a, "mix", first=a)   # itself: a cycle
+    with pytest.raises(ValueError, match="must be -1 or another material id"):
+        s.set_material(a, "mix", first=a)   # itself
+    m1 = s.add_material("mix", first=a)
+    m2 = s.add_material("mix", first=m1)
+    with pytest.raises(ValueError, match="mix 1 would contain itself"):
+        s.set_material(m1, "mix", first=m2)   # a cycle through another mix
