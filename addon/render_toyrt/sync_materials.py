@@ -6,8 +6,8 @@ id tables): it is here only to keep each file one concern. Nothing else uses it.
 from __future__ import annotations
 
 from . import materials
-from .material_normal import tangent_uv_map
 from .material_mix import MixImages
+from .material_normal import tangent_uv_map
 from .materials import PLACEHOLDER, PLACEHOLDER_PIXELS, ImageKey
 
 

@@ -46,8 +46,9 @@ void MaterialMix::check(int64_t self, size_t materials, size_t textures) const {
   if (!active) return;
   for (const int32_t child : {first, second})
     if (child < -1 || child >= int64_t(materials) || child == self)
-      throw std::invalid_argument("mix input " + std::to_string(child) + " must be -1 or another material id (the mix is " +
-                                  std::to_string(self) + ", the scene has " + std::to_string(materials) + ")");
+      throw std::invalid_argument("mix input " + std::to_string(child) +
+                                  " must be -1 or another material id (the mix is " + std::to_string(self) +
+                                  ", the scene has " + std::to_string(materials) + ")");
   if (texture < -1 || texture >= int64_t(textures))
     throw std::invalid_argument("unknown fac_texture id " + std::to_string(texture) + " (the scene has " +
                                 std::to_string(textures) + " textures)");

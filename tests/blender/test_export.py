@@ -731,7 +731,7 @@ def test_command_line_range():
         print(run.stdout[-2000:], run.stderr[-2000:])
 
 
-PARTS = [test_counts_and_transforms, test_instancing_memory, test_missing_texture, test_unsupported_node, test_mix_shader,
-         test_principled_specular_layer, test_principled_transmission, test_glass_color,
+PARTS = [test_counts_and_transforms, test_instancing_memory, test_missing_texture, test_unsupported_node,
+         test_mix_shader, test_principled_specular_layer, test_principled_transmission, test_glass_color,
          test_rough_glass_and_refraction, test_cancel, test_animation, test_command_line_range]
 run_script(PARTS, "export", TMP)
