@@ -1,8 +1,8 @@
 // The Mix / Add Shader's draw (materials/material_mix.h): each input is chosen with probability
 // proportional to its weight and carries weight / probability, so the expected weight of every
 // leaf is its share of the mixed closure; and the view-dependent factors' closed forms.
-#include "materials/fresnel.h"
 #include "materials/material_mix.h"
+#include "materials/fresnel.h"
 
 #include <gtest/gtest.h>
 
