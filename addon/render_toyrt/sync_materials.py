@@ -141,8 +141,16 @@ class MaterialSync:
                 continue
             if tid == placeholder:
                 tid = self.textures[key] = self.scene.add_texture(pixels, srgb=key.srgb)
-                for mid, spec in self.materials.values():
+                for name, (mid, spec) in list(self.materials.items()):
                     bent = spec.normal_map.texture if spec.normal_map is not None else None
+                    if spec.kind == "mix":
+                        # Its inputs are materials of their own: convert it again, all sent anew.
+                        import bpy
+                        mat = bpy.data.materials.get(name) if key in _mix_keys(spec) or key == bent else None
+                        if mat is not None:
+                            self.scene.set_material(mid, **self._material_arguments(materials.material_spec(mat),
+                                                                                    name))
+                        continue
                     if key in (spec.texture, spec.opacity_texture, bent):
                         ids = [self.textures.get(k, -1) if k is not None else -1
                                for k in (spec.texture, spec.opacity_texture, bent)]
@@ -152,3 +160,12 @@ class MaterialSync:
             self.texture_notes[key] = notes
             count += 1
         return count
+
+
+def _mix_keys(spec) -> set:
+    """Every texture key a 'mix' spec and its inputs read (the normal map's aside)."""
+    keys = {spec.texture, spec.opacity_texture, spec.mix_fac_texture}
+    for part in spec.mix_inputs:
+        if part is not None:
+            keys |= _mix_keys(part)
+    return keys - {None}
