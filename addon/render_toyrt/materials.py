@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .material_dielectric import dielectric_spec
-from .material_mix import mix_of_diffuse_and_glossy
+from .material_mix import general_mix, mix_of_diffuse_and_glossy
 
 DEFAULT_GREY = (0.8, 0.8, 0.8)   # Blender's default surface colour
 MAGENTA = (1.0, 0.0, 1.0)        # placeholder for missing images
@@ -78,6 +78,16 @@ class MaterialSpec:
     opacity_invert: bool = False
     transparent_color: tuple[float, float, float] = (1.0, 1.0, 1.0)
     normal_map: object = None    # material_normal.NormalMapSpec: the Normal Map on the Normal input
+    # 'mix' (material_mix.general_mix, the core's materials/material_mix.h): a Mix or Add Shader
+    # of two other specs (None: an unlinked input, black), one drawn per hit by its weight; the
+    # factor a constant, an image's 'alpha' or 'gray' (mix_fac_texture), 'fresnel' (mix_fac_param:
+    # the IOR), 'layer_fresnel' or 'layer_facing' (mix_fac_param: the blend).
+    mix_inputs: tuple = ()
+    mix_add: bool = False
+    mix_fac: float = 0.5
+    mix_fac_source: str = "constant"
+    mix_fac_texture: ImageKey | None = None
+    mix_fac_param: float = 0.5
 
     @property
     def transparent(self) -> bool:
@@ -109,6 +119,9 @@ class MaterialSpec:
                             coat_tint=self.coat_tint)
         if self.kind == "diffuse_glossy":
             args.update(diffuse_weight=self.diffuse_weight, glossy_color=self.glossy_color)
+        if self.kind == "mix":   # its inputs' ids: the caller's (sync_materials.py sends them first)
+            args.update(add=self.mix_add, fac=self.mix_fac, fac_source=self.mix_fac_source,
+                        fac_param=self.mix_fac_param)
         return args
 
 
@@ -325,7 +338,7 @@ def _convert_node(name, node, notes):
     if t in ("MIX_SHADER", "ADD_SHADER"):
         from .material_alpha import transparent_mix
         mixed = transparent_mix(name, node, notes, _convert_node) or mix_of_diffuse_and_glossy(
-            name, node, notes, _convert_node)
+            name, node, notes, _convert_node) or general_mix(name, node, notes, _convert_node)
         if mixed is not None:
             return mixed
     if t == "EMISSION":

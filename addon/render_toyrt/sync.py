@@ -78,6 +78,7 @@ class SceneSync(MaterialSync):
         # Keyed by name, not pointer: a final render's depsgraph may hand out new copies of the same
         # material every frame, and they must be found again.
         self.materials: dict[str, tuple[int, materials.MaterialSpec]] = {}  # name ('': none) -> (id, spec sent)
+        self.mix_parts: dict[str, list[int]] = {}  # a mix material's name -> the ids its inputs were sent into
         self.textures: dict[ImageKey, int] = {}        # image -> texture id (missing: the placeholder's)
         self.texture_notes: dict[ImageKey, tuple[str, ...]] = {}
         self.lights: tuple[LightSpec, ...] | None = None   # the light specs last sent

@@ -6,6 +6,7 @@ id tables): it is here only to keep each file one concern. Nothing else uses it.
 from __future__ import annotations
 
 from . import materials
+from .material_mix import MixImages
 from .material_normal import tangent_uv_map
 from .materials import PLACEHOLDER, PLACEHOLDER_PIXELS, ImageKey
 
@@ -20,7 +21,7 @@ class MaterialSync:
         if sent is not None:
             return sent[0]
         converted = materials.material_spec(mat)
-        mid = self.scene.add_material(**self._material_arguments(converted))
+        mid = self.scene.add_material(**self._material_arguments(converted, name))
         self.materials[name] = (mid, converted.spec)
         self._converted_now.add(name)
         return mid
@@ -47,20 +48,51 @@ class MaterialSync:
         if sent is None:
             return 0
         converted = materials.material_spec(mat)
-        arguments = self._material_arguments(converted)
         if converted.spec != sent[1]:
-            self.scene.set_material(sent[0], **arguments)
+            self.scene.set_material(sent[0], **self._material_arguments(converted, mat.name_full))
             self.materials[mat.name_full] = (sent[0], converted.spec)
         return 1
 
-    def _material_arguments(self, converted: materials.ConvertedMaterial) -> dict:
+    def _material_arguments(self, converted: materials.ConvertedMaterial, name: str) -> dict:
         self._note(converted.notes)
         spec = converted.spec
         texture, opacity = spec.texture, spec.opacity_texture
         bent = spec.normal_map.texture if spec.normal_map is not None else None
-        return spec.arguments(self._texture_id(texture, converted.image) if texture is not None else -1,
+        args = spec.arguments(self._texture_id(texture, converted.image) if texture is not None else -1,
                               self._texture_id(opacity, converted.opacity_image) if opacity is not None else -1,
                               self._texture_id(bent, converted.normal_image) if bent is not None else -1)
+        if spec.kind == "mix":
+            images = dict(converted.image.images) if isinstance(converted.image, MixImages) else {}
+            parts = iter(self.mix_parts.get(name, ()))
+            sent = []
+            args.update(self._mix_inputs(spec, images, parts, sent))
+            self.mix_parts[name] = sent
+        return args
+
+    def _mix_inputs(self, spec, images: dict, reuse, sent: list) -> dict:
+        """first, second (and fac_texture) of a 'mix' spec: its inputs sent as materials of their own
+        (nested mixes first), into the ids `reuse` yields while it has some (the material's inputs
+        sent before), else new ones; each id sent is appended to `sent`."""
+        ids = []
+        for part in spec.mix_inputs:
+            if part is None:
+                ids.append(-1)
+                continue
+            args = part.arguments(*(self._texture_id(k, images.get(k)) if k is not None else -1
+                                    for k in (part.texture, part.opacity_texture, None)))
+            if part.kind == "mix":
+                args.update(self._mix_inputs(part, images, reuse, sent))
+            mid = next(reuse, None)
+            if mid is None:
+                mid = self.scene.add_material(**args)
+            else:
+                self.scene.set_material(mid, **args)
+            sent.append(mid)
+            ids.append(mid)
+        out = dict(first=ids[0], second=ids[1])
+        if spec.mix_fac_texture is not None:
+            out["fac_texture"] = self._texture_id(spec.mix_fac_texture, images.get(spec.mix_fac_texture))
+        return out
 
     def _texture_id(self, key: ImageKey, image) -> int:
         tid = self.textures.get(key)
@@ -109,8 +141,16 @@ class MaterialSync:
                 continue
             if tid == placeholder:
                 tid = self.textures[key] = self.scene.add_texture(pixels, srgb=key.srgb)
-                for mid, spec in self.materials.values():
+                for name, (mid, spec) in list(self.materials.items()):
                     bent = spec.normal_map.texture if spec.normal_map is not None else None
+                    if spec.kind == "mix":
+                        # Its inputs are materials of their own: convert it again, all sent anew.
+                        import bpy
+                        mat = bpy.data.materials.get(name) if key in _mix_keys(spec) or key == bent else None
+                        if mat is not None:
+                            self.scene.set_material(mid, **self._material_arguments(materials.material_spec(mat),
+                                                                                    name))
+                        continue
                     if key in (spec.texture, spec.opacity_texture, bent):
                         ids = [self.textures.get(k, -1) if k is not None else -1
                                for k in (spec.texture, spec.opacity_texture, bent)]
@@ -120,3 +160,12 @@ class MaterialSync:
             self.texture_notes[key] = notes
             count += 1
         return count
+
+
+def _mix_keys(spec) -> set:
+    """Every texture key a 'mix' spec and its inputs read (the normal map's aside)."""
+    keys = {spec.texture, spec.opacity_texture, spec.mix_fac_texture}
+    for part in spec.mix_inputs:
+        if part is not None:
+            keys |= _mix_keys(part)
+    return keys - {None}

@@ -183,7 +183,12 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       "'NONE': only seen by rays that hit it). And every kind takes a Normal Map: normal_map (a texture id,\n"
       "-1: none; its RGB is the normal, 2 c - 1), normal_strength (1), normal_space ('TANGENT': needs the\n"
       "mesh's tangents, see add_mesh; 'OBJECT', 'WORLD', 'BLENDER_OBJECT', 'BLENDER_WORLD'), normal_convention\n"
-      "('OPENGL'; 'DIRECTX' negates green) and normal_strength_mode ('tangent': Blender 4.x+; 'blend': 3.x).";
+      "('OPENGL'; 'DIRECTX' negates green) and normal_strength_mode ('tangent': Blender 4.x+; 'blend': 3.x).\n"
+      "kind 'mix' (Blender's Mix and Add Shaders): first, second (ids of other materials, -1: black), add\n"
+      "(False: a Mix, (1 - f) first + f second; True: first + second), fac (0.5, clamped to [0, 1]),\n"
+      "fac_source ('constant'; 'alpha' or 'gray' of fac_texture at the hit's UV; 'fresnel' with fac_param the\n"
+      "IOR; 'layer_fresnel' or 'layer_facing' with fac_param the blend). Each hit shades one input, drawn by\n"
+      "its weight; the mix's own emission, cut-out and normal map apply (its inputs' do not).";
 
   py::class_<PyScene>(m, "Scene", "A two-level scene: meshes stored once, placed by instances.")
       .def(py::init<>())

@@ -91,16 +91,33 @@ uint32_t PyScene::add_material(const std::string& kind, const Params& params) {
   const MaterialEmission emission = emission_of(params);
   const MaterialTransparency transparency = transparency_of(params);
   const MaterialNormalMap normal_map = MaterialNormalMap::from_params(params);
-  const Material material = make_material(kind, params);
-  return write([&] { return scene_.add_material(material, emission, transparency, normal_map); });
+  // A Mix or Add Shader (materials/material_mix.h): its own slot holds a black diffuse, never
+  // shaded, beside the mix that names the two materials it stands for.
+  const bool mix = kind == "mix";
+  const MaterialMix mixed = mix ? MaterialMix::from_params(params) : MaterialMix{};
+  const Material material = mix ? Material(Lambert{Vec3(0.0f)}) : make_material(kind, params);
+  if (mix) params.check_all_read();
+  return write([&] {
+    if (mix) scene_.check_mix(int64_t(scene_.materials().size()), mixed);  // before anything changes
+    const uint32_t id = scene_.add_material(material, emission, transparency, normal_map);
+    if (mix) scene_.set_mix(id, mixed);
+    return id;
+  });
 }
 
 void PyScene::set_material(int64_t id, const std::string& kind, const Params& params) {
   const MaterialEmission emission = emission_of(params);
   const MaterialTransparency transparency = transparency_of(params);
   const MaterialNormalMap normal_map = MaterialNormalMap::from_params(params);
-  const Material material = make_material(kind, params);
-  write([&] { scene_.set_material(id, material, emission, transparency, normal_map); });
+  const bool mix = kind == "mix";
+  const MaterialMix mixed = mix ? MaterialMix::from_params(params) : MaterialMix{};
+  const Material material = mix ? Material(Lambert{Vec3(0.0f)}) : make_material(kind, params);
+  if (mix) params.check_all_read();
+  write([&] {
+    if (mix) scene_.check_mix(id, mixed);  // before anything changes
+    scene_.set_material(id, material, emission, transparency, normal_map);
+    if (mix) scene_.set_mix(id, mixed);
+  });
 }
 
 uint32_t PyScene::add_texture(py::handle pixels, bool srgb) {

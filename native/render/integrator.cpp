@@ -263,6 +263,15 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
              : direct_lighting<true, false>(scene, s, ng, ns, f, &retro, depth, pixel, sample, settings);
 }
 
+// The leaf material of a mix slot (materials/material_mix.h), drawn on its own sample dimension;
+// a slot that is no mix is its own leaf. Out of line: only scenes with a Mix Shader call it.
+[[gnu::noinline]] MixPick pick_mix(const Scene& scene, int32_t material, const Vec2& uv, const Vec3& wo, const Vec3& ns,
+                                   bool front, uint32_t pixel, uint32_t sample, int depth,
+                                   const IntegratorSettings& settings) {
+  const float u = sobol_owen_1d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 8), settings.seed);
+  return pick_mixed(scene.mixes(), scene.textures(), material, MixPoint{uv, wo, ns, !front}, u);
+}
+
 // The kind of ray that leaves a surface along wi, on the side of ng the path came from: a
 // reflection (glossy, as Cycles' path flags) or a refraction (transmission).
 RayKind kind_towards(const Vec3& wi, const Vec3& ng) {
@@ -321,8 +330,8 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     const bool front = glm::dot(s.ng, wo) > 0.0f;
     const Vec3 ng = front ? s.ng : -s.ng;
     const Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;
-    const Material& m =
-        s.material >= 0 && size_t(s.material) < materials.size() ? materials[size_t(s.material)] : kDefault;
+    const Material* m =
+        s.material >= 0 && size_t(s.material) < materials.size() ? &materials[size_t(s.material)] : &kDefault;
     if (first) {
       *first = FirstHit{true, s.p, ns, Vec3(0.0f), Vec3(0.0f), lamps, Vec3(0.0f), {wo, s.ng, s.ns, s.uv}};
       first->instance = hit.instance;
@@ -344,6 +353,15 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
       if (throughput == Vec3(0.0f)) break;
     }
     if (light_only) break;
+    // A Mix or Add Shader: one of its materials, drawn by weight (materials/material_mix.h), out
+    // of line and only in scenes that have one. Its slot's emission, cut-out and normal map were
+    // applied above.
+    if (scene.any_mix()) [[unlikely]] {
+      const MixPick pick = pick_mix(scene, s.material, s.uv, wo, ns, front, pixel, sample, depth, settings);
+      if (pick.leaf < 0) break;  // black
+      throughput *= pick.weight;
+      m = &materials[size_t(pick.leaf)];
+    }
     // One generic dispatch per hit, no per-type code: the lambda is instantiated per material
     // type, so for an inline scatter() (Lambert's) the compiler sees the answer's kind as a
     // constant and keeps only the diffuse path, as fast as a hand-written case. It returns
@@ -434,7 +452,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
           ray = Ray{offset_ray_origin(s.p, sc.branches[0].offset_normal), 0.0f, sc.branches[0].wi, kInfinity};
           return true;
         },
-        m);
+        *m);
     first = nullptr;  // passes see the first surface only
     if (!go_on) break;
   }

@@ -116,6 +116,7 @@ uint32_t Scene::add_material(const Material& material, const MaterialEmission& e
   emission_.push_back(emission);
   transparency_.push_back(transparency);
   normal_maps_.push_back(normal_map);
+  mixes_.emplace_back();
   any_transparency_ = any_transparency_ || transparency.transparent();
   any_normal_map_ = any_normal_map_ || normal_map.active();
   if (emission.emits()) {
@@ -136,6 +137,10 @@ void Scene::set_material(int64_t material, const Material& replacement, const Ma
   materials_[size_t(material)] = replacement;
   transparency_[size_t(material)] = transparency;
   normal_maps_[size_t(material)] = normal_map;
+  if (mixes_[size_t(material)].active) {
+    mixes_[size_t(material)] = MaterialMix{};
+    any_mix_ = std::any_of(mixes_.begin(), mixes_.end(), [](const MaterialMix& m) { return m.active; });
+  }
   any_normal_map_ =
       std::any_of(normal_maps_.begin(), normal_maps_.end(), [](const MaterialNormalMap& n) { return n.active(); });
   any_transparency_ = std::any_of(transparency_.begin(), transparency_.end(),
@@ -145,6 +150,31 @@ void Scene::set_material(int64_t material, const Material& replacement, const Ma
     any_emission_ =
         std::any_of(emission_.begin(), emission_.end(), [](const MaterialEmission& e) { return e.emits(); });
     committed_ = false;  // the emissive triangles are gathered again
+  }
+}
+
+void Scene::set_mix(int64_t material, const MaterialMix& mix) {
+  if (material < 0 || size_t(material) >= materials_.size())
+    throw std::invalid_argument("unknown material id " + std::to_string(material));
+  check_mix(material, mix);
+  mixes_[size_t(material)] = mix;
+  any_mix_ = std::any_of(mixes_.begin(), mixes_.end(), [](const MaterialMix& m) { return m.active; });
+}
+
+void Scene::check_mix(int64_t material, const MaterialMix& mix) const {
+  mix.check(material, materials_.size(), textures_.size());
+  // No cycles: nothing this mix reaches through other mixes may lead back to it (the render
+  // would draw forever; pick_mixed stops at a depth bound anyway).
+  std::vector<int32_t> todo{mix.first, mix.second};
+  for (size_t steps = 0; !todo.empty(); ++steps) {
+    const int32_t id = todo.back();
+    todo.pop_back();
+    if (id == material || steps > 4 * materials_.size())
+      throw std::invalid_argument("mix " + std::to_string(material) + " would contain itself");
+    if (id >= 0 && mixes_[size_t(id)].active) {
+      todo.push_back(mixes_[size_t(id)].first);
+      todo.push_back(mixes_[size_t(id)].second);
+    }
   }
 }
 
@@ -447,7 +477,7 @@ size_t Scene::memory_bytes() const {
   bytes += (grid.conditional.capacity() + grid.marginal.capacity() + grid.density.capacity()) * sizeof(float);
   bytes += emitters_.triangles.capacity() * sizeof(EmissiveTriangle) + emitters_.cdf.capacity() * sizeof(float);
   bytes += materials_.capacity() * sizeof(Material) + emission_.capacity() * sizeof(MaterialEmission) +
-           normal_maps_.capacity() * sizeof(MaterialNormalMap) +
+           normal_maps_.capacity() * sizeof(MaterialNormalMap) + mixes_.capacity() * sizeof(MaterialMix) +
            transparency_.capacity() * sizeof(MaterialTransparency) + world_.lights.capacity() * sizeof(Light);
   return bytes + light_tree_.memory_bytes();
 }

@@ -18,6 +18,7 @@
 #include "lights/mesh_emitters.h"
 #include "materials/emission.h"
 #include "materials/material.h"
+#include "materials/material_mix.h"
 #include "materials/normal_map.h"
 #include "materials/texture.h"
 #include "materials/transparency.h"
@@ -191,6 +192,15 @@ class Scene {
   // Whether some material has a normal map: only then does a hit look one up
   // (render/normal_mapping.h), so other scenes run the code they ran before.
   bool any_normal_map() const { return any_normal_map_; }
+  // Mix and Add Shaders of other materials (materials/material_mix.h): material `material`
+  // becomes a mix of two materials added before it; set_material makes it a plain material
+  // again. Throws std::invalid_argument for an unknown id or child.
+  void set_mix(int64_t material, const MaterialMix& mix);
+  // set_mix's checks alone (material may be the id the next add_material returns).
+  void check_mix(int64_t material, const MaterialMix& mix) const;
+  const std::vector<MaterialMix>& mixes() const { return mixes_; }  // parallel to materials()
+  // Whether some material is a mix: only then does a hit look its slot up (pick_mixed).
+  bool any_mix() const { return any_mix_; }
   // The nearest hit on an instance that casts shadows (the shadow walk's step), among those in the
   // blocker sets `blockers` (light linking).
   Hit intersect_shadow_casters(const Ray& ray, uint64_t blockers = kAllLightSets) const;
@@ -228,6 +238,8 @@ class Scene {
   bool any_transparency_ = false;
   std::vector<MaterialNormalMap> normal_maps_;  // parallel to materials_
   bool any_normal_map_ = false;
+  std::vector<MaterialMix> mixes_;  // parallel to materials_
+  bool any_mix_ = false;
   MeshEmitters emitters_;
   std::vector<Texture> textures_;
   World world_;

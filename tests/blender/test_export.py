@@ -421,6 +421,42 @@ def test_unsupported_node():
     check(np.isfinite(px).all() and px.mean() > 0, "the image is lit (the Toon colour as a diffuse)")
 
 
+def test_mix_shader():
+    """A Mix Shader of a Principled BSDF and an unsupported Toon BSDF, its Fac a Fresnel node's,
+    inside an Add Shader with a Glass BSDF: the general 'mix' kind (the Toon input its diffuse
+    fallback) and exactly one note, naming the Toon node."""
+    sync, toyrt = addon()
+    from render_toyrt import materials
+    clear_scene()
+    mat, add = kit.surface("mixed", "ShaderNodeAddShader")
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    mix = nodes.new("ShaderNodeMixShader")
+    links.new(mix.outputs[0], add.inputs[0])
+    links.new(nodes.new("ShaderNodeBsdfGlass").outputs[0], add.inputs[1])
+    links.new(nodes.new("ShaderNodeBsdfPrincipled").outputs[0], mix.inputs[1])
+    toon = nodes.new("ShaderNodeBsdfToon")
+    toon.inputs["Color"].default_value = (0.2, 0.6, 0.9, 1.0)
+    links.new(toon.outputs[0], mix.inputs[2])
+    fresnel = nodes.new("ShaderNodeFresnel")
+    fresnel.inputs["IOR"].default_value = 1.6
+    links.new(fresnel.outputs[0], mix.inputs[0])
+    spec = materials.material_spec(mat).spec
+    inner = spec.mix_inputs[0]
+    check(spec.kind == "mix" and spec.mix_add and inner is not None and inner.kind == "mix"
+          and inner.mix_fac_source == "fresnel" and abs(inner.mix_fac_param - 1.6) < 1e-6
+          and [p.kind for p in inner.mix_inputs] == ["principled", "diffuse"]
+          and np.allclose(inner.mix_inputs[1].color, (0.2, 0.6, 0.9)) and spec.mix_inputs[1].kind == "glass",
+          f"an Add of a Fresnel-weighted Mix and a Glass is the general mix: {spec}")
+    kit.plane("mixed_plane", 2.0, material=mat)
+    kit.point_light("point", (0, 0, 2), 100.0)
+    ortho_camera(1.5, resolution=(8, 8))
+    with captured_output() as out:
+        _, _, stats = sync.export_scene(bpy.context.evaluated_depsgraph_get(), toyrt, report=lambda kind, msg: None)
+    notes = [line for line in out[0].splitlines() if line.startswith("TOYRT note: ")]
+    check(len(notes) == 1 and "ShaderNodeBsdfToon" in notes[0] and len(stats["approximated"]) == 1,
+          f"exactly one note, naming the Toon node: {notes}")
+
+
 def test_principled_specular_layer():
     """A Principled BSDF with Metallic 0 becomes the 'principled' kind on each Blender as its Cycles
     shades it: 4.0+ keeps its IOR, Specular IOR Level and tint colour, layered over the base,
@@ -696,6 +732,6 @@ def test_command_line_range():
 
 
 PARTS = [test_counts_and_transforms, test_instancing_memory, test_missing_texture, test_unsupported_node,
-         test_principled_specular_layer, test_principled_transmission, test_glass_color,
+         test_mix_shader, test_principled_specular_layer, test_principled_transmission, test_glass_color,
          test_rough_glass_and_refraction, test_cancel, test_animation, test_command_line_range]
 run_script(PARTS, "export", TMP)

@@ -177,6 +177,21 @@ def test_incremental_equals_one_shot():
             color = bpy.data.materials["red"].node_tree.nodes["Diffuse BSDF"].inputs["Color"]
             color.default_value = (0.1, 0.8, 0.1, 1.0)
         edit("material edit", material_edit, dict(materials_converted=1, meshes_exported=0, light_sends=0))
+
+        def into_a_mix():    # the general Mix Shader: its inputs are sent as materials of their own
+            tree = bpy.data.materials["red"].node_tree
+            mix = tree.nodes.new("ShaderNodeMixShader")
+            mix.inputs[0].default_value = 0.3
+            tree.links.new(tree.nodes["Diffuse BSDF"].outputs[0], mix.inputs[1])
+            tree.links.new(tree.nodes.new("ShaderNodeBsdfGlass").outputs[0], mix.inputs[2])
+            tree.links.new(mix.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+        edit("material edit into a Mix of a Diffuse and a Glass", into_a_mix, dict(materials_converted=1))
+        parts = list(cache.mix_parts["red"])
+        edit("the Mix's factor edited (its inputs sent into the same ids)",
+             lambda: setattr(bpy.data.materials["red"].node_tree.nodes["Mix Shader"].inputs[0], "default_value",
+                             0.7), dict(materials_converted=1))
+        check(len(parts) == 2 and cache.mix_parts["red"] == parts,
+              f"the Mix's inputs keep their material ids: {parts} -> {cache.mix_parts['red']}")
         flat = bpy.data.objects["flat"]
         edit("move the flattened cube (baked again)", lambda: setattr(flat, "location", (-2.5, 0.5, 0.8)),
              dict(meshes_exported=1, light_sends=0))
