@@ -234,4 +234,11 @@ Scatter coated(const Principled& m, const ShadingPoint& s, const MaterialContext
 
 }  // namespace
 
+GlossyLobe principled_metal_lobe(const Principled& m, const ShadingPoint& s, const Vec3& base_color) {
+  return metal_lobe(m, s, base_color);
+}
+GlossyLobe principled_specular_lobe(const Principled& m, const ShadingPoint& s) {
+  return dielectric_layer(m, s, m.f0).lobe;
+}
+
 }  // namespace toyrt

@@ -90,6 +90,12 @@ struct Principled {
 };
 
 Scatter scatter(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx);
+
+// The lobes scatter() draws from at a hit, whole (not divided by a draw's probability), for the
+// Glossy Color pass (render/glossy_color.h): the metal of base colour `base_color`, and the
+// dielectric specular layer (none where eta is 1).
+GlossyLobe principled_metal_lobe(const Principled& m, const ShadingPoint& s, const Vec3& base_color);
+GlossyLobe principled_specular_lobe(const Principled& m, const ShadingPoint& s);
 inline int32_t texture_index(const Principled& m) { return m.base.texture; }
 
 }  // namespace toyrt

@@ -1,6 +1,8 @@
 #include "render/glossy_color.h"
 
+#include "materials/dielectric_albedo.h"
 #include "materials/fresnel.h"
+#include "materials/multiscatter.h"
 #include "sampling/ggx.h"
 #include "sampling/ggx_albedo.h"
 
@@ -74,10 +76,7 @@ float glass_reflectance(float roughness, float cos_o, float eta) {
   return fresnel_dielectric(cos_o, eta);  // from inside: Cycles takes the curve itself
 }
 
-[[gnu::noinline]] Vec3 glass_pass_color(const Material& material, const ShadingPoint& s) {
-  const FresnelDielectric* glass = std::get_if<FresnelDielectric>(&material);
-  if (!glass) return Vec3(0.0f);
-  const FresnelDielectric& m = *glass;
+Vec3 glass_reflection_color(const FresnelDielectric& m, const ShadingPoint& s) {
   // The lobe the material's scatter() makes there, or none where it is specular.
   DielectricLobe lobe;
   if (rough_dielectric(s, m.ior, m.rough, m.macro_fresnel ? DielectricKind::Glass3x : DielectricKind::Glass, &lobe))
@@ -90,9 +89,111 @@ float glass_reflectance(float roughness, float cos_o, float eta) {
   return m.reflect_tint * (m.macro_fresnel ? fresnel_dielectric(cos_o, eta) : glass_reflectance(0.0f, cos_o, eta));
 }
 
-void add_glass_pass_color(const std::vector<Material>& materials, FirstHit& hit) {
-  if (hit.found && hit.material >= 0 && size_t(hit.material) < materials.size())
-    hit.glossy += glass_pass_color(materials[size_t(hit.material)], hit.at);
+namespace {
+
+// cos_o about the shading normal turned to wo's side of the surface (Cycles' sd->N).
+float view_cosine(const ShadingPoint& s) {
+  const Vec3 ng = glm::dot(s.ng, s.wo) > 0.0f ? s.ng : -s.ng;
+  const Vec3 ns = glm::dot(s.ns, ng) >= 0.0f ? s.ns : -s.ns;
+  return std::clamp(glm::dot(ns, s.wo), 0.0f, 1.0f);
+}
+
+// Multiscatter GGX glass (4.0+): Cycles keeps in the closure's weight the share E (1 + F_ms (1 -
+// E) / E) of its energy compensation, with Fss the glass's transmission colour (sqrt of the base
+// colour) and E, E_avg the glass lobe's albedo and its cosine-weighted mean on this side (TOYRT's
+// table of the lobe, materials/dielectric_albedo.h). 1 for a white glass.
+Vec3 glass_energy_share(const FresnelDielectric& glass, bool entering, float cos_o, const Vec3& fss) {
+  if (glass.albedo < 0 || fss == Vec3(1.0f)) return Vec3(1.0f);
+  const DielectricAlbedo& table = dielectric_albedo_table(glass.albedo);
+  const auto& e = entering ? table.entering : table.leaving;
+  double e_avg = 0.0;  // 2 int E(mu) mu dmu, trapezoids over the table's points
+  for (int i = 0; i < DielectricAlbedo::kMu; ++i) {
+    const double mu0 = double(i) / DielectricAlbedo::kMu, mu1 = double(i + 1) / DielectricAlbedo::kMu;
+    e_avg += (double(e[size_t(i)]) * mu0 + double(e[size_t(i) + 1]) * mu1) / DielectricAlbedo::kMu;
+  }
+  const float e_o = 1.0f / multiscatter_glass_scale(table, entering, cos_o), avg = float(e_avg);
+  const Vec3 f_ms = fss * avg / (Vec3(1.0f) - fss * (1.0f - avg));
+  return e_o * (Vec3(1.0f) + f_ms * (1.0f - e_o) / e_o);
+}
+
+// 4.0+: Cycles' Principled closures from the top (kernel/svm/closure.h), each adding its weight
+// times its estimated albedo and scaling the weight left for those below it.
+Vec3 layered_principled_color(const Principled& m, const ShadingPoint& s, const Vec3& base_color) {
+  const float cos_o = view_cosine(s);
+  Vec3 sum(0.0f), weight(1.0f);
+  if (m.coat > 0.0f) {
+    // A dielectric GGX lobe of the coat's IOR, always with its energy compensation (Cycles sets
+    // up the coat's Fresnel with it whatever the distribution); its albedo the blended Fresnel
+    // curve, as the specular layer's. What it reflects is taken off everything below.
+    const float e = ggx_albedo(m.coat_roughness, cos_o);
+    const float share = multiscatter_scale(m.coat_roughness, cos_o, Vec3(fresnel_dielectric_average(m.coat_eta))).x * e;
+    const float albedo =
+        m.coat * share * glm::mix(m.coat_f0, 1.0f, ggx_fresnel_blend(m.coat_roughness, cos_o, m.coat_eta));
+    sum += Vec3(albedo);
+    weight *= std::clamp(1.0f - albedo, 0.0f, 1.0f);
+    if (m.coat_tint != Vec3(1.0f)) {  // Beer's law along the view ray refracted into the coat
+      const float sin2_t = (1.0f - cos_o * cos_o) / (m.coat_eta * m.coat_eta);
+      const float depth = 1.0f / std::sqrt(std::max(1.0f - sin2_t, 1e-6f));
+      weight *= glm::mix(Vec3(1.0f), glm::pow(glm::max(m.coat_tint, Vec3(0.0f)), Vec3(depth)), m.coat);
+    }
+  }
+  if (m.metallic > 0.0f) {
+    sum += m.metallic * weight * lobe_weight_albedo(principled_metal_lobe(m, s, base_color), m.multiscatter);
+    weight *= 1.0f - m.metallic;
+  }
+  if (m.transmission > 0.0f) {
+    // The glass's reflection: a generalised Schlick from F0(IOR) x Specular Tint to 1, its
+    // curve the IOR's, read from the table on either side (no smooth-surface case here).
+    const Vec3 f0 = glm::clamp(Vec3(f0_from_ior(m.glass.ior)) * m.specular_tint, Vec3(0.0f), Vec3(1.0f));
+    const Vec3 reflect = glm::mix(f0, Vec3(1.0f), ggx_fresnel_blend(m.roughness, cos_o, m.glass.ior));
+    const bool entering = glm::dot(s.ng, s.wo) > 0.0f;
+    const Vec3 fss = glm::sqrt(glm::clamp(base_color, Vec3(0.0f), Vec3(1.0f)));
+    sum += m.transmission * weight * glass_energy_share(m.glass, entering, cos_o, fss) * reflect;
+    weight *= 1.0f - m.transmission;
+  }
+  if (m.eta != 1.0f) sum += weight * lobe_weight_albedo(principled_specular_lobe(m, s), m.multiscatter);
+  return sum;
+}
+
+// 3.x: the closures' weights (surface_shader_glossy sums them): the specular lobe's 1 - the
+// glass's share, and the glass's reflection closure, its share times the Fresnel term at cos_o.
+// (Cycles 3.x files its Multiscatter GGX glass under Transmission Color when Roughness > 0.05;
+// TOYRT renders 3.x's glass single-scatter, with the reflection this counts: noted by the add-on.)
+Vec3 principled_3x_color(const Principled& m, const ShadingPoint& s, const Vec3& base_color) {
+  const float glass = (1.0f - m.metallic) * m.transmission;
+  Vec3 sum(m.eta != 1.0f || m.metallic > 0.0f ? 1.0f - glass : 0.0f);
+  if (glass > 0.0f) {
+    FresnelDielectric g = m.glass;
+    g.reflect_tint = Vec3(1.0f);
+    sum += glass * glass_reflection_color(g, s);
+  }
+  (void)base_color;
+  return sum;
+}
+
+}  // namespace
+
+[[gnu::noinline]] Vec3 principled_pass_color(const Principled& m, const ShadingPoint& s, const Vec3& base_color) {
+  return m.layered ? layered_principled_color(m, s, base_color) : principled_3x_color(m, s, base_color);
+}
+
+[[gnu::noinline]] Vec3 glass_pass_color(const Material& material, const ShadingPoint& s) {
+  const FresnelDielectric* glass = std::get_if<FresnelDielectric>(&material);
+  return glass ? glass_reflection_color(*glass, s) : Vec3(0.0f);
+}
+
+void add_layered_pass_color(const std::vector<Material>& materials, const std::vector<Texture>& textures,
+                            FirstHit& hit) {
+  if (!hit.found || hit.material < 0 || size_t(hit.material) >= materials.size()) return;
+  const Material& material = materials[size_t(hit.material)];
+  if (const Principled* p = std::get_if<Principled>(&material)) {
+    // Its lobes are drawn one per sample (materials/principled.h); with a coat or a glass the
+    // drawn one does not give Cycles' sum, so the pass takes the whole sum here.
+    if (p->coat > 0.0f || p->transmission > 0.0f)
+      hit.glossy = principled_pass_color(*p, hit.at, lambert_albedo(p->base, textures, hit.at.uv));
+    return;
+  }
+  hit.glossy += glass_pass_color(material, hit.at);
 }
 
 Vec3 lobe_weight_albedo(const GlossyLobe& lobe, bool multiscatter) {

@@ -69,8 +69,20 @@ float glass_reflectance(float roughness, float cos_o, float eta);
 // other material: out of line and outside the integrator (its place there, in the material
 // dispatch or after it, cost a render without passes 0.08-0.24 % more instructions).
 Vec3 glass_pass_color(const Material& m, const ShadingPoint& s);
-// Adds it to a first hit's Glossy Color: the renderer calls it in its loop with passes only, so a
-// render without passes runs none of this (its loop and the integrator's stay as they were).
-void add_glass_pass_color(const std::vector<Material>& materials, FirstHit& hit);
+// The reflection of one glass (the Glass BSDF's, or a Principled's glass with its colours).
+Vec3 glass_reflection_color(const FresnelDielectric& m, const ShadingPoint& s);
+// A Principled BSDF's whole Glossy Color at a hit of base colour `base_color`, as Cycles sums it
+// over its closures: 4.0+ the coat's (its Fresnel's estimated albedo, energy share included),
+// then the metal's, the glass's reflection and the specular layer's, each weighted by what the
+// layers above leave; 3.x the specular closure's weight (1 - the glass's share) plus the glass's
+// reflection closure (its share times the Fresnel term). Thin film (5.x) is not modelled, and
+// neither rendered nor counted here.
+Vec3 principled_pass_color(const Principled& m, const ShadingPoint& s, const Vec3& base_color);
+// Completes a first hit's Glossy Color where the lobe the integrator drew is not the whole answer:
+// adds a Glass BSDF's reflection; sets a Principled's with a coat or a glass to its whole sum.
+// The renderer calls it in its loop with passes only, so a render without passes runs none of
+// this (its loop and the integrator's stay as they were).
+void add_layered_pass_color(const std::vector<Material>& materials, const std::vector<Texture>& textures,
+                            FirstHit& hit);
 
 }  // namespace toyrt

@@ -179,7 +179,7 @@ void render_pass(const Scene& scene, const Camera& camera, const RenderSettings&
             FirstHit hit;
             const Vec3 L = trace_path(scene, primary_ray(px, py, pixel, uint32_t(s)), pixel, uint32_t(s),
                                       settings.integrator, &hit);
-            if (with_glossy) add_glass_pass_color(scene.materials(), hit);
+            if (with_glossy) add_layered_pass_color(scene.materials(), scene.textures(), hit);
             aov.add(hit, s == first);
             if (with_cryptomatte) crypto.add(hit.found ? hit.instance : -1, hit.material);
             return L;

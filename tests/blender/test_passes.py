@@ -198,7 +198,24 @@ GLOSSY_SCENE = {  # name: (material maker, location); pass index = 1 + its place
     # Glass: its reflection (3.x a closure of weight F, 4.0+ the glass closure's reflection).
     "glass": (lambda: kit.glass("glass", 1.5), (1.4, 0.55)),
     "rough_glass": (lambda: rough_glass("rough_glass", 0.3), (1.4, -0.4)),
+    # The Principled BSDF's glass (Transmission 1): its reflection's albedo (4.0+) or weight (3.x).
+    "principled_glass": (lambda: principled_glass("principled_glass", 0.3), (-1.2, -1.25)),
 }
+if bpy.app.version >= (4, 0, 0):  # Coat: 4.0+'s Principled only
+    GLOSSY_SCENE["coat"] = (lambda: coated("coat"), (-0.3, -1.25))
+
+
+def principled_glass(name, roughness):
+    mat = kit.principled_dielectric(name, (1.0, 1.0, 1.0), roughness, distribution="GGX")
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    bsdf.inputs["Transmission Weight" if "Transmission Weight" in bsdf.inputs else "Transmission"].default_value = 1.0
+    return mat
+
+
+def coated(name):
+    mat = kit.principled_dielectric(name, (0.8, 0.1, 0.1), 0.5)
+    mat.node_tree.nodes["Principled BSDF"].inputs["Coat Weight"].default_value = 1.0
+    return mat
 
 
 def rough_glass(name, roughness):
@@ -223,7 +240,7 @@ def glossy_color_environment_and_lamps_equal_cycles():
     for k, (name, (make, (x, y))) in enumerate(GLOSSY_SCENE.items()):
         kit.plane(name, 0.8, make(), location=(x, y, 0.0)).pass_index = 1 + k
     kit.area_light("lamp", (0.6, -0.45, 0.5), 30.0, 0.5, rotation=(math.pi, 0.0, 0.0), visible_camera=True)
-    kit.camera((0.0, 0.0, 5.0))
+    kit.camera((0.0, 0.0, 6.0))
     kit.world(SKY)
     kit.output(s, W, H)
     layer = bpy.context.view_layer
