@@ -51,6 +51,12 @@ class MaterialSync:
         if converted.spec != sent[1]:
             self.scene.set_material(sent[0], **self._material_arguments(converted, mat.name_full))
             self.materials[mat.name_full] = (sent[0], converted.spec)
+        else:
+            # Unchanged: nothing to send, but a final render reports what it approximates every
+            # frame (the farm test counts one note per frame), its textures' notes included.
+            self._note(converted.notes)
+            for key in _texture_keys(converted.spec):
+                self._note(self.texture_notes.get(key, ()))
         return 1
 
     def _material_arguments(self, converted: materials.ConvertedMaterial, name: str) -> dict:
@@ -169,3 +175,14 @@ def _mix_keys(spec) -> set:
         if part is not None:
             keys |= _mix_keys(part)
     return keys - {None}
+
+
+def _texture_keys(spec):
+    """Every image key a spec reads: its own textures and, for a mix, its inputs' and factor's."""
+    own = (spec.texture, spec.opacity_texture, spec.normal_map.texture if spec.normal_map is not None else None)
+    yield from (k for k in own if k is not None)
+    if spec.mix_fac_texture is not None:
+        yield spec.mix_fac_texture
+    for part in spec.mix_inputs:
+        if part is not None:
+            yield from _texture_keys(part)
