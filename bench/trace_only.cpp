@@ -8,7 +8,12 @@
 //                                         CPU milliseconds (the process's CPU clock: one thread,
 //                                         so other work on the machine does not inflate it)
 //   trace_only commit-all [rings] [repeats]   the same on every core, in wall-clock milliseconds
+//   trace_only lbvh-all [rings] [repeats]     the whole LBVH commit on every core against Embree's
+//                                             Morton build (LOW quality, dynamic scene), interleaved,
+//                                             wall-clock medians, with the LBVH's stage times
+#include "accel/lbvh_builder.h"
 #include "embree_oracle.h"
+#include "geometry/triangle_block.h"
 #include "scene/scene.h"
 #include "test_scenes.h"
 
@@ -27,6 +32,44 @@ int main(int argc, char** argv) {
   const int rings = argc > 2 ? std::atoi(argv[2]) : 224;
   const int repeats = argc > 3 ? std::atoi(argv[3]) : 1;
   const MeshData mesh = uv_sphere(rings, rings, 1.0f, 0.15f);
+  if (kind == "lbvh-all") {
+    auto wall_ms = [] {
+      timespec ts;
+      clock_gettime(CLOCK_MONOTONIC, &ts);
+      return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+    };
+    std::vector<double> mine, theirs;
+    for (int k = 0; k <= repeats; ++k) {  // the first pair warms both (kernel compilation, Embree's first build)
+      Scene s;
+      s.add_instance(s.add_mesh(mesh.vertices, mesh.triangles), Mat4(1.0f));
+      CommitOptions options;
+      options.builder = BuilderKind::Lbvh;
+      double start = wall_ms();
+      s.commit(options);
+      if (k) mine.push_back(wall_ms() - start);
+      if (!s.commit_stats().warning.empty()) std::fprintf(stderr, "%s\n", s.commit_stats().warning.c_str());
+      start = wall_ms();
+      { EmbreeScene e(mesh.vertices, mesh.triangles, false, 0, true); }
+      if (k) theirs.push_back(wall_ms() - start);
+    }
+    std::sort(mine.begin(), mine.end());
+    std::sort(theirs.begin(), theirs.end());
+    std::printf("lbvh-all: %zu triangles, LBVH commit median %.1f ms, Embree Morton %.1f ms wall (%d runs)\n",
+                mesh.triangles.size(), mine[mine.size() / 2], theirs[theirs.size() / 2], repeats);
+    const PrimitiveBounds prims = triangle_bounds(mesh);
+    LbvhStats st;
+    const Bvh bvh = build_lbvh(prims.boxes.data(), prims.centers.data(), prims.boxes.size(), {}, &st);
+    for (const auto& [name, ms] : st.stages) std::printf("  %s %.1f ms\n", name.c_str(), ms);
+    std::vector<double> collapse_ms;  // the host-side collapse of the binary tree to the 8-wide layout
+    for (int k = 0; k < 3; ++k) {
+      const double start = wall_ms();
+      const WideBvh wide = collapse(bvh, kBlockWidth);
+      collapse_ms.push_back(wall_ms() - start);
+    }
+    std::sort(collapse_ms.begin(), collapse_ms.end());
+    std::printf("  host collapse %.1f ms (median of 3)\n", collapse_ms[1]);
+    return 0;
+  }
   if (kind == "commit" || kind == "commit-all") {
     // commit-all: on every core, in wall-clock milliseconds.
     const bool all = kind == "commit-all";

@@ -118,7 +118,7 @@ int common_prefix(__global const ulong* keys, long n, long i, long j) {
 // Stage 4: one work-item per internal node i in [0, n - 2] finds the range of sorted leaves it
 // covers and where that range splits (Karras 2012, section 4). Internal node 0 is the root.
 __kernel void emit_hierarchy(__global const ulong* keys, uint n_leaves, __global LbvhNode* nodes,
-                             __global int* internal_parent, __global int* leaf_parent) {
+                             __global int* internal_parent, __global int* leaf_parent, __global uint2* range) {
   const long i = get_global_id(0), n = n_leaves;
   if (i >= n - 1) return;
   // Direction of the range: towards the neighbour sharing the longer prefix.
@@ -145,6 +145,7 @@ __kernel void emit_hierarchy(__global const ulong* keys, uint n_leaves, __global
   const int right = last == gamma + 1 ? ~(int)(gamma + 1) : (int)(gamma + 1);
   nodes[i].left = left;
   nodes[i].right = right;
+  range[i] = (uint2)((uint)first, (uint)last);  // the leaves it covers, for write_bvh_nodes
   if (left < 0) leaf_parent[~left] = (int)i; else internal_parent[left] = (int)i;
   if (right < 0) leaf_parent[~right] = (int)i; else internal_parent[right] = (int)i;
   if (i == 0) internal_parent[0] = -1;
@@ -207,9 +208,11 @@ uint child_slot(__global const LbvhNode* nodes, int p, int child) {
 // Stage 6: the flat BVH (native/accel/node.h layout), written in place on the device so that
 // neither the Karras nodes nor a host-side conversion are needed. Work-items 0 .. n - 2 write the
 // internal nodes, n - 1 .. 2n - 2 the leaves (one primitive each, slot k of the sorted order).
+// Beside each node, the sorted slots under it (first, count): the host's collapse to the wide
+// layout needs them, and deriving them there took a walk of the whole tree.
 __kernel void write_bvh_nodes(__global const LbvhNode* nodes, __global const int* internal_parent,
                               __global const int* leaf_parent, __global const float* sorted_bounds, uint n_leaves,
-                              __global BvhNode* out) {
+                              __global BvhNode* out, __global const uint2* range, __global uint2* out_range) {
   const uint id = get_global_id(0);
   const uint internal = n_leaves - 1;
   if (id >= internal + n_leaves) return;
@@ -225,12 +228,14 @@ __kernel void write_bvh_nodes(__global const LbvhNode* nodes, __global const int
     const int left = nodes[i].left;
     node.first = 1u + 2u * (uint)(left >= 0 ? left : ~left);
     node.count = 0u;
+    out_range[at] = (uint2)(range[i].x, range[i].y - range[i].x + 1u);
   } else {
     const int k = (int)(id - internal);
     at = child_slot(nodes, leaf_parent[k], ~k);
     for (int a = 0; a < 6; ++a) node.bounds[a] = sorted_bounds[6 * k + a];
     node.first = (uint)k;
     node.count = 1u;
+    out_range[at] = (uint2)((uint)k, 1u);
   }
   out[at] = node;
 }

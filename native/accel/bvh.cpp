@@ -104,6 +104,27 @@ std::string Bvh::validate(const BBox* prim_bounds, size_t prim_count) const {
       err << "primitive " << p << " in " << seen[p] << " leaves";
       return err.str();
     }
+  // A builder's ranges (when it gives them): a leaf's own slots; an interior node's, its two
+  // children's side by side (the tree is whole by now, so each child's range is checked too).
+  if (!ranges.empty()) {
+    if (ranges.size() != nodes.size()) return "ranges: not one per node";
+    for (size_t i = 0; i < nodes.size(); ++i) {
+      const Node& n = nodes[i];
+      const auto [first, count] = ranges[i];
+      bool ok;
+      if (n.is_leaf()) {
+        ok = first == n.first && count == n.count;
+      } else {
+        const auto l = ranges[n.first], r = ranges[n.first + 1];
+        ok = first == std::min(l.first, r.first) && count == l.second + r.second &&
+             std::max(l.first, r.first) == first + (l.first < r.first ? l.second : r.second);
+      }
+      if (!ok) {
+        err << "range of node " << i << " is not its subtree's";
+        return err.str();
+      }
+    }
+  }
   return "";
 }
 

@@ -6,6 +6,7 @@
 #include "accel/node.h"
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace toyrt {
@@ -16,6 +17,9 @@ inline constexpr int kMaxBvhDepth = 96;
 struct Bvh {
   std::vector<Node> nodes;
   std::vector<uint32_t> prim_ids;  // leaf slots -> primitive index in the builder's input
+  // (first, count) of the prim_ids slots under each node, when a builder has them at no cost (the
+  // LBVH kernels write them); empty otherwise, and collapse() derives them by a walk.
+  std::vector<std::pair<uint32_t, uint32_t>> ranges;
 
   bool empty() const { return nodes.empty(); }
 

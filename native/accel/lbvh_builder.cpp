@@ -245,13 +245,15 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
   }
   const size_t internal = count - 1;
   Buffer nodes(internal * sizeof(LbvhNode)), internal_parent(internal * sizeof(cl_int)),
-      leaf_parent(count * sizeof(cl_int)), flags(internal * sizeof(cl_int));
+      leaf_parent(count * sizeof(cl_int)), flags(internal * sizeof(cl_int)),
+      internal_range(internal * 2 * sizeof(cl_uint));
   Kernel(prog.program, "emit_hierarchy")
       .arg(0, keys[in].get())
       .arg(1, n)
       .arg(2, nodes.get())
       .arg(3, internal_parent.get())
       .arg(4, leaf_parent.get())
+      .arg(5, internal_range.get())
       .run(internal);
   stage("hierarchy");
 
@@ -278,8 +280,11 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
 
   if (bvh) {
     bvh->nodes.resize(2 * count - 1);
-    const size_t bytes = bvh->nodes.size() * sizeof(Node);
+    bvh->ranges.resize(2 * count - 1);
+    static_assert(sizeof(bvh->ranges[0]) == 2 * sizeof(cl_uint), "a range is the kernel's uint2");
+    const size_t bytes = bvh->nodes.size() * sizeof(Node), range_bytes = bvh->ranges.size() * sizeof(bvh->ranges[0]);
     Buffer flat(bytes, CL_MEM_WRITE_ONLY, bvh->nodes.data());  // written in place where the device can
+    Buffer flat_range(range_bytes, CL_MEM_WRITE_ONLY, bvh->ranges.data());
     Kernel(prog.program, "write_bvh_nodes")
         .arg(0, nodes.get())
         .arg(1, internal_parent.get())
@@ -287,8 +292,11 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
         .arg(3, sorted_bounds.get())
         .arg(4, n)
         .arg(5, flat.get())
+        .arg(6, internal_range.get())
+        .arg(7, flat_range.get())
         .run(2 * count - 1);
     flat.sync_to_host(bytes);
+    flat_range.sync_to_host(range_bytes);
     bvh->prim_ids = order;
     stage("flat nodes");
   }

@@ -91,6 +91,7 @@ void Mesh::finish(Bvh bvh, const std::vector<uint32_t>& valid) {
   bvh_ = std::move(bvh);
   for (uint32_t& id : bvh_.prim_ids) id = valid[id];  // builder slots -> triangle indices
   wide_ = collapse(bvh_, kBlockWidth);
+  bvh_.ranges = {};  // only the collapse reads them (16 MB at 1M triangles from the LBVH)
   // Copy every leaf's triangles into blocks and point the wide leaves at them. Each node's first
   // block comes from a serial count in node order, so the blocks are laid out the same whatever
   // the thread count; the copying (a random read of three vertices per triangle) runs in parallel.

@@ -4,6 +4,8 @@
 // (Hit-level agreement with Embree and watertightness: embree_oracle_test and watertight_test
 // run every case with both builders.)
 #include "accel/lbvh_builder.h"
+#include "accel/wide_bvh.h"
+#include "geometry/triangle_block.h"
 #include "opencl/device.h"
 #include "scene/scene.h"
 #include "test_scenes.h"
@@ -55,7 +57,17 @@ void expect_same_as_reference(const MeshData& m, MortonBits bits) {
   ASSERT_EQ(flat.nodes.size(), ref.nodes.size());
   EXPECT_EQ(0, std::memcmp(flat.nodes.data(), ref.nodes.data(), flat.nodes.size() * sizeof(Node)));
   EXPECT_EQ(flat.prim_ids, ref.prim_ids);
+  // The kernels also write each node's slot range (validate() checks them against the tree)...
+  EXPECT_EQ(flat.ranges.size(), flat.nodes.size() > 1 ? flat.nodes.size() : 0u);
   EXPECT_EQ(flat.validate(p.boxes.data(), p.boxes.size()), "");
+  // ...and collapsing with them gives the wide tree the collapse's own walk gives.
+  Bvh walked = flat;
+  walked.ranges.clear();
+  const WideBvh a = collapse(flat, kBlockWidth), b = collapse(walked, kBlockWidth);
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  if (!a.nodes.empty()) EXPECT_EQ(0, std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(WideNode)));
+  EXPECT_EQ(a.root_leaf_first, b.root_leaf_first);
+  EXPECT_EQ(a.root_leaf_count, b.root_leaf_count);
 }
 
 }  // namespace

@@ -8,14 +8,17 @@
 namespace toyrt::testing {
 
 EmbreeScene::EmbreeScene(const std::vector<Vec3>& vertices, const std::vector<Triangle>& triangles, bool robust,
-                         int threads) {
+                         int threads, bool morton) {
   const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
   device_ = rtcNewDevice(config.c_str());
   if (!device_) throw std::runtime_error("Embree: cannot create a device");
   const auto start = std::chrono::steady_clock::now();
   scene_ = rtcNewScene(device_);
-  rtcSetSceneFlags(scene_, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
+  rtcSetSceneFlags(scene_, RTCSceneFlags((robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE) |
+                                         (morton ? RTC_SCENE_FLAG_DYNAMIC : RTC_SCENE_FLAG_NONE)));
+  if (morton) rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_LOW);
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+  if (morton) rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_LOW);
   auto* vb = static_cast<float*>(
       rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertices.size()));
   auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,

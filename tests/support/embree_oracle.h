@@ -13,9 +13,11 @@ namespace toyrt::testing {
 
 class EmbreeScene {
  public:
-  // robust: RTC_SCENE_FLAG_ROBUST (Embree's watertight-leaning mode); threads 0: all cores.
+  // robust: RTC_SCENE_FLAG_ROBUST (Embree's watertight-leaning mode); threads 0: all cores;
+  // morton: Embree's fast builder (RTC_BUILD_QUALITY_LOW on a RTC_SCENE_FLAG_DYNAMIC scene, its
+  // Morton-code build), the peer of TOYRT's LBVH.
   EmbreeScene(const std::vector<Vec3>& vertices, const std::vector<Triangle>& triangles, bool robust = false,
-              int threads = 0);
+              int threads = 0, bool morton = false);
   ~EmbreeScene();
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
