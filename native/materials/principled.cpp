@@ -1,5 +1,6 @@
 #include "materials/principled.h"
 
+#include "materials/coat.h"
 #include "materials/fresnel.h"
 #include "materials/multiscatter.h"
 #include "sampling/ggx_albedo.h"
@@ -209,20 +210,15 @@ Scatter coated(const Principled& m, const ShadingPoint& s, const MaterialContext
   coat.f0 = Vec3(m.coat_f0);
   coat.ior = m.coat_eta;
   coat.ior_f0 = m.coat_f0;
-  const float mu = coat.wo.z;
-  // What the coat leaves below: Cycles estimates a lobe with the plain dielectric Fresnel (not the
-  // specular layer's generalised Schlick, which it reads from a table) as a smooth surface, the
-  // Fresnel term at wo; and the tint along the refracted path through the coat.
-  const float coat_albedo = fresnel_dielectric(mu, m.coat_eta);
-  const float sin2_t = (1.0f - mu * mu) / (m.coat_eta * m.coat_eta);
-  const float depth = 1.0f / std::sqrt(std::max(1.0f - sin2_t, 1e-6f));
-  const Vec3 tinted = glm::pow(glm::max(m.coat_tint, Vec3(0.0f)), Vec3(depth));
-  const Vec3 below = std::clamp(1.0f - m.coat * coat_albedo, 0.0f, 1.0f) * glm::mix(Vec3(1.0f), tinted, m.coat);
+  // Cycles' layering (materials/coat.h): its estimate of the coat's albedo, energy compensation
+  // included, taken off what lies below, and the tint along the refracted path.
+  const CoatLayer layer = coat_layer(m.coat, m.coat_roughness, m.coat_eta, m.coat_f0, m.coat_tint, coat.wo.z);
+  const Vec3& below = layer.below;
   const float p = 0.5f * m.coat;
   Scatter sc = opaque_scatter(m, s, ctx, albedo, scale, std::min((std::max(v - p, 0.0f)) / (1.0f - p), 0x1.fffffep-1f));
   sc.f *= below;
   if (v < p) {
-    coat.tint = Vec3(m.coat / p);
+    coat.tint = Vec3(layer.lobe_scale * m.coat / p);
     const Vec3 f = sc.kind == Scatter::Kind::Diffuse || sc.kind == Scatter::Kind::Glossy ? sc.f : Vec3(0.0f);
     Scatter out = lobe_over(coat, f);
     out.burley = false;

@@ -38,10 +38,11 @@
 //
 // Coat (4.0+ only; 3.x's Clearcoat is noted by the add-on): coat_weight (0, clamped to [0, 1]),
 // coat_roughness (0.03), coat_ior (1.5, >= 1), coat_tint ((1, 1, 1)): a GGX dielectric layer over
-// everything opaque, as Cycles 4.0+ puts it there: its lobe weighted coat_weight, the layers
-// below scaled by 1 - coat_weight x its directional albedo (as the specular layer scales the
-// base) and tinted by mix(1, coat_tint ^ d, coat_weight), d = 1 / cos of wo refracted into the
-// coat (Beer's law over the path through a coat of unit thickness). One of the coat's lobe and
+// everything opaque, as Cycles 4.0+ puts it there (materials/coat.h): its lobe weighted
+// coat_weight and always energy-compensated, the layers below scaled by 1 - coat_weight x
+// Cycles' estimate of its albedo (as the specular layer scales the base) and tinted by
+// mix(1, coat_tint ^ d, coat_weight), d = 1 / cos of wo refracted into the coat (Beer's law
+// over the path through a coat of unit thickness). One of the coat's lobe and
 // the layers' lobes is drawn per hit (the coat with probability coat_weight / 2), its weight
 // divided by that probability; the diffuse base gets its direct light on either draw. The glass
 // of Transmission is not coated (noted by the add-on).

@@ -1,5 +1,6 @@
 #include "render/glossy_color.h"
 
+#include "materials/coat.h"
 #include "materials/dielectric_albedo.h"
 #include "materials/fresnel.h"
 #include "materials/multiscatter.h"
@@ -122,20 +123,10 @@ Vec3 layered_principled_color(const Principled& m, const ShadingPoint& s, const 
   const float cos_o = view_cosine(s);
   Vec3 sum(0.0f), weight(1.0f);
   if (m.coat > 0.0f) {
-    // A dielectric GGX lobe of the coat's IOR, always with its energy compensation (Cycles sets
-    // up the coat's Fresnel with it whatever the distribution); its albedo the blended Fresnel
-    // curve, as the specular layer's. What it reflects is taken off everything below.
-    const float e = ggx_albedo(m.coat_roughness, cos_o);
-    const float share = multiscatter_scale(m.coat_roughness, cos_o, Vec3(fresnel_dielectric_average(m.coat_eta))).x * e;
-    const float albedo =
-        m.coat * share * glm::mix(m.coat_f0, 1.0f, ggx_fresnel_blend(m.coat_roughness, cos_o, m.coat_eta));
-    sum += Vec3(albedo);
-    weight *= std::clamp(1.0f - albedo, 0.0f, 1.0f);
-    if (m.coat_tint != Vec3(1.0f)) {  // Beer's law along the view ray refracted into the coat
-      const float sin2_t = (1.0f - cos_o * cos_o) / (m.coat_eta * m.coat_eta);
-      const float depth = 1.0f / std::sqrt(std::max(1.0f - sin2_t, 1e-6f));
-      weight *= glm::mix(Vec3(1.0f), glm::pow(glm::max(m.coat_tint, Vec3(0.0f)), Vec3(depth)), m.coat);
-    }
+    // The coat closure's estimated albedo, taken off everything below (materials/coat.h).
+    const CoatLayer coat = coat_layer(m.coat, m.coat_roughness, m.coat_eta, m.coat_f0, m.coat_tint, cos_o);
+    sum += Vec3(coat.albedo);
+    weight *= coat.below;
   }
   if (m.metallic > 0.0f) {
     sum += m.metallic * weight * lobe_weight_albedo(principled_metal_lobe(m, s, base_color), m.multiscatter);

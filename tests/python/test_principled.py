@@ -140,17 +140,29 @@ def test_principled_transmission_one_renders_the_glass_bsdf(version):
 def test_coat_head_on_is_its_lobe_plus_the_base_it_leaves():
     # At normal incidence under the point straight above, a coat of weight 1 over a base without a
     # specular layer (Specular IOR Level 0): the coat's lobe D(n) G2 F0 / 4 = F0 / (4 pi alpha^2)
-    # (G2 = 1, F = F0 on the normal) plus the base scaled by 1 - F0, Cycles' estimate of what a
-    # coat reflects (its Fresnel term at wo: F0 head-on). The coat is drawn on half the samples
-    # with twice the weight; 16 Sobol samples split exactly in half, so this is exact to rounding.
+    # (G2 = 1, F = F0 on the normal) times its energy compensation (Cycles always compensates the
+    # coat: 1 + F_ms (1 - E) / E, a little above 1, more the rougher), plus the base scaled by
+    # 1 - A with A Cycles' estimate of the coat's albedo, E (1 + F_ms (1 - E) / E) mix(F0, 1, s):
+    # near F0 head-on, below it as the coat roughens (E < 1; the exact value from the tables is
+    # tests/native/principled_test.cpp's). The coat is drawn on half the samples with twice the
+    # weight; 16 Sobol samples split exactly in half, so the base's scale is one number for every
+    # colour and the black base isolates the lobe.
     color = np.array([0.6, 0.3, 0.1])
     f0 = ((1.5 - 1.0) / (1.5 + 1.0)) ** 2
+    compensation = []
     for rough in (0.3, 0.6):
         alpha = rough ** 2
-        got = floor(color=tuple(color), ior=1.5, specular_ior_level=0.0, roughness=0.9, coat_weight=1.0,
-                    coat_roughness=rough, coat_ior=1.5)
-        want = IRRADIANCE * (color / math.pi * (1.0 - f0) + f0 / (4.0 * math.pi * alpha ** 2))
-        np.testing.assert_allclose(got, want, rtol=1e-4)
+        common = dict(ior=1.5, specular_ior_level=0.0, roughness=0.9, coat_weight=1.0, coat_roughness=rough,
+                      coat_ior=1.5)
+        lobe = floor(color=(0.0, 0.0, 0.0), **common)
+        got = floor(color=tuple(color), **common)
+        k = lobe / (IRRADIANCE * f0 / (4.0 * math.pi * alpha ** 2))
+        assert np.all(k >= 1.0) and np.all(k < 1.03), k
+        compensation.append(k[0])
+        kept = (got - lobe) / (IRRADIANCE * color / math.pi)
+        np.testing.assert_allclose(kept, kept[0], rtol=1e-5)
+        assert 1.0 - f0 - 1e-4 < kept[0] < 1.0 - 0.03, kept
+    assert compensation[1] > compensation[0]
 
 
 def test_coat_tint_tints_what_lies_below_it_only():
