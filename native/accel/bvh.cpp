@@ -116,8 +116,8 @@ std::string Bvh::validate(const BBox* prim_bounds, size_t prim_count) const {
         ok = first == n.first && count == n.count;
       } else {
         const auto l = ranges[n.first], r = ranges[n.first + 1];
-        ok = first == std::min(l.first, r.first) && count == l.second + r.second &&
-             std::max(l.first, r.first) == first + (l.first < r.first ? l.second : r.second);
+        ok = first == std::min(l.first, r.first) && count == l.count + r.count &&
+             std::max(l.first, r.first) == first + (l.first < r.first ? l.count : r.count);
       }
       if (!ok) {
         err << "range of node " << i << " is not its subtree's";

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "accel/node.h"
+#include "core/huge_page_allocator.h"
 
 #include <string>
 #include <utility>
@@ -14,12 +15,19 @@ namespace toyrt {
 // Traversal keeps an explicit stack of this many entries; builders never exceed this depth.
 inline constexpr int kMaxBvhDepth = 96;
 
+// The prim_ids slots under a node: first, first + 1, ..., first + count - 1.
+struct SlotRange {
+  uint32_t first, count;
+};
+
 struct Bvh {
-  std::vector<Node> nodes;
+  // Huge pages, not zeroed on resize (core/huge_page_allocator.h): the LBVH's two million nodes at
+  // 1M triangles were zeroed on one thread before its kernel wrote every one of them.
+  std::vector<Node, HugePageAllocator<Node>> nodes;
   std::vector<uint32_t> prim_ids;  // leaf slots -> primitive index in the builder's input
   // (first, count) of the prim_ids slots under each node, when a builder has them at no cost (the
   // LBVH kernels write them); empty otherwise, and collapse() derives them by a walk.
-  std::vector<std::pair<uint32_t, uint32_t>> ranges;
+  std::vector<SlotRange, HugePageAllocator<SlotRange>> ranges;
 
   bool empty() const { return nodes.empty(); }
 

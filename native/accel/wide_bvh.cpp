@@ -8,7 +8,7 @@
 namespace toyrt {
 
 namespace {
-using Ranges = std::vector<std::pair<uint32_t, uint32_t>>;
+using Ranges = std::vector<SlotRange, HugePageAllocator<SlotRange>>;
 
 // The contiguous range of prim_ids under every node (first, count), by a post-order walk:
 // builders lay nodes out in different orders (depth first for SAH, by split position for LBVH).
@@ -27,7 +27,7 @@ Ranges subtree_ranges(const Bvh& bvh) {
       stack.push_back({n.first + 1, false});
     } else {
       const auto l = range[n.first], r = range[n.first + 1];
-      range[i] = {std::min(l.first, r.first), l.second + r.second};
+      range[i] = {std::min(l.first, r.first), l.count + r.count};
     }
   }
   return range;
@@ -43,7 +43,7 @@ struct Collapser {
   const Ranges& range;
   uint32_t leaf_size;
 
-  bool is_leaf(uint32_t i) const { return bvh.nodes[i].is_leaf() || range[i].second <= leaf_size; }
+  bool is_leaf(uint32_t i) const { return bvh.nodes[i].is_leaf() || range[i].count <= leaf_size; }
 
   // The wide node for binary interior node `binary`: its children are the binary node's two, then
   // the largest (by surface area) interior one is opened until kWidth are held. Leaf slots are
@@ -89,7 +89,7 @@ struct Collapser {
       for (int b = 0; b < 6; ++b) node.bounds[b][i] = c.bounds[b];
       if (is_leaf(kids[i])) {
         node.child[i] = range[kids[i]].first;
-        node.count[i] = range[kids[i]].second;
+        node.count[i] = range[kids[i]].count;
       }
     }
     return n;
@@ -116,7 +116,7 @@ struct Collapser {
     Nodes local[kWidth];
     bool large[kWidth] = {};
     int large_count = 0;
-    for (int j = 0; j < m; ++j) large_count += large[j] = range[kids[interior[j]]].second > kParallelPrimitives;
+    for (int j = 0; j < m; ++j) large_count += large[j] = range[kids[interior[j]]].count > kParallelPrimitives;
     if (large_count > 1) {
       tbb::parallel_for(0, m, [&](int j) {
         if (large[j]) expand_alone(kids[interior[j]], local[j]);
@@ -163,7 +163,7 @@ WideBvh collapse(const Bvh& bvh, uint32_t leaf_size) {
   const Collapser c{bvh, range, leaf_size};
   if (c.is_leaf(0)) {
     wide.root_leaf_first = range[0].first;
-    wide.root_leaf_count = range[0].second;
+    wide.root_leaf_count = range[0].count;
     return wide;
   }
   wide.nodes.reserve(bvh.nodes.size() / (kWidth - 1) + 1);
