@@ -464,11 +464,11 @@ SCENES_SPEC.append(("coat", scene_coat, dict(from_version=(4, 0, 0), mean_limit=
 # The uncoated 4.0+ Principled's layers one by one (the coat scene's red base, roughness 0.5): a
 # base alone (Specular IOR Level 0), a specular layer alone (black base) and both, over a black
 # floor, under the coat scene's lamp and world. Each part matches Cycles per channel within 0.1 %;
-# over the checker floor the full ball does not (base -0.9 %, reflections +1.8 / +2.8 %): Cycles
+# over the checker floor the full ball did not (base -0.9 %, reflections +1.8 / +2.8 %): Cycles
 # picks one closure per vertex to continue with, and under diffuse bounces 0 only a glossy pick
-# carries the floor's light, weighted by the whole BSDF over the closures' mixed pdf, which TOYRT
-# (the base: direct light only; the layer: always followed) does not imitate (docs/render.md).
-# The black floor leaves nothing for that to act on, so this scene checks the layers themselves.
+# carries the floor's light, weighted by the whole BSDF over the closures' mixed pdf (TOYRT copies
+# that since: principled_closure_pick, render/closure_pick.h, docs/render.md). The black floor
+# leaves nothing for that to act on, so this scene checks the layers themselves.
 def scene_principled_layers(p):
     kit.plane("floor", 6.0, kit.diffuse("black", (0.0, 0.0, 0.0)))
     for i, (color, level) in enumerate((((0.7, 0.08, 0.05), 0.0), ((0.0, 0.0, 0.0), 0.5), ((0.7, 0.08, 0.05), 0.5))):
