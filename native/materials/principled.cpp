@@ -4,6 +4,7 @@
 #include "materials/fresnel.h"
 #include "materials/multiscatter.h"
 #include "sampling/ggx_albedo.h"
+#include "sampling/warp.h"
 
 #include <algorithm>
 #include <cmath>
@@ -196,7 +197,20 @@ Scatter opaque_scatter(const Principled& m, const ShadingPoint& s, const Materia
   const Layer layer = dielectric_layer(m, s, m.f0);
   const Vec3 f = scale * dielectric * layer.base * lambert_f(albedo);
   if (m.metallic > 0.0f && metal_drawn()) return lobe_over(metal_lobe(m, s, albedo), f);
-  return lobe_over(layer.lobe, f);
+  Scatter sc = lobe_over(layer.lobe, f);
+  // The plain two-closure case (u < 0: neither glass nor coat drew first; no metal): Cycles'
+  // sample weights, the layer's average of mix(F0, 1, s) times that of its closure weight's
+  // multiscatter darkening E (1 + F_ms (1 - E) / E), the base's its average colour times the
+  // share it keeps (render/closure_pick.h).
+  if (u < 0.0f && m.metallic == 0.0f) {
+    const float mu = layer.lobe.wo.z;
+    const Vec3 reflect = glm::mix(m.f0, Vec3(1.0f), ggx_fresnel_blend(m.roughness, mu, m.eta));
+    const Vec3 dark = m.multiscatter ? layer.lobe.tint * ggx_albedo(m.roughness, mu) : Vec3(1.0f);
+    const float layer_weight = (reflect.x + reflect.y + reflect.z) * (dark.x + dark.y + dark.z) / 9.0f;
+    const float base_weight = (f.x + f.y + f.z) / 3.0f * kPi / scale;
+    if (layer_weight > 0.0f) sc.glossy_pick = layer_weight / (layer_weight + base_weight);
+  }
+  return sc;
 }
 
 // 4.0+'s coat over what opaque_scatter answers (Principled.h): the coat's lobe drawn with

@@ -72,6 +72,10 @@ struct Scatter {
   // (Blender 3.x's Principled diffuse, materials/burley_diffuse.h) instead of f alone.
   bool burley = false;
   BurleyDiffuse retro;
+  // Glossy with a diffuse part: Cycles' probability of continuing along the glossy closure
+  // (its sample weight over both), which decides what the continuation's next vertex scatters:
+  // the whole BSDF over the closures' mixed pdf (render/closure_pick.h). 0: the lobe's own value.
+  float glossy_pick = 0.0f;
   int count = 0;
   SpecularSample branches[2];
   GlossyLobe glossy;

@@ -2,6 +2,7 @@
 
 #include "geometry/offset_ray.h"
 #include "lights/light_selector.h"
+#include "render/closure_pick.h"
 #include "render/dielectric_lighting.h"
 #include "render/glossy_color.h"
 #include "render/glossy_lighting.h"
@@ -297,6 +298,10 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
   // for the emission it finds and shades nothing there).
   float bsdf_pdf = 0.0f;
   bool light_only = false;
+  // After a glossy vertex whose diffuse part Cycles' closure pick shares in (render/closure_pick.h):
+  // the throughput for what the next vertex scatters; `throughput` serves the light the ray sees.
+  bool picked = false;
+  Vec3 picked_throughput(0.0f);
   RayKind kind = first_kind;
   uint8_t receiver = first_receiver;             // the light-linking receiver set of the ray's last vertex (0: camera)
   CutOutPath cut(path_settings, first_crossed);  // kCutOuts only (render/transparent_walk.h)
@@ -368,6 +373,10 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     // whether the path goes on along `ray`. Always inlined: with the glossy cases GCC made the
     // lambda a function of its own, and the Lambert path paid for the call (cachegrind,
     // docs/render.md "A scene pays for what it uses").
+    if (picked) [[unlikely]] {
+      throughput = picked_throughput;
+      picked = false;
+    }
     const MaterialContext ctx{&scene.textures(),
                               bounce < settings.split_depth,
                               pixel,
@@ -409,6 +418,11 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
                               vertex_dimension(depth, kDimsPerVertex - 5), settings, s.receiver_set);
             radiance += throughput * g.radiance;
             if (!(g.pdf > 0.0f)) return false;
+            if (sc.glossy_pick > 0.0f) {
+              picked_throughput =
+                  throughput * closure_pick_weight(g.weight, g.pdf, sc.f, glm::dot(ns, g.wi), sc.glossy_pick);
+              picked = true;
+            }
             throughput *= g.weight;
             bsdf_pdf = g.pdf;
             light_only = bounce >= settings.max_specular_depth;

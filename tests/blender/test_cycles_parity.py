@@ -455,9 +455,49 @@ def scene_coat(p):
 # 0.288 %, 0.92 % of pixels beyond 0.016 (before: 0.307 %, 1.31 %, the rough-coated ball's rim
 # 1.6 % darker than Cycles', now 0.6 %). A thin margin: with the tinted ball untinted, 1.67 % of
 # pixels; with Coat Weight 0 the same balls leave 1.21 %, the same red-too-dark, green-and-blue-
-# too-bright split: what is left is the uncoated Principled's (docs/render.md).
+# too-bright split: not the BSDF's but Cycles' closure pick under diffuse bounces 0, which carries the
+# floor's light along glossy picks only (principled_layers below, docs/render.md).
 SCENES_SPEC.append(("coat", scene_coat, dict(from_version=(4, 0, 0), mean_limit=0.005,
                                              sample_factor=4), 8))
+
+
+# The uncoated 4.0+ Principled's layers one by one (the coat scene's red base, roughness 0.5): a
+# base alone (Specular IOR Level 0), a specular layer alone (black base) and both, over a black
+# floor, under the coat scene's lamp and world. Each part matches Cycles per channel within 0.1 %;
+# over the checker floor the full ball did not (base -0.9 %, reflections +1.8 / +2.8 %): Cycles
+# picks one closure per vertex to continue with, and under diffuse bounces 0 only a glossy pick
+# carries the floor's light, weighted by the whole BSDF over the closures' mixed pdf (TOYRT copies
+# that since: principled_closure_pick, render/closure_pick.h, docs/render.md). The black floor
+# leaves nothing for that to act on, so this scene checks the layers themselves.
+def scene_principled_layers(p):
+    kit.plane("floor", 6.0, kit.diffuse("black", (0.0, 0.0, 0.0)))
+    for i, (color, level) in enumerate((((0.7, 0.08, 0.05), 0.0), ((0.0, 0.0, 0.0), 0.5), ((0.7, 0.08, 0.05), 0.5))):
+        mat = kit.principled_dielectric(f"layers{i}", color, 0.5, specular=level)
+        kit.uv_sphere(f"ball{i}", 0.45, (-1.0 + 1.0 * i, 0.0, 0.45), mat)
+    kit.area_light("panel", (1.0, -2.0, 3.0), 250.0, 2.0, 1.0, target=(0, 0, 0))
+    camera((0.0, -5.0, 2.5), (0, 0, 0.4))
+    kit.world((0.05, 0.05, 0.05))
+
+
+SCENES_SPEC.append(("principled_layers", scene_principled_layers, dict(from_version=(4, 0, 0), mean_limit=0.005,
+                                                                       sample_factor=2), 8))
+
+
+# The same uncoated red Principled (four balls, the coat scene's places) over the lit checker
+# floor, where Cycles' closure pick decides how the floor's light reaches base and layer: TOYRT
+# copies it (render/closure_pick.h). Before: base -0.9 %, reflections +1.8 / +2.8 % per channel.
+def scene_principled_closure_pick(p):
+    kit.plane("floor", 6.0, checker("checker", 8, 0.15, 0.85), uv_repeat=4.0)
+    for i in range(4):
+        mat = kit.principled_dielectric(f"picked{i}", (0.7, 0.08, 0.05), 0.5)
+        kit.uv_sphere(f"ball{i}", 0.45, (-1.5 + 1.0 * i, 0.0, 0.45), mat)
+    kit.area_light("panel", (1.0, -2.0, 3.0), 250.0, 2.0, 1.0, target=(0, 0, 0))
+    camera((0.0, -5.0, 2.5), (0, 0, 0.4))
+    kit.world((0.05, 0.05, 0.05))
+
+
+SCENES_SPEC.append(("principled_closure_pick", scene_principled_closure_pick,
+                    dict(from_version=(4, 0, 0), mean_limit=0.005, sample_factor=2), 8))
 
 # General Mix and Add Shaders (issue 14: the core's 'mix' kind, one input drawn per hit by its
 # weight): left, a Mix of a Principled BSDF (a warm base, roughness 0.3) and a smooth Glass BSDF

@@ -4,7 +4,9 @@
 // rest; a white multiscatter lobe reflects everything; Specular IOR Level 0 or IOR 1 is plain
 // Lambert; the lobe's sampled weights equal f cos / pdf with its Fresnel term; bad parameters have
 // a defined answer; 4.0+'s coat leaves below it what Cycles' estimate of its albedo leaves, its
-// lobe is energy-compensated, and a white coated surface returns about all light, never more.
+// lobe is energy-compensated, and a white coated surface returns about all light, never more;
+// the uncoated layer's pick share is Cycles' sample weights' and the weight of a continuation
+// under that pick averages to the closures' mixed-pdf estimator (render/closure_pick.h).
 #include "materials/principled.h"
 #include "hemisphere.h"
 #include "materials/coat.h"
@@ -12,6 +14,7 @@
 #include "materials/glossy.h"
 #include "materials/material.h"
 #include "materials/multiscatter.h"
+#include "render/closure_pick.h"
 #include "sampling/ggx_albedo.h"
 
 #include <gtest/gtest.h>
@@ -187,6 +190,65 @@ TEST(Principled, Blender3xSumKeepsTheWholeBaseUnderTheSameLayer) {
   const Vec3 wi = direction(0.5, 3.0);
   EXPECT_EQ(evaluate_lobe(s3.glossy, wi).f, evaluate_lobe(s4.glossy, wi).f);
   EXPECT_EQ(s3.glossy.shadowing, GgxShadowing::Separable);
+}
+
+// Cycles' sample weights: the layer's mix(F0, 1, s) E (1 + F_ms (1 - E) / E) (colourless), the
+// base's average colour times the share it keeps, 1 minus the layer's.
+TEST(Principled, GlossyPickIsTheLayersShareOfCyclesSampleWeights) {
+  const Vec3 color(0.7f, 0.08f, 0.05f);
+  const Principled m = principled(args({{"color", color}, {"roughness", 0.5}, {"ior", 1.5}}));
+  for (const double theta : {0.2, 0.9, 1.4}) {
+    const ShadingPoint hit = hit_from(direction(theta, 0.3));
+    const float mu = float(std::cos(theta));
+    const float s = ggx_fresnel_blend(0.5f, mu, 1.5f);
+    const float f_ms = multiscatter_scale(0.5f, mu, m.fss).x;
+    const float layer = (0.04f + 0.96f * s) * ggx_albedo(0.5f, mu) * f_ms;
+    const float base = (color.x + color.y + color.z) / 3.0f * (1.0f - layer);
+    const Scatter sc = scatter(m, hit, kContext);
+    EXPECT_NEAR(sc.glossy_pick, layer / (layer + base), 1e-4f) << theta;
+  }
+  // Only there: 3.x's sum, a coat, a metal or glass beside the layer leave the lobe its own weight.
+  const ShadingPoint hit = hit_from(direction(0.9, 0.3));
+  for (const Params& p : std::vector<Params>{
+           args({{"color", color}, {"layered", false}, {"multiscatter", false}}),
+           args({{"color", color}, {"coat_weight", 0.5}}),
+           args({{"color", color}, {"metallic", 0.5}}),
+           args({{"color", color}, {"transmission", 0.5}}),
+       })
+    EXPECT_EQ(scatter(principled(p), hit, kContext).glossy_pick, 0.0f);
+}
+
+// Averaged over the lobe's own samples, the continuation's weight under Cycles' pick is the
+// quadrature of (f_g + f_d) cos w p_g / (w p_g + (1 - w) cos / pi): the glossy picks' share of
+// the whole BSDF; a lobe without a diffuse part (w = 1) keeps its own weight.
+TEST(Principled, PickedContinuationAveragesToTheGlossyPicksShareOfTheWholeBsdf) {
+  const Principled m = principled(args({{"color", Vec3(0.7f, 0.08f, 0.05f)}, {"roughness", 0.5}, {"ior", 1.5}}));
+  const Scatter sc = scatter(m, hit_from(direction(0.9, 0.3)), kContext);
+  ASSERT_GT(sc.glossy_pick, 0.0f);
+  const float w = sc.glossy_pick;
+  constexpr int kN = 512;
+  double sampled = 0.0;
+  for (int i = 0; i < kN; ++i)
+    for (int j = 0; j < kN; ++j) {
+      const BsdfSample b = sample_lobe(sc.glossy, Vec2((i + 0.5f) / kN, (j + 0.5f) / kN));
+      if (!(b.pdf > 0.0f)) continue;
+      const Vec3 v = closure_pick_weight(b.weight, b.pdf, sc.f, b.wi.z, w);
+      sampled += v.x;
+      const Vec3 alone = closure_pick_weight(b.weight, b.pdf, Vec3(0.0f), b.wi.z, 1.0f);
+      EXPECT_NEAR(alone.x, b.weight.x, 1e-5f * b.weight.x);
+    }
+  sampled /= double(kN) * kN;
+  const double quadrature = hemisphere_integral(
+      [&](const Vec3& wi) {
+        const BsdfEval e = evaluate_lobe(sc.glossy, wi);
+        const double mixed = w * e.pdf + (1.0 - w) * wi.z * kInvPi;
+        return mixed > 0.0 ? (e.f.x + sc.f.x) * wi.z * w * e.pdf / mixed : 0.0;
+      },
+      1024, 256);
+  EXPECT_NEAR(sampled, quadrature, 2e-3 * quadrature);
+  // More than the lobe alone (the base's share), less than the whole BSDF's albedo.
+  EXPECT_GT(sampled, furnace(Scatter::glossy_lobe(sc.glossy)).x);
+  EXPECT_LT(sampled, furnace(sc).x);
 }
 
 TEST(PrincipledMetal, F82TintScalesSchlickAt82DegreesAndAveragesInClosedForm) {
