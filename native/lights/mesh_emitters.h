@@ -4,7 +4,10 @@
 // Emission surface of strength 1 and colour c sees c).
 //
 // Sampling: one triangle chosen with probability proportional to its power (area x mean
-// radiance) from a CDF (binary search, so millions of triangles cost a log2 of them); then, close
+// radiance) from a CDF (binary search, so millions of triangles cost a log2 of them), or, from
+// kEmitterTreeFrom triangles on, by its expected contribution at the shading point through a
+// light tree over them (lights/light_tree.h, the lamps' tree built from the triangles' bounds:
+// near ones and ones facing the point are chosen more); then, close
 // to it (its longest edge longer than the point's height over its plane, Cycles' rule), a
 // direction uniform in its solid angle (lights/spherical_triangle.h: density P(triangle) / Omega),
 // else a uniform point on it (density P(triangle) d^2 / (area |cos_light|)). A triangle
@@ -17,13 +20,19 @@
 #pragma once
 
 #include "core/math.h"
+#include "lights/light_bounds.h"
 #include "lights/light_sample.h"
+#include "lights/light_tree.h"
 #include "sampling/warp.h"
 
 #include <cstdint>
 #include <vector>
 
 namespace toyrt {
+
+// Scenes with at least this many sampled emissive triangles pick them through a light tree, the
+// others by the power CDF: measured in docs/lights.md ("Emissive triangles through the light tree").
+inline constexpr size_t kEmitterTreeFrom = 64;
 
 enum class EmitterSides : uint8_t { Both = 3, Front = 1, Back = 2 };
 
@@ -35,26 +44,49 @@ struct EmissiveTriangle {
   EmitterSides sides = EmitterSides::Both;
 };
 
+// What a light tree weighs a triangle by, as each lamp type provides (lights/light.h): its
+// cluster importance as a node of one (the tree's own estimate), with its normal turned to p's
+// side, and exactly zero on a side it does not emit to (where sample_emitters() finds nothing).
+float importance(const EmissiveTriangle& t, const Vec3& p, const Vec3& n);
+// Its box, power (area x mean radiance) and normal cone: one-sided (theta_o = 0 around the
+// emitting side's normal) for emission sampling Front or Back, else any direction off its plane
+// (Cycles' bounds: an axis in the plane, theta_o = pi / 2), theta_e = pi / 2 either way.
+LightBounds bounds(const EmissiveTriangle& t);
+
 struct MeshEmitters {
   std::vector<EmissiveTriangle> triangles;  // of positive area and radiance only
-  std::vector<float> cdf;                   // triangles.size() + 1 values from 0 to 1, by power
-  double total_power = 0.0;                 // sum of area x mean radiance (W/sr, for importance)
+  // Per triangle, where hits find it (instance << 32 | triangle index), ascending (index_of()).
+  std::vector<uint64_t> keys;
+  std::vector<float> cdf;    // triangles.size() + 1 values from 0 to 1, by power (without the tree)
+  double total_power = 0.0;  // sum of area x mean radiance (W/sr, for importance)
+  LightTree tree;            // over the triangles from kEmitterTreeFrom of them, else empty
 
   bool empty() const { return triangles.empty(); }
-  // Keeps `t` if it has area and radiance (a zero-area triangle cannot emit anything).
-  void add(const EmissiveTriangle& t);
-  void finish();  // builds the CDF once every triangle is added
+  bool uses_tree() const { return tree.node_count() > 0; }
+  // Keeps `t` if it has area and radiance (a zero-area triangle cannot emit anything). `key`:
+  // where the scene's hits find it, added in ascending order (default: its position).
+  void add(const EmissiveTriangle& t, uint64_t key = UINT64_MAX);
+  // Builds the CDF once every triangle is added, or the tree from `tree_from` triangles on.
+  void finish(size_t tree_from = kEmitterTreeFrom);
+  // The triangle added with `key` (instance << 32 | triangle), or -1: not sampled as a light.
+  int64_t index_of(uint64_t key) const;
+  size_t memory_bytes() const;
 };
 
-// A point on one emissive triangle seen from p (u: two uniform numbers, the first also choosing
-// the triangle). No sample when the chosen triangle faces away on a side it does not emit to.
-LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const Vec2& u);
+// A point on one emissive triangle seen from p with normal n (n = 0: no receiver cosine; the tree
+// weighs by it) (u: two uniform numbers, the first also choosing the triangle). No sample when
+// the chosen triangle faces away on a side it does not emit to.
+LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const Vec3& n, const Vec2& u);
 
-// The solid-angle density sample_emitters() gives the direction wi from p when it meets emissive
-// triangle t (world space, as gathered) at `distance`: P(t) = its power / the total, times its
-// own density (1 / Omega close to it, d^2 / (area |cos|) further away); 0 where t's side facing p
-// is not sampled. For multiple importance sampling against rays that hit emitters.
-float emitter_pdf(const MeshEmitters& emitters, const Vec3& p, const EmissiveTriangle& t, const Vec3& wi,
+// The probability that sample_emitters() chooses triangle `index` at (p, n): its power / the
+// total, or the tree's probability (the same floats select() returned).
+float emitter_probability(const MeshEmitters& emitters, const Vec3& p, const Vec3& n, size_t index);
+
+// The solid-angle density sample_emitters() gives the direction wi from (p, n) when it meets
+// emissive triangle `index` at `distance`: emitter_probability() times its own density (1 / Omega
+// close to it, d^2 / (area |cos|) further away); 0 where its side facing p is not sampled. For
+// multiple importance sampling against rays that hit emitters.
+float emitter_pdf(const MeshEmitters& emitters, const Vec3& p, const Vec3& n, size_t index, const Vec3& wi,
                   float distance);
 
 }  // namespace toyrt

@@ -48,7 +48,8 @@ struct CommitStats {
   size_t meshes_built = 0;       // meshes whose BVH the last commit (re)built
   size_t sah_meshes = 0, lbvh_meshes = 0;
   size_t emissive_triangles = 0;  // sampled as lights (world space, each instance's counted)
-  double emitters_ms = 0.0;       // gathering them, part of build_ms
+  double emitters_ms = 0.0;       // gathering them (and their light tree), part of build_ms
+  size_t emitter_tree_nodes = 0;  // 0: no tree over them (fewer than kEmitterTreeFrom)
   size_t light_tree_nodes = 0;    // 0: no tree (kLightTreeFrom lights or fewer)
   double light_tree_ms = 0.0;     // building it (only when the lights changed), part of build_ms
   // Set when an LBVH build could not run (no OpenCL device, kernel build failure) and the SAH

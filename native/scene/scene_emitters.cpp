@@ -10,7 +10,8 @@ void Scene::gather_emitters() {
   if (std::none_of(emission_.begin(), emission_.end(),
                    [](const MaterialEmission& e) { return e.emits() && e.sampled; }))
     return;  // a scene without sampled emitters pays nothing here
-  for (const Instance& inst : instances_) {
+  for (size_t i = 0; i < instances_.size(); ++i) {
+    const Instance& inst = instances_[i];
     const Mesh& mesh = *meshes_[inst.mesh];
     const MeshShading& sh = shading_[inst.mesh];
     const std::vector<Vec3>& v = mesh.vertices();
@@ -35,7 +36,7 @@ void Scene::gather_emitters() {
       et.normal = n / (2.0f * et.area);
       et.radiance = e.radiance;
       et.sides = e.sides;
-      emitters_.add(et);
+      emitters_.add(et, uint64_t(i) << 32 | uint64_t(t));  // ascending: index_of() finds hits by it
     }
   }
   emitters_.finish();
