@@ -31,15 +31,31 @@ float cos_minus_clamped(float cos_t, float sin_t, float cos_a, float sin_a) {
 
 // The cosine of the half-angle theta_u of the cone from p around `to_centre` (unit) that holds
 // the box: the widest of its eight corners (Cycles, kernel/light/tree.h, does the same). Tighter
-// than the bounding sphere's for the flat, wide clusters of lights over a floor.
-float cos_subtended(const LightTreeNode& c, const Vec3& p, const Vec3& to_centre) {
-  float cos_u = 1.0f;
-  for (int k = 0; k < 8; ++k) {
-    const Vec3 corner((k & 1) ? c.hi.x : c.lo.x, (k & 2) ? c.hi.y : c.lo.y, (k & 4) ? c.hi.z : c.lo.z);
-    const Vec3 w = corner - p;
-    cos_u = std::min(cos_u, glm::dot(to_centre, w) / glm::length(w));
+// than the bounding sphere's for the flat, wide clusters of lights over a floor. Given `hull`
+// (points whose convex hull holds every emitting point: a triangle's vertices), the widest of them.
+float cos_subtended(const LightTreeNode& c, const Vec3& p, const Vec3& to_centre, const Vec3* hull, int hull_count) {
+  // The smallest cosine dot(to_centre, w) / |w| over the points w - p, compared without a square
+  // root or a division per point: as c |c| = dot |dot| / |w|^2 (monotonic in c), cross-multiplied.
+  // One square root at the end; this loop is most of a cluster's cost.
+  float num = 1.0f, den = 1.0f;  // c |c| = num / den, den > 0
+  const auto consider = [&](const Vec3& point) {
+    const Vec3 w = point - p;
+    const float dot = glm::dot(to_centre, w), w2 = glm::dot(w, w);
+    const float n = dot * std::fabs(dot);
+    if (n * den < num * w2) {
+      num = n;
+      den = w2;
+    }
+  };
+  if (hull) {
+    for (int k = 0; k < hull_count; ++k) consider(hull[k]);
+  } else {
+    for (int k = 0; k < 8; ++k)
+      consider(Vec3((k & 1) ? c.hi.x : c.lo.x, (k & 2) ? c.hi.y : c.lo.y, (k & 4) ? c.hi.z : c.lo.z));
   }
-  return std::max(cos_u, -1.0f);
+  if (!(den > 0.0f)) return -1.0f;  // p on a corner: no angle is bounded
+  const float cos_u = std::copysign(std::sqrt(std::fabs(num) / den), num);
+  return std::clamp(cos_u, -1.0f, 1.0f);
 }
 
 }  // namespace
@@ -51,7 +67,7 @@ float cos_subtended(const LightTreeNode& c, const Vec3& p, const Vec3& to_centre
 // plane (Cycles' test), every normal turns away, or the receiver's bound cos(theta_i - theta_u)
 // is negative, or p is behind every emitter of a one-sided cluster. Inside the box no angle is
 // bounded.
-float cluster_importance(const LightTreeNode& c, const Vec3& p, const Vec3& n) {
+float cluster_importance(const LightTreeNode& c, const Vec3& p, const Vec3& n, const Vec3* hull, int hull_count) {
   const Vec3 centre = 0.5f * c.lo + 0.5f * c.hi;
   const Vec3 half = 0.5f * c.hi - 0.5f * c.lo;
   const Vec3 v = p - centre;  // from the cluster to the point
@@ -86,7 +102,7 @@ float cluster_importance(const LightTreeNode& c, const Vec3& p, const Vec3& n) {
   const bool inside =
       p.x >= c.lo.x && p.y >= c.lo.y && p.z >= c.lo.z && p.x <= c.hi.x && p.y <= c.hi.y && p.z <= c.hi.z;
   if (inside || !(d > 0.0f)) return c.power / falloff;
-  const float cos_u = cos_subtended(c, p, -v / d);
+  const float cos_u = cos_subtended(c, p, -v / d, hull, hull_count);
   const float sin_u = std::sqrt(std::max(0.0f, 1.0f - cos_u * cos_u));
   float emit = 1.0f;
   // theta_o + theta_u >= pi (a point light's cluster): some normal faces p whatever the angle.

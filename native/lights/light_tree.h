@@ -99,7 +99,10 @@ class LightTree {
 
 // The importance at p (normal n; 0: no receiver cosine) of every light a node bounds, as the tree
 // weighs an inner node: zero only where none of them can reach p. Emissive triangles weigh
-// themselves by it too (mesh_emitters.cpp), as a node of one.
-float cluster_importance(const LightTreeNode& node, const Vec3& p, const Vec3& n);
+// themselves by it too (mesh_emitters.cpp), as a node of one whose `hull` (its three vertices:
+// points whose convex hull holds every emitting point) bounds the angle it subtends from p more
+// tightly and more cheaply than the box's eight corners.
+float cluster_importance(const LightTreeNode& node, const Vec3& p, const Vec3& n, const Vec3* hull = nullptr,
+                         int hull_count = 0);
 
 }  // namespace toyrt

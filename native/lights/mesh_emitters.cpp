@@ -22,16 +22,16 @@ float importance(const EmissiveTriangle& t, const Vec3& p, const Vec3& n) {
   const float height = glm::dot(p - t.p0, t.normal);
   const uint8_t side = side_of(t, height);
   if (!(uint8_t(t.sides) & side)) return 0.0f;
-  const Vec3 p1 = t.p0 + t.e1, p2 = t.p0 + t.e2;
+  const Vec3 vertices[3] = {t.p0, t.p0 + t.e1, t.p0 + t.e2};
   LightTreeNode node;
-  node.lo = glm::min(t.p0, glm::min(p1, p2));
-  node.hi = glm::max(t.p0, glm::max(p1, p2));
+  node.lo = glm::min(vertices[0], glm::min(vertices[1], vertices[2]));
+  node.hi = glm::max(vertices[0], glm::max(vertices[1], vertices[2]));
   node.axis = height > 0.0f ? t.normal : -t.normal;  // the side p sees: theta_o = 0
   node.cos_o = 1.0f;
   node.sin_o = 0.0f;
   node.cos_e = 0.0f;  // theta_e = pi / 2: a Lambertian emitter
   node.power = t.area * mean(t.radiance);
-  return cluster_importance(node, p, n);
+  return cluster_importance(node, p, n, vertices, 3);
 }
 
 LightBounds bounds(const EmissiveTriangle& t) {
@@ -67,7 +67,7 @@ size_t MeshEmitters::memory_bytes() const {
          cdf.capacity() * sizeof(float) + tree.memory_bytes();
 }
 
-void MeshEmitters::finish(size_t tree_from) {
+void MeshEmitters::finish(size_t tree_from, uint32_t leaf_size, float min_diagonal) {
   double run = 0.0;
   for (const EmissiveTriangle& t : triangles) run += double(t.area) * mean(t.radiance);
   total_power = run;
@@ -76,9 +76,16 @@ void MeshEmitters::finish(size_t tree_from) {
   if (!triangles.empty() && triangles.size() >= tree_from) {
     std::vector<LightBounds> all;
     all.reserve(triangles.size());
-    for (const EmissiveTriangle& t : triangles) all.push_back(bounds(t));
-    tree = LightTree(all);
-    return;
+    BBox box;
+    for (const EmissiveTriangle& t : triangles) {
+      all.push_back(bounds(t));
+      box.extend(all.back().box);
+    }
+    // One compact emitter keeps the CDF (kEmitterTreeSpread).
+    if (!(glm::length(box.extent()) < min_diagonal)) {
+      tree = LightTree(all, leaf_size);
+      return;
+    }
   }
   cdf.assign(triangles.size() + 1, 0.0f);
   double acc = 0.0;

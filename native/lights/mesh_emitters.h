@@ -33,6 +33,12 @@ namespace toyrt {
 // Scenes with at least this many sampled emissive triangles pick them through a light tree, the
 // others by the power CDF: measured in docs/lights.md ("Emissive triangles through the light tree").
 inline constexpr size_t kEmitterTreeFrom = 64;
+// ... and whose box spans at least this share of the scene's diagonal: one compact emitter (a
+// glowing ball of any triangle count) keeps the CDF, which is near the best choice for it and
+// costs a tenth of the tree's walk (docs/lights.md measures both cases).
+inline constexpr float kEmitterTreeSpread = 0.25f;
+// Triangles per leaf of their tree: measured in docs/lights.md (as the lamps' LightTree::kLeafSize).
+inline constexpr uint32_t kEmitterLeafSize = 1;
 
 enum class EmitterSides : uint8_t { Both = 3, Front = 1, Back = 2 };
 
@@ -66,8 +72,9 @@ struct MeshEmitters {
   // Keeps `t` if it has area and radiance (a zero-area triangle cannot emit anything). `key`:
   // where the scene's hits find it, added in ascending order (default: its position).
   void add(const EmissiveTriangle& t, uint64_t key = UINT64_MAX);
-  // Builds the CDF once every triangle is added, or the tree from `tree_from` triangles on.
-  void finish(size_t tree_from = kEmitterTreeFrom);
+  // Builds the CDF once every triangle is added, or the tree from `tree_from` triangles on when
+  // their box's diagonal is at least `min_diagonal` (the scene's x kEmitterTreeSpread; 0: always).
+  void finish(size_t tree_from = kEmitterTreeFrom, uint32_t leaf_size = kEmitterLeafSize, float min_diagonal = 0.0f);
   // The triangle added with `key` (instance << 32 | triangle), or -1: not sampled as a light.
   int64_t index_of(uint64_t key) const;
   size_t memory_bytes() const;

@@ -206,6 +206,13 @@ class Scene {
   // blocker sets `blockers` (light linking).
   Hit intersect_shadow_casters(const Ray& ray, uint64_t blockers = kAllLightSets) const;
   const MeshEmitters& emitters() const { return emitters_; }  // the sampled emissive triangles, by commit()
+  // From how many sampled emissive triangles, spanning what share of the scene's diagonal, the
+  // next commits pick them through a light tree (kEmitterTreeFrom, kEmitterTreeSpread; benchmarks
+  // set them to compare the tree with the power CDF).
+  void set_emitter_tree_from(size_t triangles, float spread = kEmitterTreeSpread) {
+    emitter_tree_from_ = triangles;
+    emitter_tree_spread_ = spread;
+  }
   const World& world() const { return world_; }
   // The tree the render selects lights with: built by commit() over more than kLightTreeFrom
   // lights; null for fewer, and for lights edited since the last commit (they are selected
@@ -242,6 +249,8 @@ class Scene {
   std::vector<MaterialMix> mixes_;  // parallel to materials_
   bool any_mix_ = false;
   MeshEmitters emitters_;
+  size_t emitter_tree_from_ = kEmitterTreeFrom;
+  float emitter_tree_spread_ = kEmitterTreeSpread;
   std::vector<Texture> textures_;
   World world_;
   LightTree light_tree_;             // over world_.lights when light_tree_current_

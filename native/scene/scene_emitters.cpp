@@ -2,6 +2,7 @@
 #include "scene/scene.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace toyrt {
 
@@ -39,7 +40,14 @@ void Scene::gather_emitters() {
       emitters_.add(et, uint64_t(i) << 32 | uint64_t(t));  // ascending: index_of() finds hits by it
     }
   }
-  emitters_.finish();
+  // The scene's extent, for the tree's spread test (top_ is built before the emitters are gathered).
+  float diagonal = 0.0f;
+  if (!top_.nodes.empty()) {
+    const float* b = top_.nodes[0].bounds;
+    diagonal = glm::length(Vec3(b[3] - b[0], b[4] - b[1], b[5] - b[2]));
+  }
+  emitters_.finish(emitter_tree_from_, kEmitterLeafSize,
+                   std::isfinite(diagonal) ? emitter_tree_spread_ * diagonal : 0.0f);
 }
 
 }  // namespace toyrt

@@ -4,7 +4,7 @@
 // emitter_pdf()'s for the same direction (what MIS with the cosine ray needs); a one-sided
 // emitter's triangles facing away are never picked; the one-sample estimate through the tree
 // converges to the closed-form irradiance of a square tiled into 3,200 triangles; and the scene
-// builds the tree at commit only from the threshold on.
+// builds the tree at commit only for many triangles spread over much of it.
 #include "lights/light_tree.h"
 #include "lights/mesh_emitters.h"
 #include "render/renderer.h"
@@ -248,11 +248,11 @@ void add_emissive_square(Scene& scene, int side, float x, float z, float half, i
   scene.add_instance(scene.add_mesh(v, t, sh), Mat4(1.0f));
 }
 
-TEST(EmitterTree, TheSceneBuildsItAtCommitFromTheThresholdAndTheRenderKeepsItsMean) {
-  // One emissive square beside the pixel over the Lambert floor, as 2 triangles (the CDF) and as
-  // 8 x 8 quads (128 triangles, the tree): the same light, so the same pixel within the noise
-  // (both strategies, the shadow ray and the cosine ray, weighted by emitter_pdf()); a scene
-  // without emitters builds nothing.
+TEST(EmitterTree, TheSceneBuildsItAtCommitForManySpreadTrianglesAndTheRenderKeepsItsMean) {
+  // One emissive square beside the pixel over the 20 m Lambert floor, as 2 triangles (the CDF)
+  // and as 8 x 8 quads (128 triangles) through the tree: the same light, so the same pixel within
+  // the noise (both strategies, the shadow ray and the cosine ray, weighted by emitter_pdf()). By
+  // default the tiled square keeps the CDF: it spans less than kEmitterTreeSpread of the scene.
   double pixel[2];
   for (int tiled = 0; tiled < 2; ++tiled) {
     Scene scene = floor_of(Lambert{Vec3(0.5f), -1});
@@ -262,11 +262,26 @@ TEST(EmitterTree, TheSceneBuildsItAtCommitFromTheThresholdAndTheRenderKeepsItsMe
     add_emissive_square(scene, tiled ? 8 : 1, 0.7f, 0.4f, 0.4f, int32_t(lamp));
     scene.commit();
     EXPECT_EQ(scene.commit_stats().emissive_triangles, tiled ? 128u : 2u);
-    EXPECT_EQ(scene.commit_stats().emitter_tree_nodes > 0, tiled == 1);
+    EXPECT_EQ(scene.commit_stats().emitter_tree_nodes, 0u);  // few, or compact
+    if (tiled) {
+      scene.set_emitter_tree_from(kEmitterTreeFrom, 0.0f);
+      scene.commit();
+      EXPECT_GT(scene.commit_stats().emitter_tree_nodes, 0u);
+    }
     pixel[tiled] = render(scene, pixel_above(1e-3f), few_samples(16384)).rgba[0];
   }
   EXPECT_GT(pixel[0], 0.0);
   EXPECT_NEAR(pixel[1], pixel[0], 0.015 * pixel[0]);
+  // A 16 m square (a 22.6 m diagonal of the floor's 28.3 m), from the threshold on:
+  // the tree by default; fewer triangles: the CDF.
+  for (int side : {2, 8}) {
+    Scene scene = floor_of(Lambert{Vec3(0.5f), -1});
+    MaterialEmission glow;
+    glow.radiance = Vec3(5.0f);
+    add_emissive_square(scene, side, 0.0f, 2.0f, 8.0f, int32_t(scene.add_material(Lambert{Vec3(0.0f), -1}, glow)));
+    scene.commit();
+    EXPECT_EQ(scene.commit_stats().emitter_tree_nodes > 0, 2u * side * side >= kEmitterTreeFrom) << side;
+  }
   Scene dark = floor_of(Lambert{Vec3(0.5f), -1});
   dark.commit();
   EXPECT_EQ(dark.commit_stats().emitter_tree_nodes, 0u);
