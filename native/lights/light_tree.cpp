@@ -333,6 +333,9 @@ void LightTree::build(const std::vector<LightBounds>& bounds, uint32_t leaf_size
   Builder builder{nodes_, parent_, std::max(leaf_size, 1u)};
   builder.build(items, 0, items.size(), 0, 0);
   depth_ = builder.max_depth;
+  // Reserved for leaves of one; larger leaves use a fraction (half the memory at 2 a leaf).
+  nodes_.shrink_to_fit();
+  parent_.shrink_to_fit();
   order_.resize(items.size());
   for (size_t i = 0; i < items.size(); ++i) order_[i] = items[i].light;
   for (size_t k = 0; k < nodes_.size(); ++k)

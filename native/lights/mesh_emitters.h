@@ -5,7 +5,8 @@
 //
 // Sampling: one triangle chosen with probability proportional to its power (area x mean
 // radiance) from a CDF (binary search, so millions of triangles cost a log2 of them), or, from
-// kEmitterTreeFrom triangles on, by its expected contribution at the shading point through a
+// kEmitterTreeFrom triangles spread over the scene, by its expected contribution at the shading
+// point (and its normal) through a
 // light tree over them (lights/light_tree.h, the lamps' tree built from the triangles' bounds:
 // near ones and ones facing the point are chosen more); then, close
 // to it (its longest edge longer than the point's height over its plane, Cycles' rule), a
@@ -30,15 +31,21 @@
 
 namespace toyrt {
 
-// Scenes with at least this many sampled emissive triangles pick them through a light tree, the
-// others by the power CDF: measured in docs/lights.md ("Emissive triangles through the light tree").
-inline constexpr size_t kEmitterTreeFrom = 64;
-// ... and whose box spans at least this share of the scene's diagonal: one compact emitter (a
-// glowing ball of any triangle count) keeps the CDF, which is near the best choice for it and
-// costs a tenth of the tree's walk (docs/lights.md measures both cases).
+// Scenes with at least this many sampled emissive triangles, whose box spans at least
+// kEmitterTreeSpread of the scene's diagonal, pick them through a light tree; the others by the
+// power CDF. Measured in docs/lights.md ("Emissive triangles through the light tree",
+// bench_emitters): small quads spread over a room's ceiling render with 4 to 6.6x less error at
+// equal time through the tree from 18 to 2,048 triangles (1.2x at 8, 1.7 to 2.4x at 8k-33k); one
+// compact emitter (a ball of 12 to 65,000 triangles over a floor) renders with 1.5 to 2.3x more
+// error at equal time through it at every count: its CDF is near the best choice, and the tree's
+// walk costs 10x the CDF's binary search. Hence a low count and a spread test: the share is a
+// choice between the two measured cases (the ceiling spans 1.0 of its scene, the ball 0.06).
+inline constexpr size_t kEmitterTreeFrom = 16;
 inline constexpr float kEmitterTreeSpread = 0.25f;
-// Triangles per leaf of their tree: measured in docs/lights.md (as the lamps' LightTree::kLeafSize).
-inline constexpr uint32_t kEmitterLeafSize = 1;
+// Triangles per leaf of their tree: measured in docs/lights.md. Unlike lamps (LightTree::kLeafSize
+// 8), larger leaves gain no variance on triangles and cost a longer exact walk (8: 1.6x the time
+// of a pick); 2 is as fast as 1 with half the nodes.
+inline constexpr uint32_t kEmitterLeafSize = 2;
 
 enum class EmitterSides : uint8_t { Both = 3, Front = 1, Back = 2 };
 
