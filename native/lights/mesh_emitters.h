@@ -34,16 +34,16 @@ namespace toyrt {
 // Scenes with at least this many sampled emissive triangles, whose box spans at least
 // kEmitterTreeSpread of the scene's diagonal, pick them through a light tree; the others by the
 // power CDF. Measured in docs/lights.md ("Emissive triangles through the light tree",
-// bench_emitters): small quads spread over a room's ceiling render with 4 to 6.6x less error at
-// equal time through the tree from 18 to 2,048 triangles (1.2x at 8, 1.7 to 2.4x at 8k-33k); one
-// compact emitter (a ball of 12 to 65,000 triangles over a floor) renders with 1.5 to 2.3x more
+// bench_emitters): small quads spread over a room's ceiling render with 3.6 to 5.8x less error at
+// equal time through the tree from 18 to 2,048 triangles (0.94x at 8, 1.7 to 2.5x at 8k-33k); one
+// compact emitter (a ball of 12 to 65,000 triangles over a floor) renders with 1.4 to 2.2x more
 // error at equal time through it at every count: its CDF is near the best choice, and the tree's
 // walk costs 10x the CDF's binary search. Hence a low count and a spread test: the share is a
 // choice between the two measured cases (the ceiling spans 1.0 of its scene, the ball 0.06).
 inline constexpr size_t kEmitterTreeFrom = 16;
 inline constexpr float kEmitterTreeSpread = 0.25f;
 // Triangles per leaf of their tree: measured in docs/lights.md. Unlike lamps (LightTree::kLeafSize
-// 8), larger leaves gain no variance on triangles and cost a longer exact walk (8: 1.6x the time
+// 8), larger leaves gain no variance on triangles and cost a longer exact walk (8: 2.2x the time
 // of a pick); 2 is as fast as 1 with half the nodes.
 inline constexpr uint32_t kEmitterLeafSize = 2;
 
