@@ -1,4 +1,5 @@
 #include "lights/light_tree.h"
+#include "lights/mesh_emitters.h"
 
 #include <algorithm>
 #include <array>
@@ -19,6 +20,9 @@ constexpr float kBoundShare = 0.02f;
 [[gnu::noinline]] float importance_of(const Light& light, const Vec3& p, const Vec3& n) {
   return light_importance(light, p, n);
 }
+[[gnu::noinline]] float importance_of(const EmissiveTriangle& triangle, const Vec3& p, const Vec3& n) {
+  return importance(triangle, p, n);
+}
 
 // cos(max(0, theta - a)) from theta's cosine and sine and a's, a in [0, pi].
 float cos_minus_clamped(float cos_t, float sin_t, float cos_a, float sin_a) {
@@ -27,24 +31,43 @@ float cos_minus_clamped(float cos_t, float sin_t, float cos_a, float sin_a) {
 
 // The cosine of the half-angle theta_u of the cone from p around `to_centre` (unit) that holds
 // the box: the widest of its eight corners (Cycles, kernel/light/tree.h, does the same). Tighter
-// than the bounding sphere's for the flat, wide clusters of lights over a floor.
-float cos_subtended(const LightTreeNode& c, const Vec3& p, const Vec3& to_centre) {
-  float cos_u = 1.0f;
-  for (int k = 0; k < 8; ++k) {
-    const Vec3 corner((k & 1) ? c.hi.x : c.lo.x, (k & 2) ? c.hi.y : c.lo.y, (k & 4) ? c.hi.z : c.lo.z);
-    const Vec3 w = corner - p;
-    cos_u = std::min(cos_u, glm::dot(to_centre, w) / glm::length(w));
+// than the bounding sphere's for the flat, wide clusters of lights over a floor. Given `hull`
+// (points whose convex hull holds every emitting point: a triangle's vertices), the widest of them.
+float cos_subtended(const LightTreeNode& c, const Vec3& p, const Vec3& to_centre, const Vec3* hull, int hull_count) {
+  // The smallest cosine dot(to_centre, w) / |w| over the points w - p, compared without a square
+  // root or a division per point: as c |c| = dot |dot| / |w|^2 (monotonic in c), cross-multiplied.
+  // One square root at the end; this loop is most of a cluster's cost.
+  float num = 1.0f, den = 1.0f;  // c |c| = num / den, den > 0
+  const auto consider = [&](const Vec3& point) {
+    const Vec3 w = point - p;
+    const float dot = glm::dot(to_centre, w), w2 = glm::dot(w, w);
+    const float n = dot * std::fabs(dot);
+    if (n * den < num * w2) {
+      num = n;
+      den = w2;
+    }
+  };
+  if (hull) {
+    for (int k = 0; k < hull_count; ++k) consider(hull[k]);
+  } else {
+    for (int k = 0; k < 8; ++k)
+      consider(Vec3((k & 1) ? c.hi.x : c.lo.x, (k & 2) ? c.hi.y : c.lo.y, (k & 4) ? c.hi.z : c.lo.z));
   }
-  return std::max(cos_u, -1.0f);
+  if (!(den > 0.0f)) return -1.0f;  // p on a corner: no angle is bounded
+  const float cos_u = std::copysign(std::sqrt(std::fabs(num) / den), num);
+  return std::clamp(cos_u, -1.0f, 1.0f);
 }
+
+}  // namespace
 
 // The cluster's importance at p with normal n (n = 0: no receiver cosine): power / distance^2,
 // times the emitter's cosine bound (theta' = theta - theta_o - theta_u against theta_e, Conty
 // Estevez and Kulla 2018, eq. 3) and a receiver's cosine, theta_u the half-angle the box subtends
 // from p. Zero only where no light in the box can reach p: the box lies wholly below p's tangent
 // plane (Cycles' test), every normal turns away, or the receiver's bound cos(theta_i - theta_u)
-// is negative. Inside the box no angle is bounded.
-float cluster_importance(const LightTreeNode& c, const Vec3& p, const Vec3& n) {
+// is negative, or p is behind every emitter of a one-sided cluster. Inside the box no angle is
+// bounded.
+float cluster_importance(const LightTreeNode& c, const Vec3& p, const Vec3& n, const Vec3* hull, int hull_count) {
   const Vec3 centre = 0.5f * c.lo + 0.5f * c.hi;
   const Vec3 half = 0.5f * c.hi - 0.5f * c.lo;
   const Vec3 v = p - centre;  // from the cluster to the point
@@ -64,10 +87,22 @@ float cluster_importance(const LightTreeNode& c, const Vec3& p, const Vec3& n) {
     const float reach = glm::dot(glm::abs(n), half) - glm::dot(n, v);
     if (reach < -kMargin * n_length * (d + std::sqrt(r2))) return 0.0f;
   }
+  // The emitters' horizon: lights that emit only into the half-space in front of them (theta_e
+  // <= pi / 2) and nearly share a normal (theta_o < pi / 2) reach p only if it is in front of
+  // some point of the box, by a normal within theta_o of the axis (|m - axis| <= 2 sin(theta_o / 2)).
+  // A flat one-sided emitter mesh seen from behind weighs zero here instead of being entered and
+  // found dark at every leaf (a dead end: no light chosen).
+  // (cos_e of theta_e = pi / 2 in floats is -4e-8: still a hemisphere.)
+  if (c.cos_e >= -1e-6f && c.cos_o > 0.0f) {
+    const float reach_bound = d + std::sqrt(r2);
+    const float front = glm::dot(c.axis, v) + glm::dot(glm::abs(c.axis), half) +
+                        std::sqrt(std::max(0.0f, 2.0f * (1.0f - c.cos_o))) * reach_bound;
+    if (front < -kMargin * reach_bound) return 0.0f;
+  }
   const bool inside =
       p.x >= c.lo.x && p.y >= c.lo.y && p.z >= c.lo.z && p.x <= c.hi.x && p.y <= c.hi.y && p.z <= c.hi.z;
   if (inside || !(d > 0.0f)) return c.power / falloff;
-  const float cos_u = cos_subtended(c, p, -v / d);
+  const float cos_u = cos_subtended(c, p, -v / d, hull, hull_count);
   const float sin_u = std::sqrt(std::max(0.0f, 1.0f - cos_u * cos_u));
   float emit = 1.0f;
   // theta_o + theta_u >= pi (a point light's cluster): some normal faces p whatever the angle.
@@ -95,6 +130,8 @@ float cluster_importance(const LightTreeNode& c, const Vec3& p, const Vec3& n) {
   }
   return c.power * emit * receive / falloff;
 }
+
+namespace {
 
 // ---- the build: binned, by Conty Estevez and Kulla's surface area orientation heuristic.
 
@@ -262,10 +299,21 @@ struct Builder {
 
 }  // namespace
 
-LightTree::LightTree(const std::vector<Light>& lights, uint32_t leaf_size) : leaf_of_(lights.size(), -1) {
+LightTree::LightTree(const std::vector<Light>& lights, uint32_t leaf_size) {
+  std::vector<LightBounds> bounds;
+  bounds.reserve(lights.size());
+  for (const Light& light : lights) bounds.push_back(light_bounds(light));
+  build(bounds, leaf_size);
+}
+
+LightTree::LightTree(const std::vector<LightBounds>& bounds, uint32_t leaf_size) { build(bounds, leaf_size); }
+
+void LightTree::build(const std::vector<LightBounds>& bounds, uint32_t leaf_size) {
+  leaf_of_.assign(bounds.size(), -1);
   std::vector<Item> items;
-  for (uint32_t i = 0; i < lights.size(); ++i) {
-    const LightBounds b = light_bounds(lights[i]);
+  items.reserve(bounds.size());
+  for (uint32_t i = 0; i < bounds.size(); ++i) {
+    const LightBounds& b = bounds[i];
     if (b.distant) {
       distant_.push_back(i);
       continue;
@@ -285,6 +333,9 @@ LightTree::LightTree(const std::vector<Light>& lights, uint32_t leaf_size) : lea
   Builder builder{nodes_, parent_, std::max(leaf_size, 1u)};
   builder.build(items, 0, items.size(), 0, 0);
   depth_ = builder.max_depth;
+  // Reserved for leaves of one; larger leaves use a fraction (half the memory at 2 a leaf).
+  nodes_.shrink_to_fit();
+  parent_.shrink_to_fit();
   order_.resize(items.size());
   for (size_t i = 0; i < items.size(); ++i) order_[i] = items[i].light;
   for (size_t k = 0; k < nodes_.size(); ++k)
@@ -300,7 +351,8 @@ size_t LightTree::memory_bytes() const {
 
 // Out of line, and the only place the weights are computed, so select() and probability() divide
 // the very same floats (an inlined copy could be contracted into different FMAs).
-[[gnu::noinline]] LightTree::Weights LightTree::top_weights(const Light* lights, const Vec3& p, const Vec3& n) const {
+template <class T>
+[[gnu::noinline]] LightTree::Weights LightTree::top_weights(const T* lights, const Vec3& p, const Vec3& n) const {
   Weights w{0.0f, 0.0f};
   if (!nodes_.empty()) {
     const LightTreeNode& root = nodes_[0];
@@ -310,7 +362,8 @@ size_t LightTree::memory_bytes() const {
   return w;
 }
 
-[[gnu::noinline]] LightTree::Weights LightTree::child_weights(const Light* lights, int32_t node, const Vec3& p,
+template <class T>
+[[gnu::noinline]] LightTree::Weights LightTree::child_weights(const T* lights, int32_t node, const Vec3& p,
                                                               const Vec3& n) const {
   const int32_t first = nodes_[size_t(node)].child;
   const LightTreeNode& a = nodes_[size_t(first)];
@@ -319,7 +372,8 @@ size_t LightTree::memory_bytes() const {
 }
 
 // A cluster's bound, or a leaf's exact sum, in order_'s order (the pick's running sum repeats it).
-[[gnu::noinline]] float LightTree::weight(const Light* lights, const LightTreeNode& node, const Vec3& p,
+template <class T>
+[[gnu::noinline]] float LightTree::weight(const T* lights, const LightTreeNode& node, const Vec3& p,
                                           const Vec3& n) const {
   if (!node.leaf()) return cluster_importance(node, p, n);
   float sum = 0.0f;
@@ -334,24 +388,29 @@ float rescale(float u, float lo, float width) { return std::min((u - lo) / width
 // The linear selector's pick among lights ids[0, count), whose importances sum to `total` in this
 // order (so the running sum ends at exactly `total`; u * total rounding up to it keeps the last
 // candidate), the probability scaled by that of reaching them.
-LightSelection pick_among(const Light* lights, const uint32_t* ids, size_t count, float total, float u, float scale,
+template <class T>
+LightSelection pick_among(const T* lights, const uint32_t* ids, size_t count, float total, float u, float scale,
                           const Vec3& p, const Vec3& n) {
   LightSelection chosen;
   const float target = u * total;
-  float running = 0.0f;
+  float running = 0.0f, before = 0.0f, chosen_w = 0.0f;
   for (size_t i = 0; i < count; ++i) {
     const float w = importance_of(lights[ids[i]], p, n);
     if (w <= 0.0f) continue;
+    before = running;
     running += w;
     chosen.index = int32_t(ids[i]);
     chosen.probability = scale * (w / total);
+    chosen_w = w;
     if (target < running) break;
   }
+  if (chosen_w > 0.0f) chosen.remainder = std::clamp((target - before) / chosen_w, 0.0f, 0x1.fffffep-1f);
   return chosen;
 }
 }  // namespace
 
-LightSelection LightTree::select(const Light* lights, const Vec3& p, const Vec3& n, float u) const {
+template <class T>
+LightSelection LightTree::select_in(const T* lights, const Vec3& p, const Vec3& n, float u) const {
   LightSelection chosen;
   const Weights top = top_weights(lights, p, n);
   const float total = top.first + top.second;
@@ -384,7 +443,8 @@ LightSelection LightTree::select(const Light* lights, const Vec3& p, const Vec3&
   return pick_among(lights, order_.data() + leaf.first(), leaf.count, weight(lights, leaf, p, n), u, probability, p, n);
 }
 
-float LightTree::probability(const Light* lights, const Vec3& p, const Vec3& n, size_t index) const {
+template <class T>
+float LightTree::probability_in(const T* lights, const Vec3& p, const Vec3& n, size_t index) const {
   if (index >= leaf_of_.size()) return 0.0f;
   const Weights top = top_weights(lights, p, n);
   const float total = top.first + top.second;
@@ -408,6 +468,19 @@ float LightTree::probability(const Light* lights, const Vec3& p, const Vec3& n, 
   }
   const float w = importance_of(lights[index], p, n);
   return w > 0.0f ? probability * (w / weight(lights, nodes_[size_t(leaf)], p, n)) : 0.0f;
+}
+
+LightSelection LightTree::select(const Light* lights, const Vec3& p, const Vec3& n, float u) const {
+  return select_in(lights, p, n, u);
+}
+float LightTree::probability(const Light* lights, const Vec3& p, const Vec3& n, size_t index) const {
+  return probability_in(lights, p, n, index);
+}
+LightSelection LightTree::select(const EmissiveTriangle* triangles, const Vec3& p, const Vec3& n, float u) const {
+  return select_in(triangles, p, n, u);
+}
+float LightTree::probability(const EmissiveTriangle* triangles, const Vec3& p, const Vec3& n, size_t index) const {
+  return probability_in(triangles, p, n, index);
 }
 
 }  // namespace toyrt

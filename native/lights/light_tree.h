@@ -16,7 +16,12 @@
 // Lights at infinity (suns) have no box: they are chosen among themselves by importance(),
 // against the tree's root.
 //
-// Built once per commit by the scene (Scene::light_tree). Flat arrays, no allocation per call.
+// The same tree serves the scene's emissive triangles (lights/mesh_emitters.h): built from their
+// LightBounds, walked with their own importance() at the leaves. select() and probability() come
+// in one overload per kind of primitive, each the same template (light_tree.cpp).
+//
+// Built once per commit by the scene (Scene::light_tree, MeshEmitters::finish). Flat arrays, no
+// allocation per call.
 #pragma once
 
 #include "lights/light.h"
@@ -26,6 +31,8 @@
 #include <vector>
 
 namespace toyrt {
+
+struct EmissiveTriangle;  // lights/mesh_emitters.h
 
 // A cluster, 64 bytes. The box bounds the angle it subtends (theta_u) and the receiver's horizon.
 struct LightTreeNode {
@@ -51,10 +58,14 @@ class LightTree {
 
   LightTree() = default;
   explicit LightTree(const std::vector<Light>& lights, uint32_t leaf_size = kLeafSize);
+  // Over any primitives by their bounds, in the order select() returns their indices.
+  explicit LightTree(const std::vector<LightBounds>& bounds, uint32_t leaf_size = kLeafSize);
 
-  // `lights` must be the ones the tree was built from.
+  // `lights` (or `triangles`) must be the ones the tree was built from.
   LightSelection select(const Light* lights, const Vec3& p, const Vec3& n, float u) const;
   float probability(const Light* lights, const Vec3& p, const Vec3& n, size_t index) const;
+  LightSelection select(const EmissiveTriangle* triangles, const Vec3& p, const Vec3& n, float u) const;
+  float probability(const EmissiveTriangle* triangles, const Vec3& p, const Vec3& n, size_t index) const;
 
   size_t light_count() const { return leaf_of_.size(); }
   size_t node_count() const { return nodes_.size(); }
@@ -65,9 +76,18 @@ class LightTree {
   struct Weights {
     float first, second;
   };
-  Weights top_weights(const Light* lights, const Vec3& p, const Vec3& n) const;
-  Weights child_weights(const Light* lights, int32_t node, const Vec3& p, const Vec3& n) const;
-  float weight(const Light* lights, const LightTreeNode& node, const Vec3& p, const Vec3& n) const;
+  void build(const std::vector<LightBounds>& bounds, uint32_t leaf_size);
+  // T: Light or EmissiveTriangle (instantiated in light_tree.cpp).
+  template <class T>
+  LightSelection select_in(const T* items, const Vec3& p, const Vec3& n, float u) const;
+  template <class T>
+  float probability_in(const T* items, const Vec3& p, const Vec3& n, size_t index) const;
+  template <class T>
+  Weights top_weights(const T* items, const Vec3& p, const Vec3& n) const;
+  template <class T>
+  Weights child_weights(const T* items, int32_t node, const Vec3& p, const Vec3& n) const;
+  template <class T>
+  float weight(const T* items, const LightTreeNode& node, const Vec3& p, const Vec3& n) const;
 
   std::vector<LightTreeNode> nodes_;  // nodes_[0]: the root over the local lights, if any
   std::vector<int32_t> parent_;       // per node; -1 for the root
@@ -76,5 +96,13 @@ class LightTree {
   std::vector<uint32_t> distant_;     // the lights at infinity
   int depth_ = 0;
 };
+
+// The importance at p (normal n; 0: no receiver cosine) of every light a node bounds, as the tree
+// weighs an inner node: zero only where none of them can reach p. Emissive triangles weigh
+// themselves by it too (mesh_emitters.cpp), as a node of one whose `hull` (its three vertices:
+// points whose convex hull holds every emitting point) bounds the angle it subtends from p more
+// tightly and more cheaply than the box's eight corners.
+float cluster_importance(const LightTreeNode& node, const Vec3& p, const Vec3& n, const Vec3* hull = nullptr,
+                         int hull_count = 0);
 
 }  // namespace toyrt

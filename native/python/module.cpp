@@ -360,6 +360,7 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
           "last_commit", &PyScene::last_commit,
           "What the last commit did: build_ms, lbvh_compile_ms (OpenCL compilation, first LBVH build of\n"
           "the process only), meshes_built, sah_meshes, lbvh_meshes, emissive_triangles, emitters_ms,\n"
+          "emitter_tree_nodes (0: emissive triangles chosen by power, too few for a tree),\n"
           "light_tree_nodes (0: no light tree, too few lights to pay for one), light_tree_ms, warning.")
       .def("intersect", &PyScene::intersect, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0f,
            py::arg("tfar") = std::numeric_limits<float>::infinity(), py::arg("threads") = 0, py::arg("normals") = false,

@@ -238,6 +238,7 @@ py::dict PyScene::last_commit() {
   d["lbvh_meshes"] = st.lbvh_meshes;
   d["emissive_triangles"] = st.emissive_triangles;
   d["emitters_ms"] = st.emitters_ms;
+  d["emitter_tree_nodes"] = st.emitter_tree_nodes;
   d["light_tree_nodes"] = st.light_tree_nodes;
   d["light_tree_ms"] = st.light_tree_ms;
   d["warning"] = st.warning;

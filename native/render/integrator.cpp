@@ -135,24 +135,6 @@ template <bool kBurley>
   return sum;
 }
 
-// The emissive triangle a hit found, in world space as the scene gathers them (scene_emitters.cpp).
-EmissiveTriangle emissive_triangle_at(const Scene& scene, const Hit& hit, const MaterialEmission& e) {
-  const Instance& inst = scene.instance(uint32_t(hit.instance));
-  const Mesh& mesh = scene.mesh(inst.mesh);
-  const Triangle& tri = mesh.triangles()[size_t(hit.prim)];
-  const auto world = [&](uint32_t v) { return Vec3(inst.to_world * glm::vec4(mesh.vertices()[v], 1.0f)); };
-  EmissiveTriangle t;
-  t.p0 = world(tri.x);
-  t.e1 = world(tri.y) - t.p0;
-  t.e2 = world(tri.z) - t.p0;
-  const Vec3 n = glm::cross(t.e1, t.e2);
-  t.area = 0.5f * glm::length(n);
-  t.normal = t.area > 0.0f ? n / (2.0f * t.area) : Vec3(0.0f);
-  t.radiance = e.radiance;
-  t.sides = e.sampled ? e.sides : EmitterSides(0);
-  return t;
-}
-
 // Emissive meshes, by two strategies combined with the power heuristic, as Cycles combines its
 // light sampling with the BSDF-sampled ray of the last bounce: a shadow ray to one emissive
 // triangle chosen by power, and one cosine ray that collects the emission it hits. The cosine ray wins beside a large
@@ -165,8 +147,9 @@ template <bool kBurley>
   const MeshEmitters& emitters = scene.emitters();
   Vec3 sum(0.0f);
   if (!emitters.empty()) {
-    const LightSample ls = sample_emitters(
-        emitters, p, sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 3), settings.seed));
+    const LightSample ls =
+        sample_emitters(emitters, p, at.ns,
+                        sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 3), settings.seed));
     if (ls.valid()) {
       const float cos_s = glm::dot(at.ns, ls.wi);
       Vec3 tr(1.0f);
@@ -187,8 +170,13 @@ template <bool kBurley>
   const int32_t m = hit.found() ? material_of(scene, hit) : -1;
   if (m < 0 || size_t(m) >= scene.emission().size() || !scene.emission()[size_t(m)].emits()) return sum;
   const MaterialEmission& e = scene.emission()[size_t(m)];
-  const EmissiveTriangle t = emissive_triangle_at(scene, hit, e);
-  const float pl = emitter_pdf(emitters, p, t, wi, glm::dot(t.p0 + hit.u * t.e1 + hit.v * t.e2 - p, wi));
+  // Not among the sampled triangles (emission sampling None): the cosine ray alone finds it.
+  const int64_t index = emitters.index_of(uint64_t(uint32_t(hit.instance)) << 32 | uint64_t(uint32_t(hit.prim)));
+  float pl = 0.0f;
+  if (index >= 0) {
+    const EmissiveTriangle& t = emitters.triangles[size_t(index)];
+    pl = emitter_pdf(emitters, p, at.ns, size_t(index), wi, glm::dot(t.p0 + hit.u * t.e1 + hit.v * t.e2 - p, wi));
+  }
   return sum + diffuse_f<kBurley>(at, retro, wi) * e.radiance * tr * mis_cos_over_pdf(c.cos, c.cos * kInvPi, pl);
 }
 

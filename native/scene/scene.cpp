@@ -332,6 +332,7 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
   const auto gather_start = std::chrono::steady_clock::now();
   gather_emitters();
   stats_.emissive_triangles = emitters_.triangles.size();
+  stats_.emitter_tree_nodes = emitters_.tree.node_count();
   stats_.emitters_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - gather_start).count();
   if (!light_tree_current_) {
@@ -475,7 +476,7 @@ size_t Scene::memory_bytes() const {
   for (const Texture& t : textures_) bytes += t.texels.capacity() * sizeof(float);
   const Distribution2D& grid = world_.environment.sampling;
   bytes += (grid.conditional.capacity() + grid.marginal.capacity() + grid.density.capacity()) * sizeof(float);
-  bytes += emitters_.triangles.capacity() * sizeof(EmissiveTriangle) + emitters_.cdf.capacity() * sizeof(float);
+  bytes += emitters_.memory_bytes();  // with their tree
   bytes += materials_.capacity() * sizeof(Material) + emission_.capacity() * sizeof(MaterialEmission) +
            normal_maps_.capacity() * sizeof(MaterialNormalMap) + mixes_.capacity() * sizeof(MaterialMix) +
            transparency_.capacity() * sizeof(MaterialTransparency) + world_.lights.capacity() * sizeof(Light);

@@ -48,7 +48,8 @@ struct CommitStats {
   size_t meshes_built = 0;       // meshes whose BVH the last commit (re)built
   size_t sah_meshes = 0, lbvh_meshes = 0;
   size_t emissive_triangles = 0;  // sampled as lights (world space, each instance's counted)
-  double emitters_ms = 0.0;       // gathering them, part of build_ms
+  double emitters_ms = 0.0;       // gathering them (and their light tree), part of build_ms
+  size_t emitter_tree_nodes = 0;  // 0: no tree over them (fewer than kEmitterTreeFrom)
   size_t light_tree_nodes = 0;    // 0: no tree (kLightTreeFrom lights or fewer)
   double light_tree_ms = 0.0;     // building it (only when the lights changed), part of build_ms
   // Set when an LBVH build could not run (no OpenCL device, kernel build failure) and the SAH
@@ -205,6 +206,13 @@ class Scene {
   // blocker sets `blockers` (light linking).
   Hit intersect_shadow_casters(const Ray& ray, uint64_t blockers = kAllLightSets) const;
   const MeshEmitters& emitters() const { return emitters_; }  // the sampled emissive triangles, by commit()
+  // From how many sampled emissive triangles, spanning what share of the scene's diagonal, the
+  // next commits pick them through a light tree (kEmitterTreeFrom, kEmitterTreeSpread; benchmarks
+  // set them to compare the tree with the power CDF).
+  void set_emitter_tree_from(size_t triangles, float spread = kEmitterTreeSpread) {
+    emitter_tree_from_ = triangles;
+    emitter_tree_spread_ = spread;
+  }
   const World& world() const { return world_; }
   // The tree the render selects lights with: built by commit() over more than kLightTreeFrom
   // lights; null for fewer, and for lights edited since the last commit (they are selected
@@ -241,6 +249,8 @@ class Scene {
   std::vector<MaterialMix> mixes_;  // parallel to materials_
   bool any_mix_ = false;
   MeshEmitters emitters_;
+  size_t emitter_tree_from_ = kEmitterTreeFrom;
+  float emitter_tree_spread_ = kEmitterTreeSpread;
   std::vector<Texture> textures_;
   World world_;
   LightTree light_tree_;             // over world_.lights when light_tree_current_

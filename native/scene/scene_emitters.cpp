@@ -2,6 +2,7 @@
 #include "scene/scene.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace toyrt {
 
@@ -10,7 +11,8 @@ void Scene::gather_emitters() {
   if (std::none_of(emission_.begin(), emission_.end(),
                    [](const MaterialEmission& e) { return e.emits() && e.sampled; }))
     return;  // a scene without sampled emitters pays nothing here
-  for (const Instance& inst : instances_) {
+  for (size_t i = 0; i < instances_.size(); ++i) {
+    const Instance& inst = instances_[i];
     const Mesh& mesh = *meshes_[inst.mesh];
     const MeshShading& sh = shading_[inst.mesh];
     const std::vector<Vec3>& v = mesh.vertices();
@@ -35,10 +37,17 @@ void Scene::gather_emitters() {
       et.normal = n / (2.0f * et.area);
       et.radiance = e.radiance;
       et.sides = e.sides;
-      emitters_.add(et);
+      emitters_.add(et, uint64_t(i) << 32 | uint64_t(t));  // ascending: index_of() finds hits by it
     }
   }
-  emitters_.finish();
+  // The scene's extent, for the tree's spread test (top_ is built before the emitters are gathered).
+  float diagonal = 0.0f;
+  if (!top_.nodes.empty()) {
+    const float* b = top_.nodes[0].bounds;
+    diagonal = glm::length(Vec3(b[3] - b[0], b[4] - b[1], b[5] - b[2]));
+  }
+  emitters_.finish(emitter_tree_from_, kEmitterLeafSize,
+                   std::isfinite(diagonal) ? emitter_tree_spread_ * diagonal : 0.0f);
 }
 
 }  // namespace toyrt

@@ -330,8 +330,8 @@ TEST(LightTree, BuildsOnNoneOneTwoAndCoincidentLights) {
   const Vec3 p(0.0f), n(0, 0, 1);
   const LightTree none{std::vector<Light>{}};
   EXPECT_EQ(none.node_count(), 0u);
-  EXPECT_FALSE(none.select(nullptr, p, n, 0.5f).found());
-  EXPECT_EQ(none.probability(nullptr, p, n, 0), 0.0f);
+  EXPECT_FALSE(none.select(static_cast<const Light*>(nullptr), p, n, 0.5f).found());
+  EXPECT_EQ(none.probability(static_cast<const Light*>(nullptr), p, n, 0), 0.0f);
 
   const std::vector<Light> one = {PointLight::make(Vec3(0, 0, 1), 10.0f, Vec3(1.0f))};
   const LightTree tree_one(one);

@@ -324,7 +324,7 @@ TEST(SphericalTriangle, AFloorPointBesideAGlowingTriangleGetsItsIrradianceWithLi
   emitters.finish();
   const Vec3 n = glm::normalize(Vec3(-0.2f, 0.0f, 1.0f));
   const Estimate e = monte_carlo(20000, [&](uint32_t i) {
-    const LightSample s = sample_emitters(emitters, Vec3(0.0f), rand2(i, 32));
+    const LightSample s = sample_emitters(emitters, Vec3(0.0f), n, rand2(i, 32));
     return s.valid() ? double(s.radiance.x) * std::max(0.0f, glm::dot(n, s.wi)) / s.pdf : 0.0;
   });
   // Each sample is L cos_receiver / (1 / Omega) <= L Omega: a relative standard error of well

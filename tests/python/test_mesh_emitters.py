@@ -49,6 +49,24 @@ def test_an_emissive_square_lights_the_point_below_with_pi_L_F(triangles):
     assert got == pytest.approx(expected, rel=0.01)
 
 
+def test_a_wide_emissive_ceiling_is_picked_through_the_light_tree_with_the_same_closed_form():
+    # A 30 m square of 3,200 triangles 0.5 m over the 40 m floor spans most of the scene: the
+    # commit builds the emitter tree (docs/lights.md), and the point below still gets pi L F.
+    L, a, h = 2.0, 30.0, 0.5
+    s = toyrt.Scene()
+    s.add_material("diffuse", color=(1.0, 1.0, 1.0))
+    s.add_material("diffuse", color=(0.0, 0.0, 0.0), emission=(L, L, L))
+    fv, ft = grid(1, 40.0, 0.0)
+    s.add_mesh(fv, ft, material_ids=0)
+    ev, et = grid(40, a, h)
+    s.add_mesh(ev, et, material_ids=1)
+    s.commit()
+    assert s.last_commit["emissive_triangles"] == 3200
+    assert s.last_commit["emitter_tree_nodes"] > 0
+    got = s.render(camera_above(height=0.25, size=0.002, resolution=2), samples=1024)[..., 0].mean()
+    assert got == pytest.approx(L * square_irradiance_over_radiance(a, h) / np.pi, rel=0.01)
+
+
 def test_the_camera_sees_colour_times_strength_on_both_sides():
     for flip in (False, True):
         s = toyrt.Scene()
@@ -104,5 +122,6 @@ def test_a_mesh_without_material_ids_is_default_grey_and_emits_nothing():
     s.add_mesh(ev, et)                                    # no material ids
     s.commit()
     assert s.last_commit["emissive_triangles"] == 0
+    assert s.last_commit["emitter_tree_nodes"] == 0
     img = s.render(camera_above(height=0.25, size=0.002, resolution=2), samples=16)
     assert not img[..., :3].any()
