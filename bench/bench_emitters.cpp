@@ -29,16 +29,9 @@
 
 using namespace toyrt;
 using namespace toyrt::testing;
+using namespace toyrt::bench;
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 struct Grid {
   std::vector<Vec3> vertices;

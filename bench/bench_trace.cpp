@@ -66,10 +66,6 @@ double ms_of(const std::function<void()>& f) {
   f();
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
 Timing interleaved(int runs, const std::function<void()>& a, const std::function<void()>& b) {
   a();  // warm: first-touch page faults, the thread pool, each engine's first build
   b();

@@ -35,6 +35,15 @@ inline double best_ms(int runs, const std::function<void()>& f) {
   return best;
 }
 
+using Clock = std::chrono::steady_clock;
+inline double ms_since(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+inline double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
 inline std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");
   std::string line;
