@@ -2,9 +2,9 @@
 
 namespace toyrt {
 
-LightSelection LightSelector::select_linear(const Vec3& p, const Vec3& n, float u) const {
+LightSelection LightSelector::select_linear(const Vec3& p, const Vec3& n, float u, uint8_t set) const {
   float total = 0.0f;
-  for (size_t i = 0; i < count; ++i) total += light_importance(lights[i], p, n);
+  for (size_t i = 0; i < count; ++i) total += weight(i, p, n, set);
   LightSelection chosen;
   if (!(total > 0.0f)) return chosen;
   // The second pass repeats the first pass's sums in the same order, so the running sum ends at
@@ -12,7 +12,7 @@ LightSelection LightSelector::select_linear(const Vec3& p, const Vec3& n, float 
   const float target = u * total;
   float running = 0.0f;
   for (size_t i = 0; i < count; ++i) {
-    const float w = light_importance(lights[i], p, n);
+    const float w = weight(i, p, n, set);
     if (w <= 0.0f) continue;
     running += w;
     chosen.index = int32_t(i);
@@ -22,11 +22,11 @@ LightSelection LightSelector::select_linear(const Vec3& p, const Vec3& n, float 
   return chosen;
 }
 
-float LightSelector::probability_linear(const Vec3& p, const Vec3& n, size_t index) const {
+float LightSelector::probability_linear(const Vec3& p, const Vec3& n, size_t index, uint8_t set) const {
   if (index >= count) return 0.0f;
   float total = 0.0f;
-  for (size_t i = 0; i < count; ++i) total += light_importance(lights[i], p, n);
-  return total > 0.0f ? light_importance(lights[index], p, n) / total : 0.0f;
+  for (size_t i = 0; i < count; ++i) total += weight(i, p, n, set);
+  return total > 0.0f ? weight(index, p, n, set) / total : 0.0f;
 }
 
 }  // namespace toyrt

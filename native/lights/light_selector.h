@@ -8,9 +8,12 @@
 // It walks all lights twice per call (sum, then the pick), with no allocation: the cheapest for
 // a few lights. Given the scene's light tree (lights/light_tree.h, built at commit for more than
 // kLightTreeFrom lights) it asks the tree instead: O(log lights) per call, behind the same two calls.
+// Given the lights' receiver sets (light linking), both leave out the lights that do not light
+// the receiver's set, as Cycles does, instead of picking them for a zero contribution.
 #pragma once
 
 #include "lights/light.h"
+#include "lights/light_linking.h"
 #include "lights/light_selection.h"
 #include "lights/light_tree.h"
 
@@ -30,23 +33,33 @@ struct LightSelector {
   const Light* lights = nullptr;  // not owned: the scene's lights, which must outlive the selector
   size_t count = 0;
   const LightTree* tree = nullptr;  // built over exactly these lights, or null: the linear walk
+  // Per light, the receiver sets it lights (lights/light_linking.h), or null: every light lights
+  // every receiver. A tree given with these must have been given the same (set_receiver_sets).
+  const uint64_t* sets = nullptr;
 
   LightSelector() = default;
-  explicit LightSelector(const std::vector<Light>& all, const LightTree* over_all = nullptr)
-      : lights(all.data()), count(all.size()), tree(over_all) {}
+  explicit LightSelector(const std::vector<Light>& all, const LightTree* over_all = nullptr,
+                         const uint64_t* receiver_sets = nullptr)
+      : lights(all.data()), count(all.size()), tree(over_all), sets(receiver_sets) {}
 
-  // The light for uniform number u in [0, 1) at point p with normal n (n = 0: no cosine bound).
-  LightSelection select(const Vec3& p, const Vec3& n, float u) const {
-    return tree ? tree->select(lights, p, n, u) : select_linear(p, n, u);
+  // The light for uniform number u in [0, 1) at point p with normal n (n = 0: no cosine bound),
+  // of a receiver in light-linking set `set`.
+  LightSelection select(const Vec3& p, const Vec3& n, float u, uint8_t set = 0) const {
+    return tree ? tree->select(lights, p, n, u, set) : select_linear(p, n, u, set);
   }
   // The probability that select() picks `index` at (p, n), e.g. for multiple importance sampling.
-  float probability(const Vec3& p, const Vec3& n, size_t index) const {
-    return tree ? tree->probability(lights, p, n, index) : probability_linear(p, n, index);
+  float probability(const Vec3& p, const Vec3& n, size_t index, uint8_t set = 0) const {
+    return tree ? tree->probability(lights, p, n, index, set) : probability_linear(p, n, index, set);
   }
 
-  // The linear walk, proportional to each light's importance().
-  LightSelection select_linear(const Vec3& p, const Vec3& n, float u) const;
-  float probability_linear(const Vec3& p, const Vec3& n, size_t index) const;
+  // The linear walk, proportional to each light's importance() (0 for a light not linked to `set`).
+  LightSelection select_linear(const Vec3& p, const Vec3& n, float u, uint8_t set = 0) const;
+  float probability_linear(const Vec3& p, const Vec3& n, size_t index, uint8_t set = 0) const;
+
+ private:
+  float weight(size_t i, const Vec3& p, const Vec3& n, uint8_t set) const {
+    return sets && !in_light_sets(sets[i], set) ? 0.0f : light_importance(lights[i], p, n);
+  }
 };
 
 }  // namespace toyrt

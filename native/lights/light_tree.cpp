@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <stdexcept>
 
 namespace toyrt {
 namespace {
@@ -343,59 +344,83 @@ void LightTree::build(const std::vector<LightBounds>& bounds, uint32_t leaf_size
       for (uint32_t i = 0; i < nodes_[k].count; ++i) leaf_of_[order_[nodes_[k].first() + i]] = int32_t(k);
 }
 
+void LightTree::set_receiver_sets(std::vector<uint64_t> per_light) {
+  if (per_light.empty()) {
+    sets_.clear();
+    node_sets_.clear();
+    return;
+  }
+  if (per_light.size() != leaf_of_.size())
+    throw std::invalid_argument("light tree: one receiver-set mask per light expected");
+  sets_ = std::move(per_light);
+  // Children are stored after their parent (the builder appends them), so one pass from the
+  // back sees every child's union before its parent's.
+  node_sets_.assign(nodes_.size(), 0);
+  for (size_t k = nodes_.size(); k-- > 0;) {
+    const LightTreeNode& node = nodes_[k];
+    if (node.leaf()) {
+      for (uint32_t i = 0; i < node.count; ++i) node_sets_[k] |= sets_[order_[node.first() + i]];
+    } else {
+      node_sets_[k] = node_sets_[size_t(node.child)] | node_sets_[size_t(node.child) + 1];
+    }
+  }
+}
+
 size_t LightTree::memory_bytes() const {
   return nodes_.capacity() * sizeof(LightTreeNode) + parent_.capacity() * sizeof(int32_t) +
          order_.capacity() * sizeof(uint32_t) + leaf_of_.capacity() * sizeof(int32_t) +
-         distant_.capacity() * sizeof(uint32_t);
+         distant_.capacity() * sizeof(uint32_t) + (sets_.capacity() + node_sets_.capacity()) * sizeof(uint64_t);
 }
 
 // Out of line, and the only place the weights are computed, so select() and probability() divide
 // the very same floats (an inlined copy could be contracted into different FMAs).
 template <class T>
-[[gnu::noinline]] LightTree::Weights LightTree::top_weights(const T* lights, const Vec3& p, const Vec3& n) const {
+float LightTree::item_weight(const T* items, uint32_t i, const At& at) const {
+  if (!sets_.empty() && !in_light_sets(sets_[i], at.set)) return 0.0f;
+  return importance_of(items[i], at.p, at.n);
+}
+
+template <class T>
+[[gnu::noinline]] LightTree::Weights LightTree::top_weights(const T* lights, const At& at) const {
   Weights w{0.0f, 0.0f};
-  if (!nodes_.empty()) {
-    const LightTreeNode& root = nodes_[0];
-    w.first = weight(lights, root, p, n);
-  }
-  for (uint32_t i : distant_) w.second += importance_of(lights[i], p, n);
+  if (!nodes_.empty()) w.first = weight(lights, 0, at);
+  for (uint32_t i : distant_) w.second += item_weight(lights, i, at);
   return w;
 }
 
 template <class T>
-[[gnu::noinline]] LightTree::Weights LightTree::child_weights(const T* lights, int32_t node, const Vec3& p,
-                                                              const Vec3& n) const {
-  const int32_t first = nodes_[size_t(node)].child;
-  const LightTreeNode& a = nodes_[size_t(first)];
-  const LightTreeNode& b = nodes_[size_t(first) + 1];
-  return {weight(lights, a, p, n), weight(lights, b, p, n)};
+[[gnu::noinline]] LightTree::Weights LightTree::child_weights(const T* lights, int32_t node, const At& at) const {
+  const size_t first = size_t(nodes_[size_t(node)].child);
+  return {weight(lights, first, at), weight(lights, first + 1, at)};
 }
 
 // A cluster's bound, or a leaf's exact sum, in order_'s order (the pick's running sum repeats it).
 template <class T>
-[[gnu::noinline]] float LightTree::weight(const T* lights, const LightTreeNode& node, const Vec3& p,
-                                          const Vec3& n) const {
-  if (!node.leaf()) return cluster_importance(node, p, n);
+[[gnu::noinline]] float LightTree::weight(const T* lights, size_t index, const At& at) const {
+  const LightTreeNode& node = nodes_[index];
+  if (!node_sets_.empty() && !in_light_sets(node_sets_[index], at.set)) return 0.0f;
+  if (!node.leaf()) return cluster_importance(node, at.p, at.n);
   float sum = 0.0f;
-  for (uint32_t i = 0; i < node.count; ++i) sum += importance_of(lights[order_[node.first() + i]], p, n);
+  for (uint32_t i = 0; i < node.count; ++i) sum += item_weight(lights, order_[node.first() + i], at);
   return sum;
 }
 
 namespace {
 // u rescaled into the branch it chose, kept below 1 (rounding could reach it).
 float rescale(float u, float lo, float width) { return std::min((u - lo) / width, 0x1.fffffep-1f); }
+}  // namespace
 
 // The linear selector's pick among lights ids[0, count), whose importances sum to `total` in this
 // order (so the running sum ends at exactly `total`; u * total rounding up to it keeps the last
 // candidate), the probability scaled by that of reaching them.
 template <class T>
-LightSelection pick_among(const T* lights, const uint32_t* ids, size_t count, float total, float u, float scale,
-                          const Vec3& p, const Vec3& n) {
+LightSelection LightTree::pick_among(const T* lights, const uint32_t* ids, size_t count, float total, float u,
+                                     float scale, const At& at) const {
   LightSelection chosen;
   const float target = u * total;
   float running = 0.0f, before = 0.0f, chosen_w = 0.0f;
   for (size_t i = 0; i < count; ++i) {
-    const float w = importance_of(lights[ids[i]], p, n);
+    const float w = item_weight(lights, ids[i], at);
     if (w <= 0.0f) continue;
     before = running;
     running += w;
@@ -407,25 +432,24 @@ LightSelection pick_among(const T* lights, const uint32_t* ids, size_t count, fl
   if (chosen_w > 0.0f) chosen.remainder = std::clamp((target - before) / chosen_w, 0.0f, 0x1.fffffep-1f);
   return chosen;
 }
-}  // namespace
 
 template <class T>
-LightSelection LightTree::select_in(const T* lights, const Vec3& p, const Vec3& n, float u) const {
+LightSelection LightTree::select_in(const T* lights, const At& at, float u) const {
   LightSelection chosen;
-  const Weights top = top_weights(lights, p, n);
+  const Weights top = top_weights(lights, at);
   const float total = top.first + top.second;
   if (!(total > 0.0f)) return chosen;
   const float p_tree = top.first / total;
   if (!(u < p_tree)) {
     // A light at infinity, by importance among them.
     return pick_among(lights, distant_.data(), distant_.size(), top.second, rescale(u, p_tree, top.second / total),
-                      top.second / total, p, n);
+                      top.second / total, at);
   }
   u = rescale(u, 0.0f, p_tree);
   float probability = top.first / total;
   int32_t node = 0;
   while (!nodes_[size_t(node)].leaf()) {
-    const Weights w = child_weights(lights, node, p, n);
+    const Weights w = child_weights(lights, node, at);
     const float sum = w.first + w.second;
     if (!(sum > 0.0f)) return chosen;  // a bound above passed, both below fail: nothing here reaches p
     const float p_first = w.first / sum;
@@ -440,18 +464,19 @@ LightSelection LightTree::select_in(const T* lights, const Vec3& p, const Vec3& 
     }
   }
   const LightTreeNode& leaf = nodes_[size_t(node)];
-  return pick_among(lights, order_.data() + leaf.first(), leaf.count, weight(lights, leaf, p, n), u, probability, p, n);
+  return pick_among(lights, order_.data() + leaf.first(), leaf.count, weight(lights, size_t(node), at), u, probability,
+                    at);
 }
 
 template <class T>
-float LightTree::probability_in(const T* lights, const Vec3& p, const Vec3& n, size_t index) const {
+float LightTree::probability_in(const T* lights, const At& at, size_t index) const {
   if (index >= leaf_of_.size()) return 0.0f;
-  const Weights top = top_weights(lights, p, n);
+  const Weights top = top_weights(lights, at);
   const float total = top.first + top.second;
   if (!(total > 0.0f)) return 0.0f;
   const int32_t leaf = leaf_of_[index];
   if (leaf < 0) {
-    const float w = importance_of(lights[index], p, n);
+    const float w = item_weight(lights, uint32_t(index), at);
     return w > 0.0f ? top.second / total * (w / top.second) : 0.0f;
   }
   // The path root to leaf, then the same products in the same order as select().
@@ -461,26 +486,26 @@ float LightTree::probability_in(const T* lights, const Vec3& p, const Vec3& n, s
   float probability = top.first / total;
   for (int i = length - 1; i > 0; --i) {
     const int32_t node = path[size_t(i)];
-    const Weights w = child_weights(lights, node, p, n);
+    const Weights w = child_weights(lights, node, at);
     const float sum = w.first + w.second;
     if (!(sum > 0.0f)) return 0.0f;
     probability *= (path[size_t(i - 1)] == nodes_[size_t(node)].child ? w.first : w.second) / sum;
   }
-  const float w = importance_of(lights[index], p, n);
-  return w > 0.0f ? probability * (w / weight(lights, nodes_[size_t(leaf)], p, n)) : 0.0f;
+  const float w = item_weight(lights, uint32_t(index), at);
+  return w > 0.0f ? probability * (w / weight(lights, size_t(leaf), at)) : 0.0f;
 }
 
-LightSelection LightTree::select(const Light* lights, const Vec3& p, const Vec3& n, float u) const {
-  return select_in(lights, p, n, u);
+LightSelection LightTree::select(const Light* lights, const Vec3& p, const Vec3& n, float u, uint8_t set) const {
+  return select_in(lights, At{p, n, set}, u);
 }
-float LightTree::probability(const Light* lights, const Vec3& p, const Vec3& n, size_t index) const {
-  return probability_in(lights, p, n, index);
+float LightTree::probability(const Light* lights, const Vec3& p, const Vec3& n, size_t index, uint8_t set) const {
+  return probability_in(lights, At{p, n, set}, index);
 }
 LightSelection LightTree::select(const EmissiveTriangle* triangles, const Vec3& p, const Vec3& n, float u) const {
-  return select_in(triangles, p, n, u);
+  return select_in(triangles, At{p, n, 0}, u);
 }
 float LightTree::probability(const EmissiveTriangle* triangles, const Vec3& p, const Vec3& n, size_t index) const {
-  return probability_in(triangles, p, n, index);
+  return probability_in(triangles, At{p, n, 0}, index);
 }
 
 }  // namespace toyrt

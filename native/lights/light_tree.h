@@ -25,6 +25,7 @@
 #pragma once
 
 #include "lights/light.h"
+#include "lights/light_linking.h"
 #include "lights/light_selection.h"
 
 #include <cstdint>
@@ -61,9 +62,17 @@ class LightTree {
   // Over any primitives by their bounds, in the order select() returns their indices.
   explicit LightTree(const std::vector<LightBounds>& bounds, uint32_t leaf_size = kLeafSize);
 
-  // `lights` (or `triangles`) must be the ones the tree was built from.
-  LightSelection select(const Light* lights, const Vec3& p, const Vec3& n, float u) const;
-  float probability(const Light* lights, const Vec3& p, const Vec3& n, size_t index) const;
+  // Light linking (lights/light_linking.h): per light, the receiver sets it lights. After this,
+  // select() and probability() for a receiver in set `set` leave out the lights that do not light
+  // that set, and never enter a cluster none of whose lights does (Cycles' light tree does the
+  // same), so an unlinked lamp costs no sample. An empty vector (the default) links nothing.
+  void set_receiver_sets(std::vector<uint64_t> per_light);
+  bool linked() const { return !sets_.empty(); }
+
+  // `lights` (or `triangles`) must be the ones the tree was built from; `set`: the receiver's
+  // light-linking set, read only after set_receiver_sets.
+  LightSelection select(const Light* lights, const Vec3& p, const Vec3& n, float u, uint8_t set = 0) const;
+  float probability(const Light* lights, const Vec3& p, const Vec3& n, size_t index, uint8_t set = 0) const;
   LightSelection select(const EmissiveTriangle* triangles, const Vec3& p, const Vec3& n, float u) const;
   float probability(const EmissiveTriangle* triangles, const Vec3& p, const Vec3& n, size_t index) const;
 
@@ -78,22 +87,35 @@ class LightTree {
   };
   void build(const std::vector<LightBounds>& bounds, uint32_t leaf_size);
   // T: Light or EmissiveTriangle (instantiated in light_tree.cpp).
+  // The receiver: its point, normal and light-linking set.
+  struct At {
+    Vec3 p, n;
+    uint8_t set;
+  };
   template <class T>
-  LightSelection select_in(const T* items, const Vec3& p, const Vec3& n, float u) const;
+  LightSelection select_in(const T* items, const At& at, float u) const;
   template <class T>
-  float probability_in(const T* items, const Vec3& p, const Vec3& n, size_t index) const;
+  float probability_in(const T* items, const At& at, size_t index) const;
   template <class T>
-  Weights top_weights(const T* items, const Vec3& p, const Vec3& n) const;
+  Weights top_weights(const T* items, const At& at) const;
   template <class T>
-  Weights child_weights(const T* items, int32_t node, const Vec3& p, const Vec3& n) const;
+  Weights child_weights(const T* items, int32_t node, const At& at) const;
   template <class T>
-  float weight(const T* items, const LightTreeNode& node, const Vec3& p, const Vec3& n) const;
+  float weight(const T* items, size_t node, const At& at) const;
+  // One primitive's importance, 0 for a light that does not light the receiver's set.
+  template <class T>
+  float item_weight(const T* items, uint32_t i, const At& at) const;
+  template <class T>
+  LightSelection pick_among(const T* items, const uint32_t* ids, size_t count, float total, float u, float scale,
+                            const At& at) const;
 
   std::vector<LightTreeNode> nodes_;  // nodes_[0]: the root over the local lights, if any
   std::vector<int32_t> parent_;       // per node; -1 for the root
   std::vector<uint32_t> order_;       // the local lights, leaf by leaf
   std::vector<int32_t> leaf_of_;      // per light, its leaf; -1 for a light at infinity
   std::vector<uint32_t> distant_;     // the lights at infinity
+  std::vector<uint64_t> sets_;        // light linking: per light, the receiver sets it lights; or empty
+  std::vector<uint64_t> node_sets_;   // per node, the union of its lights' sets_ (empty with sets_)
   int depth_ = 0;
 };
 

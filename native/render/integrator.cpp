@@ -194,9 +194,9 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
   Vec3 sum(0.0f);
   auto add = [&](size_t index, float select_probability, uint32_t dim) {
     const LightVisibility v = world.light_visibility[index];
-    // Light linking: a light that does not light this object adds nothing. Zeroed here rather
-    // than left out of the selection: the same mean as Cycles, which leaves it out
-    // (docs/lights.md); unlinked scenes have full masks and always pass.
+    // Light linking: a light that does not light this object adds nothing. The selection below
+    // never picks one (Scene::light_receiver_sets); this check serves the loop over every light.
+    // Unlinked scenes have full masks and always pass.
     if (!v.diffuse || !in_light_sets(v.receiver_sets, s.receiver_set)) return;
     const LightSample ls =
         sample_light(world.lights[index], s.p,
@@ -235,9 +235,9 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
   if (settings.light_sampling != LightSampling::One || lights.size() == 1) {
     for (size_t j = 0; j < lights.size(); ++j) add(j, 1.0f, 1 + uint32_t(j));
   } else {
-    const LightSelector selector(lights, scene.light_tree());
-    const LightSelection pick =
-        selector.select(s.p, ns, sobol_owen_1d(pixel, sample, vertex_dimension(depth, 0), settings.seed));
+    const LightSelector selector(lights, scene.light_tree(), scene.light_receiver_sets());
+    const LightSelection pick = selector.select(
+        s.p, ns, sobol_owen_1d(pixel, sample, vertex_dimension(depth, 0), settings.seed), s.receiver_set);
     if (pick.found()) add(size_t(pick.index), pick.probability, 1);
   }
   return sum;

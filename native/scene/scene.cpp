@@ -196,12 +196,19 @@ uint32_t Scene::add_light(const Light& light, LightVisibility visibility) {
   world_.lights.push_back(light);
   world_.light_visibility.push_back(visibility);
   light_tree_current_ = false;
+  // Kept only once some light does not light every receiver, so unlinked scenes check nothing.
+  const uint64_t reach = visibility.diffuse ? visibility.receiver_sets : 0;
+  if (reach != kAllLightSets || !light_reach_.empty()) {
+    light_reach_.resize(world_.lights.size() - 1, kAllLightSets);  // the full masks of the lights before
+    light_reach_.push_back(reach);
+  }
   return uint32_t(world_.lights.size() - 1);
 }
 
 void Scene::clear_lights() {
   world_.lights.clear();
   world_.light_visibility.clear();
+  light_reach_.clear();
   light_tree_current_ = false;
 }
 
@@ -340,6 +347,7 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
     // few lights keeps no tree (the linear walk is cheaper there: kLightTreeFrom).
     const auto tree_start = std::chrono::steady_clock::now();
     light_tree_ = world_.lights.size() > kLightTreeFrom ? LightTree(world_.lights) : LightTree{};
+    if (light_tree_.node_count() > 0) light_tree_.set_receiver_sets(light_reach_);
     light_tree_current_ = true;
     stats_.light_tree_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tree_start).count();

@@ -222,6 +222,10 @@ class Scene {
                ? &light_tree_
                : nullptr;
   }
+  // Per light, the receiver sets whose diffuse surfaces it lights (its light-linking receiver
+  // sets, none when it is hidden from diffuse rays), for the light selection; null when every
+  // light lights every receiver (no linking: the selection checks nothing).
+  const uint64_t* light_receiver_sets() const { return light_reach_.empty() ? nullptr : light_reach_.data(); }
   // Triangles stored (each mesh counted once) and placed (each instance counting its mesh).
   size_t stored_triangle_count() const;
   size_t instanced_triangle_count() const;
@@ -253,8 +257,9 @@ class Scene {
   float emitter_tree_spread_ = kEmitterTreeSpread;
   std::vector<Texture> textures_;
   World world_;
-  LightTree light_tree_;             // over world_.lights when light_tree_current_
-  bool light_tree_current_ = false;  // add_light and clear_lights reset it, commit() rebuilds
+  LightTree light_tree_;               // over world_.lights when light_tree_current_
+  bool light_tree_current_ = false;    // add_light and clear_lights reset it, commit() rebuilds
+  std::vector<uint64_t> light_reach_;  // light_receiver_sets(), parallel to world_.lights, or empty
   std::vector<Instance> instances_;
   Bvh top_;                       // over instances with a non-empty world box
   bool single_identity_ = false;  // one untransformed instance: skip the top level

@@ -262,6 +262,50 @@ TEST_P(LightTreeLeaves, AClusterWhollyBelowTheReceiversPlaneIsNeverEntered) {
   }
 }
 
+TEST_P(LightTreeLeaves, LightsNotLinkedToTheReceiversSetAreLeftOutByTheTreeAndTheLinearWalk) {
+  // 300 point lights over a floor facing up (every one reaches it); one in three lights only
+  // receiver set 5 (light linking). For a receiver in set 2 those never come out and weigh 0, the
+  // rest share all the probability; in set 5 the tree answers exactly as an unlinked tree does.
+  std::vector<Light> lights;
+  std::vector<uint64_t> sets;
+  for (uint32_t i = 0; i < 300; ++i) {
+    const Vec3 pos(20.0f * random_float(i, 0, 0, 12) - 10.0f, 20.0f * random_float(i, 0, 1, 12) - 10.0f,
+                   0.5f + 3.0f * random_float(i, 0, 2, 12));
+    lights.emplace_back(PointLight::make(pos, 1.0f + 50.0f * random_float(i, 0, 3, 12), Vec3(1.0f)));
+    sets.push_back(i % 3 == 0 ? uint64_t(1) << 5 : kAllLightSets);
+  }
+  LightTree tree(lights, GetParam());
+  const LightTree unlinked(lights, GetParam());
+  tree.set_receiver_sets(sets);
+  const LightSelector walk(lights, nullptr, sets.data());
+  const Vec3 p(0.7f, -1.3f, 0.0f), n(0, 0, 1);
+  double through_tree = 0.0, linear = 0.0;
+  for (size_t i = 0; i < lights.size(); ++i) {
+    const float t = tree.probability(lights.data(), p, n, i, 2), w = walk.probability(p, n, i, 2);
+    if (i % 3 == 0) {
+      EXPECT_EQ(t, 0.0f) << i;
+      EXPECT_EQ(w, 0.0f) << i;
+    } else {
+      EXPECT_GT(t, 0.0f) << i;
+      EXPECT_GT(w, 0.0f) << i;
+    }
+    through_tree += t;
+    linear += w;
+    EXPECT_EQ(tree.probability(lights.data(), p, n, i, 5), unlinked.probability(lights.data(), p, n, i)) << i;
+  }
+  EXPECT_NEAR(through_tree, 1.0, 1e-5);
+  EXPECT_NEAR(linear, 1.0, 1e-5);
+  for (uint32_t k = 0; k < 5000; ++k) {
+    const float u = random_float(k, 0, 0, 13);
+    for (const LightSelection& s : {tree.select(lights.data(), p, n, u, 2), walk.select(p, n, u, 2)}) {
+      ASSERT_TRUE(s.found());
+      ASSERT_NE(s.index % 3, 0) << s.index;
+    }
+    const LightSelection s = tree.select(lights.data(), p, n, u, 2);
+    ASSERT_EQ(s.probability, tree.probability(lights.data(), p, n, size_t(s.index), 2));
+  }
+}
+
 TEST_P(LightTreeLeaves, OneSampleEstimateConvergesToTheSumOfTwoHundredLightsIrradiance) {
   // 200 point lights of radius 0 and a sun over a floor facing up: E = sum of I cos / r^2 over
   // those above it, plus S cos for the sun.

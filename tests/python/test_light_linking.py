@@ -38,10 +38,12 @@ def test_a_plane_linked_to_one_of_two_lights_renders_as_under_that_light_alone()
     want = alone.render(cam, samples=4)
     np.testing.assert_array_equal(linked.render(cam, samples=4), want)
     np.testing.assert_allclose(want[0, 0, :3], 0.8 / math.pi * 100.0 / (4 * math.pi * 4.0), rtol=1e-3)
-    # One lamp chosen per point: the unlinked lamp's picks add nothing, so the mean is the same.
-    one = linked.render(camera_above(size=1.0, resolution=8), samples=256, light_sampling="one")
-    ref = alone.render(camera_above(size=1.0, resolution=8), samples=256, light_sampling="one")
-    assert abs(one[..., :3].mean() / ref[..., :3].mean() - 1) < 0.02
+    # One lamp chosen per point: the unlinked lamp is left out of the selection (as Cycles' light
+    # tree leaves it out), so the linked one is picked with probability 1: the same image, sample
+    # for sample, not only the same mean.
+    one = linked.render(camera_above(size=1.0, resolution=8), samples=16, light_sampling="one")
+    ref = alone.render(camera_above(size=1.0, resolution=8), samples=16, light_sampling="one")
+    np.testing.assert_array_equal(one, ref)
     # Unlinked (set 0), the floor gets both.
     both = toyrt.Scene()
     floor(both, receiver_set=0)
@@ -49,6 +51,28 @@ def test_a_plane_linked_to_one_of_two_lights_renders_as_under_that_light_alone()
     both.add_light("POINT", position=(0.5, 0, 1), power=300.0, radius=0.0, receiver_sets=ALL & ~(1 << 1))
     both.commit()
     assert both.render(cam, samples=4)[0, 0, 0] > 2 * want[0, 0, 0]
+
+
+def test_through_the_light_tree_the_lamps_not_linked_to_a_floor_are_never_picked():
+    """1,000 lamps (radius 0: the camera cannot see them) that do not light the floor's set and one
+    that does: above kLightTreeFrom the
+    scene selects through its light tree, which never enters a cluster of unlinked lamps, so the
+    one lamp is picked with probability 1 and the image is that lamp's alone, sample for sample."""
+    cam = camera_above(size=1.0, resolution=8)
+    alone = toyrt.Scene()
+    floor(alone, receiver_set=1)
+    alone.add_light("POINT", position=(0, 0, 2), power=100.0, radius=0.1)
+    alone.commit()
+    many = toyrt.Scene()
+    floor(many, receiver_set=1)
+    rng = np.random.default_rng(3)
+    for x, y, z in rng.uniform((-3, -3, 0.5), (3, 3, 3), size=(1000, 3)):
+        many.add_light("POINT", position=(x, y, z), power=50.0, radius=0.0, receiver_sets=ALL & ~(1 << 1))
+    many.add_light("POINT", position=(0, 0, 2), power=100.0, radius=0.1)
+    many.commit()
+    assert many.last_commit["light_tree_nodes"] > 0
+    want = alone.render(cam, samples=8, light_sampling="one")
+    np.testing.assert_array_equal(many.render(cam, samples=8, light_sampling="one"), want)
 
 
 def occluded_scene(blocker_sets):
