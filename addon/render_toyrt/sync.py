@@ -79,6 +79,8 @@ class SceneSync(MaterialSync):
         # material every frame, and they must be found again.
         self.materials: dict[str, tuple[int, materials.MaterialSpec]] = {}  # name ('': none) -> (id, spec sent)
         self.mix_parts: dict[str, list[int]] = {}  # a mix material's name -> the ids its inputs were sent into
+        self.tangent_maps: dict[str, str | None] = {}  # material name -> the UV map its normal map's tangents read
+        self.material_users: dict[str, set[int]] = {}  # name -> objects sent with it (original pointers)
         self.textures: dict[ImageKey, int] = {}        # image -> texture id (missing: the placeholder's)
         self.texture_notes: dict[ImageKey, tuple[str, ...]] = {}
         self.lights: tuple[LightSpec, ...] | None = None   # the light specs last sent
@@ -127,6 +129,9 @@ class SceneSync(MaterialSync):
                     geometry.add(original.as_pointer())
             elif kind == "Material":
                 self.counters["materials_converted"] += self._reconvert(id_)
+                if self._tangents_changed(id_):  # a normal map added or removed: send its meshes again
+                    walk = True
+                    geometry |= self.material_users.get(id_.name_full, set())
             elif kind == "Image":
                 self.counters["textures_refreshed"] += self._refresh_image(id_)
             elif kind == "World":
@@ -335,6 +340,9 @@ class SceneSync(MaterialSync):
                 self._empty(old_id)
             return [-1, 0, fingerprint]
         slot_ids = np.array([self._material_id(m) for m in geometry.materials], np.int32)
+        for m in geometry.materials:
+            if m is not None:
+                self.material_users.setdefault(m.name_full, set()).add(obj.original.as_pointer())
         mat_ids = slot_ids[geometry.slots]
         g = geometry
         if g.tangents is None and (uv_map := self._tangent_uv_map(g.materials)) is not None:

@@ -12,7 +12,7 @@ from .materials import PLACEHOLDER, PLACEHOLDER_PIXELS, ImageKey
 
 
 class MaterialSync:
-    """Needs from SceneSync: scene, materials, textures, texture_notes, _converted_now, _note()."""
+    """Needs from SceneSync: scene, materials, tangent_maps, textures, texture_notes, _converted_now, _note()."""
 
     def _material_id(self, mat) -> int:
         """The material id of a Blender material (None: an empty slot), converted on first use."""
@@ -23,8 +23,22 @@ class MaterialSync:
         converted = materials.material_spec(mat)
         mid = self.scene.add_material(**self._material_arguments(converted, name))
         self.materials[name] = (mid, converted.spec)
+        self.tangent_maps[name] = tangent_uv_map(mat) if mat is not None else None
         self._converted_now.add(name)
         return mid
+
+    def _tangents_changed(self, mat) -> bool:
+        """Whether the UV map whose tangents `mat`'s normal map reads (None: none) changed since
+        it was last sent, so the meshes using it need sending again (a viewport update of the
+        material alone does not say their geometry changed). False for a material not sent yet."""
+        name = mat.name_full
+        if name not in self.tangent_maps:
+            return False
+        now = tangent_uv_map(mat)
+        if now == self.tangent_maps[name]:
+            return False
+        self.tangent_maps[name] = now
+        return True
 
     def _tangent_uv_map(self, slot_materials: tuple) -> str | None:
         """The UV map whose tangents a mesh with these slot materials needs ('': the render-active

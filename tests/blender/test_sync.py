@@ -11,8 +11,9 @@
 #      differs from the scene without it where it lies).
 #   2. IncrementalEqualsOneShot: a SceneSync fed with Blender's depsgraph.updates (as the viewport
 #      is) after a light edit, a material edit, moving the flattened object, flattening another
-#      object and giving the first its volume back, each time gives what a fresh export_scene of
-#      the same depsgraph gives: counts, lights and the image (bit for bit).
+#      object and giving the first its volume back, adding a Normal Map to a material and removing
+#      it (its meshes are sent again with and without tangents), each time gives what a fresh
+#      export_scene of the same depsgraph gives: counts, lights and the image (bit for bit).
 #   3. DefaultsMatchTheCore: properties.py's defaults (literal, so the add-on registers without
 #      the native module) equal the core's toyrt.defaults, where the module has them.
 import os
@@ -202,6 +203,15 @@ def test_incremental_equals_one_shot():
         edit("then move it (instance matrices only)", lambda: setattr(flat, "location", (-2.0, 0.0, 0.5)),
              dict(meshes_exported=0, walks=0, transforms_set=1))
         edit("move a collection instance", lambda: setattr(bpy.data.objects["instancer1"], "location", (1.5, 3.0, 0.0)))
+        # A material edit alone does not tell the viewport that geometry changed, but a normal map
+        # needs its meshes' tangents: the floor (a UV-mapped plane) is sent again with them.
+        edit("a Normal Map added to the floor's material (its mesh sent again, with tangents)",
+             lambda: kit.normal_map(bpy.data.materials["floor"], kit.bump_normal_image("bumps")),
+             dict(materials_converted=1, meshes_exported=1))
+        edit("and removed again (sent without them)",
+             lambda: bpy.data.materials["floor"].node_tree.nodes.remove(
+                 bpy.data.materials["floor"].node_tree.nodes["Normal Map"]),
+             dict(materials_converted=1, meshes_exported=1))
 
 
 # ---- 3. defaults ----------------------------------------------------------------------------------------
