@@ -22,7 +22,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]
 import kit  # noqa: E402
-from harness import check, render_still, run_script  # noqa: E402
+from harness import check, counted_edit, live_sync, render_still, run_script  # noqa: E402
 
 TMP = tempfile.mkdtemp(prefix="toyrt-test-lights-world-")
 
@@ -187,10 +187,54 @@ def test_a_lamp_whose_receiver_collection_excludes_the_floor_does_not_light_it()
           f"({'glow' in notes})")
 
 
+def test_light_linking_edits_reach_the_viewport_as_a_fresh_export():
+    """Light linking edited while the viewport renders (4.0+): a SceneSync kept up to date with
+    Blender's depsgraph.updates, as the viewport's is, renders what a fresh export of the same
+    scene renders, bit for bit, after each edit: a receiver collection given to a lamp, the floor
+    excluded from it, then included again; and the excluded lamp really drops out."""
+    if "light_linking" not in bpy.types.Object.bl_rna.properties.keys():
+        check(True, "no light linking in this Blender (3.x): nothing to edit")
+        return
+    import render_toyrt
+    from render_toyrt import sync
+    toyrt = render_toyrt.native()
+    scene_with_floor(0.5)
+    kit.point_light("key", (0.5, 0.0, 3.0), 300.0)
+    other = kit.point_light("other", (-1.0, 0.5, 2.0), 500.0)
+    receivers = bpy.data.collections.new("live_receivers")
+    means = {}
+    with live_sync(sync, toyrt) as cache:
+        def same_as_fresh(label):
+            fresh, camera, _ = sync.export_scene(bpy.context.evaluated_depsgraph_get(), toyrt)
+            fresh.commit()
+            a, b = cache.scene.render(camera, samples=2, seed=0), fresh.render(camera, samples=2, seed=0)
+            means[label] = float(a[..., :3].mean())
+            check(np.array_equal(a, b), f"{label}: the live scene renders what a fresh export renders "
+                                        f"(max difference {np.abs(a - b).max():.3g})")
+
+        same_as_fresh("before any linking")
+
+        def give_collection():
+            receivers.objects.link(bpy.data.objects["floor"])
+            other.light_linking.receiver_collection = receivers
+        counted_edit(cache, "a receiver collection holding the floor given to a lamp", give_collection)
+        same_as_fresh("receiver collection given")
+        counted_edit(cache, "the floor excluded", lambda: setattr(
+            receivers.collection_objects[0].light_linking, "link_state", "EXCLUDE"))
+        same_as_fresh("floor excluded")
+        counted_edit(cache, "and included again", lambda: setattr(
+            receivers.collection_objects[0].light_linking, "link_state", "INCLUDE"))
+        same_as_fresh("floor included again")
+    check(means["floor excluded"] < 0.9 * means["before any linking"]
+          and abs(means["floor included again"] / means["before any linking"] - 1) < 1e-6,
+          f"the excluded lamp drops out and comes back: mean {means}")
+
+
 PARTS = [test_sun_over_a_floor_gives_strength_cos_over_pi, test_portal_is_not_a_light,
          test_shadow_switch_removes_the_shadow, test_missing_environment_image_is_magenta_with_one_note,
          test_non_finite_texels_are_noted_and_the_image_stays_finite, test_one_pixel_environment_is_a_uniform_world,
          test_a_world_hidden_from_the_camera_still_lights_the_floor,
          test_principled_emission_is_seen_as_colour_times_strength,
-         test_a_lamp_whose_receiver_collection_excludes_the_floor_does_not_light_it]
+         test_a_lamp_whose_receiver_collection_excludes_the_floor_does_not_light_it,
+         test_light_linking_edits_reach_the_viewport_as_a_fresh_export]
 run_script(PARTS, "lights and world", TMP)
