@@ -28,8 +28,8 @@ def principled_spec(name, node, notes):
     extras = []
     metallic = _constant(name, metal, "Metallic", 0.0, notes, 0.0, 1.0)
     glass = _transmission(name, node, notes)
-    coat = _coat(name, node, glass, notes)
-    for label, names in (("clearcoat", ("Clearcoat",)), ("sheen", ("Sheen Weight", "Sheen")),
+    coat = _coat(name, node, glass, notes) or _clearcoat(name, node, notes)
+    for label, names in (("sheen", ("Sheen Weight", "Sheen")),
                          ("subsurface", ("Subsurface Weight", "Subsurface")), ("anisotropy", ("Anisotropic",)),
                          ("diffuse roughness", ("Diffuse Roughness",)), ("thin film", ("Thin Film Thickness",))):
         sock = input_socket(node, *names)
@@ -53,7 +53,9 @@ def principled_spec(name, node, notes):
                      ior=1.0, multiscatter=new and getattr(node, "distribution", "GGX") == "MULTI_GGX",
                      shadowing="correlated" if new else "separable", layered=new)
     if layer is None and coat:   # a coat over a plain base: the 'principled' kind without a layer
-        layer = dict(roughness=0.5, ior=1.0, multiscatter=False, shadowing="correlated", layered=True)
+        new = _blender_version() >= (4, 0, 0)
+        layer = dict(roughness=0.5, ior=1.0, multiscatter=False, shadowing="correlated" if new else "separable",
+                     layered=new, burley=not new)
     spec = base if layer is None else replace(base, kind="principled", metallic=metallic, **layer, **glass, **coat)
     return replace(spec, emission=emission), image
 
@@ -73,7 +75,7 @@ def _coat(name, node, glass, notes) -> dict:
     """4.0+'s Coat (Weight, Roughness, IOR, Tint) as the 'principled' kind's coat arguments ({} for
     none): Cycles 4.0+'s dielectric layer over everything opaque. A linked socket is its constant
     value, a Coat Normal is not modelled, the glass of Transmission is not coated: each noted.
-    (3.x's Clearcoat, a GTR1 lobe added beside the rest, is noted by the caller.)"""
+    (3.x's Clearcoat, a GTR1 lobe added beside the rest: _clearcoat.)"""
     weight_sock = input_socket(node, "Coat Weight")
     if weight_sock is None:
         return {}
@@ -89,6 +91,24 @@ def _coat(name, node, glass, notes) -> dict:
     if glass:
         notes.append(f"material '{name}': Principled coat over Transmission (the glass uncoated)")
     return dict(coat_weight=weight, coat_roughness=rough, coat_ior=ior, coat_tint=tint)
+
+
+def _clearcoat(name, node, notes) -> dict:
+    """3.x's Clearcoat and Clearcoat Roughness as the 'principled' kind's coat arguments ({} for
+    none; the core reads them, with layered False, as Cycles 3.x's GTR1 clearcoat added beside the
+    rest: materials/clearcoat.h). A linked socket is its constant value, a Clearcoat Normal is not
+    modelled: noted."""
+    sock = input_socket(node, "Clearcoat")
+    if sock is None or input_socket(node, "Coat Weight") is not None:
+        return {}
+    weight = _constant(name, sock, "Clearcoat", 0.0, notes, 0.0, 1.0)
+    if weight <= 0.0:
+        return {}
+    rough = _constant(name, input_socket(node, "Clearcoat Roughness"), "Clearcoat Roughness", 0.03, notes, 0.0, 1.0)
+    normal = input_socket(node, "Clearcoat Normal")
+    if normal is not None and normal.is_linked:
+        notes.append(f"material '{name}': Principled Clearcoat Normal (not modelled)")
+    return dict(coat_weight=weight, coat_roughness=rough)
 
 
 def _transmission(name, node, notes) -> dict:
@@ -155,12 +175,9 @@ def _metal(name, node, notes):
     """Principled BSDF with Metallic 1: a metal layer whose reflectance at normal incidence is the
     base colour (or its texture), no base under it, emission kept. 4.0+: F82-tint Fresnel with
     Specular Tint, Multiscatter GGX by default; 3.x: the dielectric curve of the Specular's IOR
-    blended from the base colour to white. The coat, anisotropy and other distributions go in the
-    one note."""
+    blended from the base colour to white. The coat (4.0+) or Clearcoat (3.x) as over the other
+    kinds; anisotropy and other distributions go in the one note."""
     extras = []
-    clearcoat = input_socket(node, "Clearcoat")   # 3.x; 4.0+'s Coat is modelled (_coat)
-    if clearcoat is not None and (clearcoat.is_linked or clearcoat.default_value > 0.0):
-        extras.append("clearcoat")
     aniso = input_socket(node, "Anisotropic")
     if aniso is not None and (aniso.is_linked or aniso.default_value > 0.0):
         extras.append("anisotropy")
@@ -184,7 +201,8 @@ def _metal(name, node, notes):
         specular = _constant(name, input_socket(node, "Specular"), "Specular", 0.5, notes, 0.0, 1e30)
         root = min(0.08 * specular, 0.99) ** 0.5
         layer = dict(ior=(1.0 + root) / (1.0 - root), multiscatter=False, shadowing="separable", layered=False)
-    spec = replace(base, kind="principled", roughness=rough, metallic=1.0, **layer, **_coat(name, node, {}, notes))
+    coat = _coat(name, node, {}, notes) or _clearcoat(name, node, notes)
+    spec = replace(base, kind="principled", roughness=rough, metallic=1.0, **layer, **coat)
     emission = _emission(name, input_socket(node, "Emission Color", "Emission"),
                          input_socket(node, "Emission Strength"), notes)
     return replace(spec, emission=emission), image

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "core/math.h"
+#include "materials/clearcoat.h"
 #include "materials/fresnel.h"
 #include "sampling/frame.h"
 #include "sampling/ggx.h"
@@ -28,6 +29,9 @@ struct GlossyLobe {
   Vec3 tint{0.0f};  // the Fresnel term as Blender's Glossy BSDF has it: the colour, at every angle
   float alpha = kGgxMinAlpha;
   GgxShadowing shadowing = GgxShadowing::Separable;
+  // Blender 3.x's Principled Clearcoat: GTR1 with fixed masking, sampled as GGX with Cycles' pdf
+  // (materials/clearcoat.h); shadowing is then unread.
+  bool clearcoat = false;
   // The Fresnel term on the microfacet normal, times the tint: f0 sets its strength at normal
   // incidence; the dielectric curve's shape comes from ior, the metal's dip towards grazing from
   // f82_b.
@@ -64,13 +68,15 @@ struct BsdfSample {
 // wi: world, unit. The caller checks that wi leaves on the geometric normal's side.
 inline BsdfEval evaluate_lobe(const GlossyLobe& lobe, const Vec3& wi) {
   const Vec3 wi_local = lobe.frame.to_local(wi);
-  const GgxEval e = ggx_reflection_eval(lobe.alpha, lobe.shadowing, lobe.wo, wi_local);
+  const GgxEval e = lobe.clearcoat ? clearcoat_eval(lobe.alpha, lobe.wo, wi_local)
+                                   : ggx_reflection_eval(lobe.alpha, lobe.shadowing, lobe.wo, wi_local);
   if (!(e.f > 0.0f)) return {Vec3(0.0f), e.pdf};
   return {lobe.tint * lobe_fresnel(lobe, wi_local) * e.f, e.pdf};
 }
 
 inline BsdfSample sample_lobe(const GlossyLobe& lobe, const Vec2& u) {
-  const GgxSample s = ggx_reflection_sample(lobe.alpha, lobe.shadowing, lobe.wo, u);
+  const GgxSample s = lobe.clearcoat ? clearcoat_sample(lobe.alpha, lobe.wo, u)
+                                     : ggx_reflection_sample(lobe.alpha, lobe.shadowing, lobe.wo, u);
   if (!(s.weight > 0.0f)) return {lobe.frame.to_world(s.wi), Vec3(0.0f), s.pdf};
   return {lobe.frame.to_world(s.wi), lobe.tint * lobe_fresnel(lobe, s.wi) * s.weight, s.pdf};
 }

@@ -65,7 +65,6 @@ Principled Principled::from_params(const Params& params) {
   m.coat_eta = std::max(float(params.positive("coat_ior", m.coat_eta)), 1.0f);
   m.coat_f0 = f0_from_ior(m.coat_eta);
   m.coat_tint = params.color("coat_tint", m.coat_tint);
-  if (m.coat > 0.0f && !m.layered) throw std::invalid_argument("principled: the coat is 4.0+'s (layered True)");
   return m;
 }
 
@@ -139,6 +138,8 @@ Scatter opaque_scatter(const Principled& m, const ShadingPoint& s, const Materia
                        float scale, float u);
 Scatter coated(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx, const Vec3& albedo, float scale,
                float u);
+Scatter clearcoated(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx, const Vec3& albedo,
+                    float scale, float u);
 
 }  // namespace
 
@@ -216,8 +217,38 @@ Scatter opaque_scatter(const Principled& m, const ShadingPoint& s, const Materia
 // 4.0+'s coat over what opaque_scatter answers (Principled.h): the coat's lobe drawn with
 // probability coat / 2 (its weight divided by that), else the answer below with its lobe divided
 // by the rest; the layers below are attenuated and tinted on both draws, the diffuse part kept.
+// 3.x's Clearcoat beside what opaque_scatter answers (materials/clearcoat.h), added as Cycles 3.x
+// adds its closure, nothing below attenuated: its lobe, 0.25 x Clearcoat times the Fresnel term of
+// IOR 1.5, drawn with probability coat / 2 (its weight divided by that), else the answer below with
+// its lobe divided by the rest; the diffuse part is kept on both draws. A Transmission's glass
+// draw carries no clearcoat, so the opaque draws carry it over their share of the draws.
+Scatter clearcoated(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx, const Vec3& albedo,
+                    float scale, float u) {
+  const float v = u < 0.0f ? ctx.lobe_uniform() : u;
+  const float p = 0.5f * m.coat;
+  Scatter sc = opaque_scatter(m, s, ctx, albedo, scale, std::min(std::max(v - p, 0.0f) / (1.0f - p), 0x1.fffffep-1f));
+  if (!(v < p)) {
+    if (sc.kind == Scatter::Kind::Glossy) sc.glossy.tint /= 1.0f - p;
+    return sc;
+  }
+  GlossyLobe coat = oriented_lobe(s, m.coat_roughness, GgxShadowing::Separable);
+  coat.clearcoat = true;
+  coat.fresnel = LobeFresnel::Dielectric;
+  coat.f0 = Vec3(kClearcoatF0);
+  coat.ior = kClearcoatIor;
+  coat.ior_f0 = kClearcoatF0;
+  const float glass = (1.0f - m.metallic) * m.transmission;
+  coat.tint = Vec3(0.25f * m.coat / (p * (1.0f - glass)));
+  Scatter out =
+      lobe_over(coat, sc.kind == Scatter::Kind::Diffuse || sc.kind == Scatter::Kind::Glossy ? sc.f : Vec3(0.0f));
+  out.burley = sc.burley;
+  out.retro = sc.retro;
+  return out;
+}
+
 Scatter coated(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx, const Vec3& albedo, float scale,
                float u) {
+  if (!m.layered) return clearcoated(m, s, ctx, albedo, scale, u);
   const float v = u < 0.0f ? ctx.lobe_uniform() : u;
   GlossyLobe coat = oriented_lobe(s, m.coat_roughness, m.shadowing);
   coat.fresnel = LobeFresnel::Dielectric;

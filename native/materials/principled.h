@@ -36,7 +36,7 @@
 // hit (principled.cpp): 4.0+ sqrt(base) on each transmission and Specular Tint on the reflection,
 // 3.x the base colour on the refraction.
 //
-// Coat (4.0+ only; 3.x's Clearcoat is noted by the add-on): coat_weight (0, clamped to [0, 1]),
+// Coat (4.0+): coat_weight (0, clamped to [0, 1]),
 // coat_roughness (0.03), coat_ior (1.5, >= 1), coat_tint ((1, 1, 1)): a GGX dielectric layer over
 // everything opaque, as Cycles 4.0+ puts it there (materials/coat.h): its lobe weighted
 // coat_weight and always energy-compensated, the layers below scaled by 1 - coat_weight x
@@ -46,6 +46,8 @@
 // the layers' lobes is drawn per hit (the coat with probability coat_weight / 2), its weight
 // divided by that probability; the diffuse base gets its direct light on either draw. The glass
 // of Transmission is not coated (noted by the add-on).
+// With layered False (3.x) coat_weight and coat_roughness are 3.x's Clearcoat and Clearcoat
+// Roughness: Cycles 3.x's GTR1 lobe added beside the rest, nothing attenuated (materials/clearcoat.h).
 #pragma once
 
 #include "core/params.h"
@@ -65,7 +67,7 @@ struct Principled {
       "specular_tint ((1, 1, 1)), multiscatter (True), layered (True; False: Blender 3.x's sum),\n"
       "shadowing ('correlated'; 'separable': 3.x), metallic (0), burley (False; True: 3.x's diffuse),\n"
       "transmission (0), transmission_ior (the ior), coat_weight (0), coat_roughness (0.03), coat_ior (1.5),\n"
-      "coat_tint ((1, 1, 1); the coat: 4.0+ only): the Principled BSDF";
+      "coat_tint ((1, 1, 1); with layered False: 3.x's Clearcoat and its roughness): the Principled BSDF";
   Lambert base;
   float roughness = 0.5f;  // in [0, 1]
   bool multiscatter = true;

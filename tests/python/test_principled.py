@@ -186,5 +186,16 @@ def test_coated_metal_and_bad_coats():
     assert np.all(np.isfinite(coated)) and coated.sum() != bare.sum()
     with pytest.raises(ValueError, match="coat_weight"):
         floor(coat_weight=float("nan"))
-    with pytest.raises(ValueError, match="layered"):
-        floor(coat_weight=0.5, layered=False, burley=True, shadowing="separable")
+
+
+
+def test_3x_clearcoat_head_on_is_a_quarter_of_its_weight_times_f0_times_gtr1():
+    # Blender 3.x's Clearcoat (layered False: coat_weight is it) over a black base with no layer:
+    # head-on under a point lamp, f = 0.25 x Clearcoat x F0(1.5) x D G1 G1 / 4, with GTR1's
+    # D(n) = 1 / pi at Clearcoat Roughness 1 and the masking 1 at the normal. Drawn in half the
+    # samples (probability Clearcoat / 2) at twice its weight: exact over 16 stratified samples.
+    common = dict(color=(0.0, 0.0, 0.0), roughness=0.5, ior=1.0, layered=False, burley=True, multiscatter=False,
+                  shadowing="separable", coat_roughness=1.0)
+    np.testing.assert_allclose(floor(coat_weight=1.0, **common), 0.25 * 0.04 / (4 * math.pi) * IRRADIANCE,
+                               rtol=1e-4)
+    np.testing.assert_array_equal(floor(coat_weight=0.0, **common), 0.0)
