@@ -106,6 +106,18 @@ bool close_to(const EmissiveTriangle& t, float height) {
   return longest2 > height * height;
 }
 
+// The barycentrics (along e1, e2) of a point in t's plane: the solid-angle sampler finds the
+// point, not its coordinates.
+Vec2 barycentrics(const EmissiveTriangle& t, const Vec3& point) {
+  const Vec3 d = point - t.p0;
+  const float a = glm::dot(t.e1, t.e1), b = glm::dot(t.e1, t.e2), c = glm::dot(t.e2, t.e2);
+  const float x = glm::dot(d, t.e1), y = glm::dot(d, t.e2);
+  const float det = a * c - b * b;
+  if (!(det > 0.0f)) return Vec2(1.0f / 3.0f);
+  const Vec2 r((c * x - b * y) / det, (a * y - b * x) / det);
+  return glm::clamp(r, Vec2(0.0f), Vec2(1.0f));
+}
+
 }  // namespace
 
 float emitter_probability(const MeshEmitters& emitters, const Vec3& p, const Vec3& n, size_t index) {
@@ -131,7 +143,8 @@ float emitter_pdf(const MeshEmitters& emitters, const Vec3& p, const Vec3& n, si
   return cos_light > 0.0f ? chosen * distance * distance / (t.area * cos_light) : 0.0f;
 }
 
-LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const Vec3& normal, const Vec2& u) {
+LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const Vec3& normal, const Vec2& u,
+                            EmitterPoint* where) {
   LightSample s;
   const size_t n = emitters.triangles.size();
   if (n == 0) return s;
@@ -167,6 +180,7 @@ LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const V
       s.point = p + s.distance * s.wi;
       s.pdf = width / float(st.solid_angle);
       s.radiance = t.radiance;
+      if (where != nullptr && t.textured) *where = EmitterPoint{i, barycentrics(t, s.point)};
       s.point = offset_ray_origin(s.point, cos_light > 0.0f ? t.normal : -t.normal);
       return s;
     }
@@ -182,6 +196,7 @@ LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const V
   if (cos_light == 0.0f || (cos_light > 0.0f) != (height > 0.0f)) return s;
   s.pdf = width * d2 / (t.area * std::fabs(cos_light));
   s.radiance = t.radiance;
+  if (where != nullptr) *where = EmitterPoint{i, b};
   // The shadow ray ends at `point`: moved off the triangle towards p, so the emitter's own
   // surface (at t = 1 up to rounding) cannot block it.
   s.point = offset_ray_origin(s.point, cos_light > 0.0f ? t.normal : -t.normal);

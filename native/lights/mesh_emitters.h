@@ -54,9 +54,20 @@ enum class EmitterSides : uint8_t { Both = 3, Front = 1, Back = 2 };
 struct EmissiveTriangle {
   Vec3 p0{0.0f}, e1{0.0f}, e2{0.0f};  // world space: p0, p1 - p0, p2 - p0
   Vec3 normal{0.0f};                  // unit, (e1 x e2) / |e1 x e2|: the front side
+  // Its uniform radiance; for a textured one (an image on the emission colour) an estimate of its
+  // mean, which weighs it among the others: the scene evaluates the image where a sample lands
+  // (EmitterPoint, Scene::emitted_at).
   Vec3 radiance{0.0f};
   float area = 0.0f;
   EmitterSides sides = EmitterSides::Both;
+  bool textured = false;
+};
+
+// Where sample_emitters() landed: the triangle's index and the point's barycentrics (b.x along
+// e1, b.y along e2), for the emission of a textured triangle.
+struct EmitterPoint {
+  size_t index = 0;
+  Vec2 b{0.0f};
 };
 
 // What a light tree weighs a triangle by, as each lamp type provides (lights/light.h): its
@@ -92,7 +103,9 @@ struct MeshEmitters {
 // A point on one emissive triangle seen from p with normal n (n = 0: no receiver cosine; the tree
 // weighs by it) (u: two uniform numbers, the first also choosing the triangle). No sample when
 // the chosen triangle faces away on a side it does not emit to.
-LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const Vec3& n, const Vec2& u);
+// `where` (optional) receives the triangle and point of a valid sample.
+LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const Vec3& n, const Vec2& u,
+                           EmitterPoint* where = nullptr);
 
 // The probability that sample_emitters() chooses triangle `index` at (p, n): its power / the
 // total, or the tree's probability (the same floats select() returned).

@@ -50,11 +50,13 @@ void PyScene::clear_instances() {
 namespace {
 
 // The emission every material kind accepts (materials/emission.h), read before the kind reads
-// its own parameters: emission (linear RGB radiance, colour x strength) and emission_sampling
+// its own parameters: emission (linear RGB radiance, colour x strength), emission_texture (-1:
+// none; else the colour's image, emission its strength) and emission_sampling
 // (Blender 4.x's names: 'NONE', 'AUTO', 'FRONT', 'BACK', 'FRONT_AND_BACK'; AUTO samples both).
 MaterialEmission emission_of(const Params& params) {
   MaterialEmission e;
   e.radiance = params.color("emission", e.radiance);
+  e.texture = int32_t(params.integer("emission_texture", e.texture));
   const std::string sampling = params.text("emission_sampling", "AUTO");
   if (sampling == "NONE")
     e.sampled = false;

@@ -147,9 +147,13 @@ template <bool kBurley>
   const MeshEmitters& emitters = scene.emitters();
   Vec3 sum(0.0f);
   if (!emitters.empty()) {
-    const LightSample ls =
+    EmitterPoint where;
+    LightSample ls =
         sample_emitters(emitters, p, at.ns,
-                        sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 3), settings.seed));
+                        sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 3), settings.seed),
+                        &where);
+    if (ls.valid() && emitters.triangles[where.index].textured)  // its image, where the sample landed
+      ls.radiance = scene.emitted_at(emitters.keys[where.index], where.b);
     if (ls.valid()) {
       const float cos_s = glm::dot(at.ns, ls.wi);
       Vec3 tr(1.0f);
@@ -170,14 +174,16 @@ template <bool kBurley>
   const int32_t m = hit.found() ? material_of(scene, hit) : -1;
   if (m < 0 || size_t(m) >= scene.emission().size() || !scene.emission()[size_t(m)].emits()) return sum;
   const MaterialEmission& e = scene.emission()[size_t(m)];
+  const uint64_t key = uint64_t(uint32_t(hit.instance)) << 32 | uint64_t(uint32_t(hit.prim));
+  const Vec3 radiance = e.texture < 0 ? e.radiance : scene.emitted_at(key, Vec2(hit.u, hit.v));
   // Not among the sampled triangles (emission sampling None): the cosine ray alone finds it.
-  const int64_t index = emitters.index_of(uint64_t(uint32_t(hit.instance)) << 32 | uint64_t(uint32_t(hit.prim)));
+  const int64_t index = emitters.index_of(key);
   float pl = 0.0f;
   if (index >= 0) {
     const EmissiveTriangle& t = emitters.triangles[size_t(index)];
     pl = emitter_pdf(emitters, p, at.ns, size_t(index), wi, glm::dot(t.p0 + hit.u * t.e1 + hit.v * t.e2 - p, wi));
   }
-  return sum + diffuse_f<kBurley>(at, retro, wi) * e.radiance * tr * mis_cos_over_pdf(c.cos, c.cos * kInvPi, pl);
+  return sum + diffuse_f<kBurley>(at, retro, wi) * radiance * tr * mis_cos_over_pdf(c.cos, c.cos * kInvPi, pl);
 }
 
 // Light arriving at a diffuse point: one sample per light, or one light chosen by contribution.
@@ -333,8 +339,9 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     // A camera or specular ray sees an emitting surface's radiance (both sides, as Cycles' mesh
     // lights); its BSDF (black for a pure Emission shader) still scatters below.
     if (scene.any_emission() && s.material >= 0 && size_t(s.material) < materials.size()) {
-      radiance += throughput * scene.emission()[size_t(s.material)].radiance;
-      if (first) first->emission += scene.emission()[size_t(s.material)].radiance;
+      const Vec3 glow = emitted(scene.emission()[size_t(s.material)], scene.textures(), s.uv);
+      radiance += throughput * glow;
+      if (first) first->emission += glow;
     }
     if constexpr (kCutOuts) {
       if (cut.ends_here()) break;

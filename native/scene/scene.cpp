@@ -109,7 +109,7 @@ void check_texture_id(const Material& m, size_t textures) {
 uint32_t Scene::add_material(const Material& material, const MaterialEmission& emission,
                              const MaterialTransparency& transparency, const MaterialNormalMap& normal_map) {
   check_texture_id(material, textures_.size());
-  emission.check();
+  emission.check(textures_.size());
   transparency.check(textures_.size());
   normal_map.check(textures_.size());
   materials_.push_back(material);
@@ -131,7 +131,7 @@ void Scene::set_material(int64_t material, const Material& replacement, const Ma
   if (material < 0 || size_t(material) >= materials_.size())
     throw std::invalid_argument("unknown material id " + std::to_string(material));
   check_texture_id(replacement, textures_.size());
-  emission.check();
+  emission.check(textures_.size());
   transparency.check(textures_.size());
   normal_map.check(textures_.size());
   materials_[size_t(material)] = replacement;
@@ -187,6 +187,10 @@ void Scene::set_texture(int64_t texture, Texture replacement) {
   if (texture < 0 || size_t(texture) >= textures_.size())
     throw std::invalid_argument("unknown texture id " + std::to_string(texture));
   textures_[size_t(texture)] = std::move(replacement);
+  // Emissive triangles weigh textured ones by their pixels (Scene::gather_emitters).
+  if (std::any_of(emission_.begin(), emission_.end(),
+                  [&](const MaterialEmission& e) { return e.texture == texture && e.emits(); }))
+    committed_ = false;
   // The environment's sampling grid was made from the old pixels.
   const Environment& env = world_.environment;
   if (env.texture == texture) set_environment(texture, env.strength, env.to_map);

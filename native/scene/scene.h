@@ -206,6 +206,11 @@ class Scene {
   // blocker sets `blockers` (light linking).
   Hit intersect_shadow_casters(const Ray& ray, uint64_t blockers = kAllLightSets) const;
   const MeshEmitters& emitters() const { return emitters_; }  // the sampled emissive triangles, by commit()
+  // What the emissive triangle of `key` (instance << 32 | triangle, MeshEmitters::keys) emits at
+  // barycentrics b (along its second and third corners), its image read at the UV there; and
+  // that UV ((0, 0) for a mesh without UVs).
+  Vec3 emitted_at(uint64_t key, const Vec2& b) const;
+  Vec2 emitter_uv(uint64_t key, const Vec2& b) const;
   // From how many sampled emissive triangles, spanning what share of the scene's diagonal, the
   // next commits pick them through a light tree (kEmitterTreeFrom, kEmitterTreeSpread; benchmarks
   // set them to compare the tree with the power CDF).
