@@ -124,13 +124,19 @@ def metal(name, color, roughness):
     return mat
 
 
-def emission(name, color, strength=1.0, sampling=None):
+def emission(name, color, strength=1.0, sampling=None, image=None):
     """An Emission shader: a surface of radiance colour x strength on both sides, black itself.
     sampling: whether Cycles samples it as a light (4.x+ emission_sampling names; 3.x reads
-    'NONE' as sample_as_light off); None leaves Blender's default (sampled)."""
+    'NONE' as sample_as_light off); None leaves Blender's default (sampled). image: the colour
+    is this image's (an Image Texture node's Color)."""
     mat, node = surface(name, "ShaderNodeEmission")
     node.inputs["Color"].default_value = (*color, 1.0)
     node.inputs["Strength"].default_value = strength
+    if image is not None:
+        tex = mat.node_tree.nodes.new("ShaderNodeTexImage")
+        tex.image = image
+        tex.interpolation, tex.extension = "Linear", "REPEAT"
+        mat.node_tree.links.new(tex.outputs["Color"], node.inputs["Color"])
     if sampling is not None:
         if hasattr(mat.cycles, "emission_sampling"):
             mat.cycles.emission_sampling = sampling

@@ -146,12 +146,20 @@ def general_mix(name, node, notes, convert):
     # Cycles weights it; by a factor that varies over the surface, with its constant value, noted.
     w = (1.0, 1.0) if add else (1.0 - fac, fac)
     emission = [0.0, 0.0, 0.0]
-    for weight, spec in zip(w, parts):
-        if spec is not None:
-            emission = [e + weight * c for e, c in zip(emission, spec.emission)]
+    emitting = [(weight, spec) for weight, spec in zip(w, parts)
+                if spec is not None and weight > 0.0 and any(c > 0.0 for c in spec.emission)]
+    for weight, spec in emitting:
+        emission = [e + weight * c for e, c in zip(emission, spec.emission)]
+    # An image on one input's emission colour stays the slot's; beside another input's emission
+    # the slot has one image or none: the strengths alone, noted.
+    glow = emitting[0][1].emission_texture if len(emitting) == 1 else None
+    if len(emitting) > 1 and any(spec.emission_texture is not None for _, spec in emitting):
+        notes.append(f"material '{name}': an emission image beside another emission in a Mix (white x strength)")
     if source != "constant" and any(c > 0.0 for c in emission):
         notes.append(f"material '{name}': emission inside a Mix with a varying factor (weighted by its constant value)")
-    parts = tuple(replace(p, emission=(0.0, 0.0, 0.0)) if p is not None else None for p in parts)
+    parts = tuple(replace(p, emission=(0.0, 0.0, 0.0), emission_texture=None) if p is not None else None
+                  for p in parts)
     spec = MaterialSpec("mix", color=(0.0, 0.0, 0.0), mix_inputs=parts, mix_add=add, mix_fac=fac,
-                        mix_fac_source=source, mix_fac_texture=key, mix_fac_param=param, emission=tuple(emission))
+                        mix_fac_source=source, mix_fac_texture=key, mix_fac_param=param, emission=tuple(emission),
+                        emission_texture=glow)
     return spec, MixImages(tuple(images))

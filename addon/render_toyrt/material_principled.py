@@ -8,11 +8,11 @@ from __future__ import annotations
 from dataclasses import replace
 
 from .material_dielectric import ior_value
+from .material_emission import emission_of
 from .materials import (
     _blender_version,
     _color_material,
     _constant,
-    _emission,
     _finite_color,
     input_socket,
 )
@@ -35,8 +35,7 @@ def principled_spec(name, node, notes):
         sock = input_socket(node, *names)
         if sock is not None and (sock.is_linked or sock.default_value > 0.0):
             extras.append(label)
-    emission = _emission(name, input_socket(node, "Emission Color", "Emission"),  # 4.0+ / 3.x
-                         input_socket(node, "Emission Strength"), notes)
+    emission, emission_key = emission_of(name, node, notes)
     base, image = _color_material(name, input_socket(node, "Base Color"), notes)
     if base.texture is None:
         base = replace(base, color=_finite_color(name, base.color, "base colour", notes))
@@ -57,7 +56,7 @@ def principled_spec(name, node, notes):
         layer = dict(roughness=0.5, ior=1.0, multiscatter=False, shadowing="correlated" if new else "separable",
                      layered=new, burley=not new)
     spec = base if layer is None else replace(base, kind="principled", metallic=metallic, **layer, **glass, **coat)
-    return replace(spec, emission=emission), image
+    return replace(spec, emission=emission, emission_texture=emission_key), image
 
 
 def _color_socket(name, node, socket, notes) -> tuple[float, float, float]:
@@ -203,6 +202,5 @@ def _metal(name, node, notes):
         layer = dict(ior=(1.0 + root) / (1.0 - root), multiscatter=False, shadowing="separable", layered=False)
     coat = _coat(name, node, {}, notes) or _clearcoat(name, node, notes)
     spec = replace(base, kind="principled", roughness=rough, metallic=1.0, **layer, **coat)
-    emission = _emission(name, input_socket(node, "Emission Color", "Emission"),
-                         input_socket(node, "Emission Strength"), notes)
-    return replace(spec, emission=emission), image
+    emission, emission_key = emission_of(name, node, notes)
+    return replace(spec, emission=emission, emission_texture=emission_key), image

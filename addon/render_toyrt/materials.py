@@ -67,6 +67,7 @@ class MaterialSpec:
     coat_tint: tuple[float, float, float] = (1.0, 1.0, 1.0)
     emission: tuple[float, float, float] = (0.0, 0.0, 0.0)   # colour x strength, linear radiance
     emission_sampling: str = "AUTO"                           # Blender 4.x's names (3.x: AUTO or NONE)
+    emission_texture: ImageKey | None = None                 # the emission colour's image (emission: its strength)
     fresnel: str = "microfacet"                              # 'glass': 4.0+'s per microfacet, 3.x's 'macro'
     distribution: str = "ggx"                                # 'glass', 'refraction': or 'beckmann'
     # The part rays pass through (material_alpha.py, the core's materials/transparency.h): the
@@ -93,10 +94,13 @@ class MaterialSpec:
     def transparent(self) -> bool:
         return self.opacity < 1.0 or self.opacity_texture is not None or self.opacity_invert
 
-    def arguments(self, texture_id: int = -1, opacity_texture_id: int = -1, normal_texture_id: int = -1) -> dict:
+    def arguments(self, texture_id: int = -1, opacity_texture_id: int = -1, normal_texture_id: int = -1,
+                  emission_texture_id: int = -1) -> dict:
         """Keyword arguments of toyrt.Scene.add_material / set_material, with the textures' ids."""
         args = dict(kind=self.kind, color=self.color, texture=texture_id, ior=self.ior, emission=self.emission,
                     emission_sampling=self.emission_sampling)
+        if self.emission_texture is not None:
+            args["emission_texture"] = emission_texture_id
         if self.normal_map is not None:
             args.update(self.normal_map.arguments(normal_texture_id))
         if self.transparent:
@@ -134,6 +138,7 @@ class ConvertedMaterial:
     image: object = field(default=None, compare=False)
     opacity_image: object = field(default=None, compare=False)   # the image opacity_texture reads
     normal_image: object = field(default=None, compare=False)    # the image the normal map reads
+    emission_image: object = field(default=None, compare=False)  # the image the emission colour reads
 
 
 def material_spec(mat) -> ConvertedMaterial:
@@ -150,7 +155,9 @@ def material_spec(mat) -> ConvertedMaterial:
     if bent is not None:
         lift = spec.kind != "diffuse" or _blender_version() < (4, 0, 0)   # 4.x+ lifts glossy normals only
         spec = replace(spec, normal_map=replace(bent, lift=lift))
-    return ConvertedMaterial(spec, tuple(dict.fromkeys(notes)), image, opacity_image, normal_image)
+    from .material_emission import emission_image
+    return ConvertedMaterial(spec, tuple(dict.fromkeys(notes)), image, opacity_image, normal_image,
+                             emission_image(mat, spec.emission_texture))
 
 
 @dataclass(frozen=True)
@@ -169,17 +176,6 @@ def _emission_sampling(mat) -> str:
     if isinstance(sampling, str):
         return sampling
     return "AUTO" if getattr(cycles, "sample_as_light", True) else "NONE"
-
-
-def _emission(name, color, strength, notes) -> tuple[float, float, float]:
-    """Colour x strength of an Emission shader's or a Principled BSDF's emission sockets, as
-    constants (a linked socket: its constant value, noted)."""
-    if color is None:
-        return (0.0, 0.0, 0.0)
-    if color.is_linked or (strength is not None and strength.is_linked):
-        notes.append(f"material '{name}': linked emission colour or strength (its constant value)")
-    k = float(strength.default_value) if strength is not None else 1.0
-    return tuple(max(0.0, c * k) for c in rgb(color.default_value))
 
 
 def image_key(image) -> ImageKey:
@@ -343,8 +339,9 @@ def _convert_node(name, node, notes):
             return mixed
     if t == "EMISSION":
         # Emission alone has no BSDF: a black surface that glows (Cycles).
-        emission = _emission(name, input_socket(node, "Color"), input_socket(node, "Strength"), notes)
-        return MaterialSpec("diffuse", color=(0.0, 0.0, 0.0), emission=emission), None
+        from .material_emission import emission_of
+        emission, key = emission_of(name, node, notes)
+        return MaterialSpec("diffuse", color=(0.0, 0.0, 0.0), emission=emission, emission_texture=key), None
     if t == "BSDF_REFRACTION":
         return dielectric_spec(name, node, "refraction", "Refraction", notes), None
     if t == "BSDF_GLASS":

@@ -78,9 +78,11 @@ class MaterialSync:
         spec = converted.spec
         texture, opacity = spec.texture, spec.opacity_texture
         bent = spec.normal_map.texture if spec.normal_map is not None else None
+        glow = spec.emission_texture
         args = spec.arguments(self._texture_id(texture, converted.image) if texture is not None else -1,
                               self._texture_id(opacity, converted.opacity_image) if opacity is not None else -1,
-                              self._texture_id(bent, converted.normal_image) if bent is not None else -1)
+                              self._texture_id(bent, converted.normal_image) if bent is not None else -1,
+                              self._texture_id(glow, converted.emission_image) if glow is not None else -1)
         if spec.kind == "mix":
             images = dict(converted.image.images) if isinstance(converted.image, MixImages) else {}
             parts = iter(self.mix_parts.get(name, ()))
@@ -166,14 +168,15 @@ class MaterialSync:
                     if spec.kind == "mix":
                         # Its inputs are materials of their own: convert it again, all sent anew.
                         import bpy
-                        mat = bpy.data.materials.get(name) if key in _mix_keys(spec) or key == bent else None
+                        mat = (bpy.data.materials.get(name)
+                               if key in _mix_keys(spec) or key in (bent, spec.emission_texture) else None)
                         if mat is not None:
                             self.scene.set_material(mid, **self._material_arguments(materials.material_spec(mat),
                                                                                     name))
                         continue
-                    if key in (spec.texture, spec.opacity_texture, bent):
+                    if key in (spec.texture, spec.opacity_texture, bent, spec.emission_texture):
                         ids = [self.textures.get(k, -1) if k is not None else -1
-                               for k in (spec.texture, spec.opacity_texture, bent)]
+                               for k in (spec.texture, spec.opacity_texture, bent, spec.emission_texture)]
                         self.scene.set_material(mid, **spec.arguments(*ids))
             else:
                 self.scene.set_texture(tid, pixels, srgb=key.srgb)
@@ -193,7 +196,8 @@ def _mix_keys(spec) -> set:
 
 def _texture_keys(spec):
     """Every image key a spec reads: its own textures and, for a mix, its inputs' and factor's."""
-    own = (spec.texture, spec.opacity_texture, spec.normal_map.texture if spec.normal_map is not None else None)
+    own = (spec.texture, spec.opacity_texture, spec.normal_map.texture if spec.normal_map is not None else None,
+           spec.emission_texture)
     yield from (k for k in own if k is not None)
     if spec.mix_fac_texture is not None:
         yield spec.mix_fac_texture

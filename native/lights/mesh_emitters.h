@@ -105,7 +105,7 @@ struct MeshEmitters {
 // the chosen triangle faces away on a side it does not emit to.
 // `where` (optional) receives the triangle and point of a valid sample.
 LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const Vec3& n, const Vec2& u,
-                           EmitterPoint* where = nullptr);
+                            EmitterPoint* where = nullptr);
 
 // The probability that sample_emitters() chooses triangle `index` at (p, n): its power / the
 // total, or the tree's probability (the same floats select() returned).

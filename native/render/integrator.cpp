@@ -148,10 +148,9 @@ template <bool kBurley>
   Vec3 sum(0.0f);
   if (!emitters.empty()) {
     EmitterPoint where;
-    LightSample ls =
-        sample_emitters(emitters, p, at.ns,
-                        sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 3), settings.seed),
-                        &where);
+    LightSample ls = sample_emitters(
+        emitters, p, at.ns, sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 3), settings.seed),
+        &where);
     if (ls.valid() && emitters.triangles[where.index].textured)  // its image, where the sample landed
       ls.radiance = scene.emitted_at(emitters.keys[where.index], where.b);
     if (ls.valid()) {

@@ -44,7 +44,7 @@ void Scene::gather_emitters() {
   emitters_ = MeshEmitters{};
   if (std::none_of(emission_.begin(), emission_.end(),
                    [](const MaterialEmission& e) { return e.emits() && e.sampled; }))
-    return;  // a scene without sampled emitters pays nothing here
+    return;                                                // a scene without sampled emitters pays nothing here
   std::vector<Vec3> means(textures_.size(), Vec3(-1.0f));  // per texture, once some emitter reads it
   for (size_t i = 0; i < instances_.size(); ++i) {
     const Instance& inst = instances_[i];
@@ -80,8 +80,8 @@ void Scene::gather_emitters() {
         // it emits); the sample itself reads the image where it lands.
         Vec3& whole = means[size_t(e.texture)];
         if (whole.x < 0.0f) whole = texture_mean(textures_[size_t(e.texture)]);
-        static constexpr float kPoints[7][2] = {{0, 0},       {1, 0},       {0, 1},        {0.5f, 0},
-                                                {0.5f, 0.5f}, {0, 0.5f},    {1 / 3.0f, 1 / 3.0f}};
+        static constexpr float kPoints[7][2] = {
+            {0, 0}, {1, 0}, {0, 1}, {0.5f, 0}, {0.5f, 0.5f}, {0, 0.5f}, {1 / 3.0f, 1 / 3.0f}};
         Vec3 local(0.0f);
         for (const auto& q : kPoints) local += emitted_at(key, Vec2(q[0], q[1]));
         et.radiance = 0.5f * (local / 7.0f + e.radiance * whole);

@@ -177,7 +177,8 @@ def scene_emitters(p):
     # triangles), and (with transmission) a glass sphere the panel is seen through.
     kit.plane("floor", 8.0, kit.diffuse("white", (0.8, 0.8, 0.8)))
     kit.box("occluder", 0.5, (0.6, 0.3, 0.25), kit.diffuse("grey", (0.5, 0.5, 0.5)))
-    panel = kit.plane("panel", 1.2, kit.emission("glow", (1.0, 0.85, 0.6), p["strength"], p["sampling"]),
+    image = stripes("stripes", 16) if p.get("image") else None
+    panel = kit.plane("panel", 1.2, kit.emission("glow", (1.0, 0.85, 0.6), p["strength"], p["sampling"], image),
                       (-0.4, 0.6, 1.6))
     panel.rotation_euler = (0.5, 0.3, 0.0)
     kit.uv_sphere("glowing_ball", 0.3, (-1.2, -0.6, 0.3), kit.emission("ball_glow", (0.2, 0.5, 1.0), 2.0))
@@ -185,6 +186,15 @@ def scene_emitters(p):
         kit.uv_sphere("ball", 0.5, (0.0, -0.8, 0.5), kit.glass("glass", 1.45))
     camera(p["camera"], (0, 0, 0.3))
     kit.world((0, 0, 0))
+
+
+def stripes(name, n):
+    """An 8-bit sRGB n x n image: warm, cool and dark vertical stripes, a brighter band across."""
+    u = (np.arange(n) + 0.5) / n
+    colors = np.array([(1.0, 0.7, 0.3), (0.3, 0.6, 1.0), (0.05, 0.05, 0.05)])
+    rgb = np.broadcast_to(colors[(np.arange(n) * 3) // n][None, :, :], (n, n, 3)).copy()
+    rgb[(u > 0.6) & (u < 0.8)] = np.minimum(rgb[(u > 0.6) & (u < 0.8)] * 1.6, 1.0)
+    return kit.image(name, np.concatenate([rgb, np.ones((n, n, 1))], axis=2))
 
 
 def sky_image(width, height, sun_elevation, sun_azimuth, sun_radiance):
@@ -320,6 +330,10 @@ SCENES_SPEC = [
     # Emissive meshes: sampled as lights, seen directly and (second scene) through glass; and an
     # emitter Cycles does not sample (emission sampling None), which lights nothing.
     ("emitters", scene_emitters, dict(strength=6.0, sampling=None, glass=False, camera=(0.5, -5.5, 3.0)), 0),
+    # An Emission panel whose colour is an image (8-bit sRGB stripes): seen directly, and lighting
+    # the floor and the box by its pixels where shadow rays land on it.
+    ("emitters_textured", scene_emitters, dict(strength=6.0, sampling=None, glass=False, image=True,
+                                               camera=(0.5, -5.5, 3.0)), 0),
     ("emitters_through_glass", scene_emitters, dict(strength=6.0, sampling=None, glass=True,
                                                     camera=(0.5, -5.5, 3.0)), 8),
     # Not sampled as a light, Cycles' emitter still lights the floor through the BSDF-sampled ray

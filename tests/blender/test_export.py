@@ -392,6 +392,50 @@ def test_missing_texture():
           f"the placeholder is magenta: mean lit pixel R {r:.4f} G {g:.6f} B {b:.4f}")
 
 
+def test_emission_image():
+    """An Image Texture's Color on an Emission shader's Color: the strength times the image, seen
+    directly pixel for pixel; on a Principled BSDF's Emission Color the same spec; from the
+    texture's Alpha output the constant colour, noted."""
+    sync, toyrt = addon()
+    from render_toyrt import materials
+    scene = clear_scene()
+    px = np.zeros((1, 16, 4), np.float32)
+    px[..., 3] = 1.0
+    px[0, :8, 0] = 1.0      # the left half red, the right half blue (linear, a float image)
+    px[0, 8:, 2] = 1.0
+    image = kit.image("halves", px, float_buffer=True)
+    kit.plane("screen", 2.0, material=kit.emission("screen", (0.3, 0.3, 0.3), 2.0, image=image))
+    ortho_camera(2.0, resolution=(8, 8))
+    scene.toyrt.samples = 1
+    c = materials.material_spec(bpy.data.materials["screen"])
+    check(c.spec.emission == (2.0, 2.0, 2.0) and c.spec.emission_texture is not None
+          and c.spec.emission_texture.name == image.name_full and c.emission_image == image and not c.notes,
+          f"the Emission shader's colour is the image, its strength the emission: {c.spec.emission}, "
+          f"{c.spec.emission_texture}, {c.notes}")
+    path = os.path.join(tempfile.mkdtemp(dir=TMP), "screen.exr")
+    result, _ = render_to(path)
+    shown = kit.read_image(path)[..., :3]
+    # Columns 1 and 6: u = 0.19 and 0.81, texel centres 2.5 and 12.5 (no blend with the other half).
+    check(result == {"FINISHED"} and np.allclose(shown[:, 1], (2.0, 0.0, 0.0), atol=1e-4)
+          and np.allclose(shown[:, 6], (0.0, 0.0, 2.0), atol=1e-4),
+          f"seen directly: 2 x red on the left, 2 x blue on the right: {shown[4, 1]}, {shown[4, 6]}")
+
+    mat = kit.principled("glowing", (0.5, 0.5, 0.5))
+    node = mat.node_tree.nodes["Principled BSDF"]
+    tex = mat.node_tree.nodes.new("ShaderNodeTexImage")
+    tex.image = image
+    mat.node_tree.links.new(tex.outputs["Color"], kit.input_of(node, "Emission Color", "Emission"))
+    node.inputs["Emission Strength"].default_value = 3.0
+    p = materials.material_spec(mat)
+    check(p.spec.emission == (3.0, 3.0, 3.0) and p.spec.emission_texture == c.spec.emission_texture
+          and p.emission_image == image,
+          f"Principled Emission Color from the image: {p.spec.emission}, {p.spec.emission_texture}")
+    mat.node_tree.links.new(tex.outputs["Alpha"], kit.input_of(node, "Emission Color", "Emission"))
+    a = materials.material_spec(mat)
+    check(a.spec.emission_texture is None and any("emission colour from" in n for n in a.notes),
+          f"from the Alpha output: the constant colour, noted: {a.notes}")
+
+
 # ---- 4. an unsupported shader node --------------------------------------------------------------
 
 def test_unsupported_node():
@@ -731,7 +775,8 @@ def test_command_line_range():
         print(run.stdout[-2000:], run.stderr[-2000:])
 
 
-PARTS = [test_counts_and_transforms, test_instancing_memory, test_missing_texture, test_unsupported_node,
+PARTS = [test_counts_and_transforms, test_instancing_memory, test_missing_texture, test_emission_image,
+         test_unsupported_node,
          test_mix_shader, test_principled_specular_layer, test_principled_transmission, test_glass_color,
          test_rough_glass_and_refraction, test_cancel, test_animation, test_command_line_range]
 run_script(PARTS, "export", TMP)

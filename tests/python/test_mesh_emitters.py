@@ -125,3 +125,36 @@ def test_a_mesh_without_material_ids_is_default_grey_and_emits_nothing():
     assert s.last_commit["emitter_tree_nodes"] == 0
     img = s.render(camera_above(height=0.25, size=0.002, resolution=2), samples=16)
     assert not img[..., :3].any()
+
+
+def textured_square(pixels, strength=2.0):
+    """lit_floor's scene (a = 1 m at h = 0.5) with the square's colour an image over uv [0, 1]^2."""
+    s = toyrt.Scene()
+    s.add_material("diffuse", color=(1.0, 1.0, 1.0))
+    tex = s.add_texture(np.asarray(pixels, np.float32), srgb=False)
+    s.add_material("diffuse", color=(0.0, 0.0, 0.0), emission=(strength,) * 3, emission_texture=tex)
+    fv, ft = grid(1, 40.0, 0.0)
+    s.add_mesh(fv, ft, material_ids=0)
+    ev, et = grid(4, 1.0, 0.5)
+    s.add_mesh(ev, et, uvs=ev[:, :2] + 0.5, material_ids=1)
+    s.commit()
+    return s, tex
+
+
+def test_an_emission_image_lights_as_its_colour_and_an_edit_of_its_pixels_lights_anew():
+    # A uniform image of colour c emits strength x c: the closed form pi L F per channel. New
+    # pixels (a quarter as bright) weigh the triangles anew at the next commit: a quarter the light.
+    c = np.array([0.25, 0.5, 1.0], np.float32)
+    s, tex = textured_square(np.broadcast_to(c, (2, 2, 3)))
+    cam = camera_above(height=0.25, size=0.002, resolution=2)
+    expected = 2.0 * c * square_irradiance_over_radiance(1.0, 0.5) / np.pi
+    np.testing.assert_allclose(s.render(cam, samples=1024)[..., :3].mean(axis=(0, 1)), expected, rtol=0.01)
+    s.set_texture(tex, np.broadcast_to(c / 4, (2, 2, 3)).astype(np.float32), srgb=False)
+    s.commit()
+    np.testing.assert_allclose(s.render(cam, samples=1024)[..., :3].mean(axis=(0, 1)), expected / 4, rtol=0.01)
+
+
+def test_an_unknown_emission_texture_is_refused():
+    s = toyrt.Scene()
+    with pytest.raises(ValueError, match="emission_texture"):
+        s.add_material("diffuse", emission=(1.0, 1.0, 1.0), emission_texture=3)
