@@ -49,6 +49,18 @@ MaterialNormalMap MaterialNormalMap::from_params(const Params& params) {
                 : shadowing == "chiang" ? BumpShadowing::Chiang
                                         : BumpShadowing::None;
   n.lift = params.flag("normal_lift", n.lift);
+  const int64_t bump = params.integer("bump_map", -1);
+  if (bump >= 0 || params.has("bump_strength") || params.has("bump_distance") || params.has("bump_channel")) {
+    if (n.texture >= 0) throw std::invalid_argument("a material takes a normal_map or a bump_map, not both");
+    n.texture = int32_t(bump);
+    n.bump = true;
+    n.strength = float(params.number("bump_strength", 1.0));
+    n.distance = float(params.number("bump_distance", 1.0));
+    const std::string channel = params.text("bump_channel", "gray");
+    if (channel != "gray" && channel != "alpha")
+      throw std::invalid_argument("bump_channel must be 'gray' or 'alpha', got '" + channel + "'");
+    n.bump_alpha = channel == "alpha";
+  }
   return n;
 }
 
@@ -75,7 +87,7 @@ Vec3 tangent_space_normal(const MaterialNormalMap& map, Vec3 n, const Vec3& t, f
 
 Vec3 blend_normal_strength(const MaterialNormalMap& map, const Vec3& bent, const Vec3& ns) {
   Vec3 n = unit_or_zero(bent);
-  const bool blend = map.strength_mode == NormalStrength::Blend || map.space != NormalMapSpace::Tangent;
+  const bool blend = map.strength_mode == NormalStrength::Blend || map.space != NormalMapSpace::Tangent || map.bump;
   if (blend && map.strength != 1.0f && n != Vec3(0.0f)) n = unit_or_zero(ns + (n - ns) * std::max(map.strength, 0.0f));
   return n == Vec3(0.0f) ? ns : n;
 }
@@ -102,6 +114,14 @@ Vec3 valid_reflection_normal(const Vec3& ng, const Vec3& wo, const Vec3& n) {
   const float w = std::clamp(0.25f * (ix < 0.0f ? b + root : b - root) / a, 0.0f, 1.0f);
   const Vec3 out = std::sqrt(1.0f - w) * x_axis + std::sqrt(w) * ng;
   return is_finite(out) ? out : ng;
+}
+
+Vec3 bump_normal(const MaterialNormalMap& map, const Vec3& n, const Vec3& dx, const Vec3& dy, float hx, float hy) {
+  const Vec3 rx = glm::cross(dy, n), ry = glm::cross(n, dx);
+  const float det = glm::dot(dx, rx);
+  const Vec3 surface_gradient = hx * rx + hy * ry;
+  const Vec3 bent = unit_or_zero(std::fabs(det) * n - map.distance * (det < 0.0f ? -1.0f : 1.0f) * surface_gradient);
+  return bent == Vec3(0.0f) ? n : bent;
 }
 
 }  // namespace toyrt

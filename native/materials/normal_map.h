@@ -17,6 +17,15 @@
 // (a black or leaking pixel). valid_reflection_normal() turns it towards Ng just enough that the
 // mirror direction of wo leaves the surface at a small positive elevation, as Cycles does for
 // every closure normal (ensure_valid_reflection in 3.x, ensure_valid_specular_reflection in 4.x+).
+//
+// Blender's Bump node takes the map's place when `bump` is set: the texture is a height field h
+// (the image's Rec. 709 luminance, or its alpha) and the normal follows Cycles' node. With two
+// tangent vectors dx, dy of the surface and the heights' changes h_x, h_y along them,
+// R_x = dy x N, R_y = N x dx, det = dx . R_x, and
+// N' = normalize(|det| N - distance sign(det) ((h_x) R_x + (h_y) R_y)), blended with N by the
+// strength as 3.x's normal maps are (distance < 0: Invert). To first order the result does not
+// depend on dx, dy: Cycles takes the pixel's footprint, TOYRT the triangle's edges, with the
+// height's change along them from its UV gradient (bump_normal(); render/normal_mapping.cpp).
 #pragma once
 
 #include "core/math.h"
@@ -44,24 +53,31 @@ struct MaterialNormalMap {
   // Lift the bent normal so the view's mirror stays above the surface (valid_reflection_normal):
   // Cycles 3.x does for every closure, 4.x+ only for glossy ones (not a Diffuse BSDF's).
   bool lift = true;
+  bool bump = false;        // a Bump node's height field (above), not a Normal Map
+  float distance = 1.0f;    // the Bump node's Distance, negated by Invert
+  bool bump_alpha = false;  // the height is the image's alpha (else its luminance)
 
   // From add_material's keywords, which every material kind accepts: normal_map (a texture id,
   // -1: none), normal_strength (1), normal_space ('TANGENT', 'OBJECT', 'WORLD', 'BLENDER_OBJECT',
   // 'BLENDER_WORLD'), normal_convention ('OPENGL', 'DIRECTX'), normal_strength_mode ('tangent':
   // Blender 4.x+, 'blend': 3.x), normal_shadowing ('conty': 4.x+, 'chiang': 3.x, 'none'),
-  // normal_lift (True).
-  // Throws std::invalid_argument for an unknown name.
+  // normal_lift (True). Or a Bump node: bump_map (a texture id), bump_strength (1),
+  // bump_distance (1; negative: inverted), bump_channel ('gray': luminance, 'alpha'), with
+  // normal_shadowing and normal_lift as above.
+  // Throws std::invalid_argument for an unknown name, or for both a normal map and a bump map.
   static MaterialNormalMap from_params(const Params& params);
 
   bool active() const { return texture >= 0; }
   bool operator==(const MaterialNormalMap& o) const {
     return texture == o.texture && strength == o.strength && space == o.space && directx == o.directx &&
-           strength_mode == o.strength_mode && shadowing == o.shadowing && lift == o.lift;
+           strength_mode == o.strength_mode && shadowing == o.shadowing && lift == o.lift && bump == o.bump &&
+           distance == o.distance && bump_alpha == o.bump_alpha;
   }
   // Throws std::invalid_argument for a non-finite strength or a texture id that is not -1 or
   // below `textures` (the scene's count).
   void check(size_t textures) const {
     if (!std::isfinite(strength)) throw std::invalid_argument("normal_strength must be finite");
+    if (!std::isfinite(distance)) throw std::invalid_argument("bump_distance must be finite");
     if (texture < -1 || texture >= int64_t(textures))
       throw std::invalid_argument("unknown normal_map texture id " + std::to_string(texture) + " (the scene has " +
                                   std::to_string(textures) + " textures)");
@@ -81,6 +97,15 @@ Vec3 tangent_space_normal(const MaterialNormalMap& map, Vec3 n, const Vec3& t, f
 // normal ns (3.x's rule, and 4.x+'s in object and world space); ns for a zero or non-finite
 // result. Unit out.
 Vec3 blend_normal_strength(const MaterialNormalMap& map, const Vec3& bent, const Vec3& ns);
+
+// The Bump node's normal (above) from the smooth unit normal n, two tangent vectors dx, dy and
+// the height's changes hx, hy along them; n for a degenerate result. Unit, before the strength.
+Vec3 bump_normal(const MaterialNormalMap& map, const Vec3& n, const Vec3& dx, const Vec3& dy, float hx, float hy);
+
+// The height a bump map reads from a texel (linear RGBA).
+inline float bump_height(const MaterialNormalMap& map, const glm::vec4& t) {
+  return map.bump_alpha ? t.w : 0.2126f * t.x + 0.7152f * t.y + 0.0722f * t.z;
+}
 
 // n turned towards ng, in the plane of both, until the mirror reflection of wo about it is at
 // least min(0.9 dot(ng, wo), 0.01) above the surface (cosine to ng); n itself when it already
