@@ -196,6 +196,37 @@ def normal_map(mat, image, strength=1.0, space="TANGENT", uv_map="", shader=None
     return node
 
 
+def bump(mat, image, strength=1.0, distance=1.0, invert=False, shader=None):
+    """Wire an Image Texture of `image` (its Color as the height) through a Bump node into the
+    Normal input of `shader` (the node linked to the material's output when None). Returns the
+    Bump node."""
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    if shader is None:
+        out = next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
+        shader = out.inputs["Surface"].links[0].from_node
+    tex = nodes.new("ShaderNodeTexImage")
+    tex.image = image
+    tex.interpolation, tex.extension = "Linear", "REPEAT"
+    node = nodes.new("ShaderNodeBump")
+    node.invert = invert
+    node.inputs["Strength"].default_value = strength
+    node.inputs["Distance"].default_value = distance
+    links.new(tex.outputs["Color"], node.inputs["Height"])
+    links.new(node.outputs["Normal"], shader.inputs["Normal"])
+    return node
+
+
+def height_image(name, size=256, cycles=3):
+    """A float, Non-Color height field h = 0.5 + 0.5 sin(2 pi c u) sin(2 pi c v) over the unit UV
+    square (c = `cycles`, tileable), grey."""
+    u = (np.arange(size) + 0.5) / size
+    su, sv = np.meshgrid(u, u)                      # rows: v, from the bottom (Blender's order)
+    w = 2 * np.pi * cycles
+    h = 0.5 + 0.5 * np.sin(w * su) * np.sin(w * sv)
+    rgba = np.stack([h, h, h, np.ones_like(h)], -1)
+    return image(name, rgba, float_buffer=True, colorspace="Non-Color")
+
+
 def bump_normal_image(name, size=64, cycles=3, slope=0.5):
     """A float, Non-Color tangent-space normal map of the height h = a sin(2 pi c u) sin(2 pi c v)
     over the unit UV square (c = `cycles`, tileable), with the largest slope `slope`: each texel

@@ -4,14 +4,19 @@ tangent space (the mesh then carries MikkTSpace tangents of the node's UV map: m
 object or world space, its Strength a constant, 5.x+'s convention (DirectX negates green) where
 the node has it.
 
+A Bump node takes the same place: its Height an Image Texture's Color (Rec. 709 luminance) or
+Alpha, its Strength and Distance constants, Invert a negative distance (the core's bump_map;
+docs/render.md). A Bump's own Normal input (a chain of bumps or a normal map under it) is not
+followed, noted.
+
 One normal per material: the surface shader's own Normal input (Principled, Diffuse, Glossy,
 Glass, Refraction), or for a Mix or Add Shader the one normal map its shaders share. Anything else
-on a Normal input (a Bump node, another node, a Normal Map without an image or fed by another
-node, shaders of a Mix with different maps) keeps the surface normal and is noted, as is a
-linked Strength (its constant)."""
+on a Normal input (another node, a Normal Map or Bump without an image or fed by another node,
+shaders of a Mix with different maps) keeps the surface normal and is noted, as is a linked
+Strength (its constant)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from .materials import ImageKey, _blender_version, _texture, input_socket, linked_node, output_node
 
@@ -39,9 +44,15 @@ class NormalMapSpec:
     # Lift the bent normal so the view's mirror stays above the surface: Cycles 3.x for every
     # closure, 4.x+ for glossy ones only (materials.material_spec clears it for a diffuse kind).
     lift: bool = True
+    # A Bump node (space 'BUMP'): its Distance (negative: Invert) and the height's channel.
+    distance: float = 1.0
+    channel: str = "gray"
 
     def arguments(self, texture_id: int) -> dict:
         """add_material's keywords for the core's MaterialNormalMap."""
+        if self.space == "BUMP":
+            return dict(bump_map=texture_id, bump_strength=self.strength, bump_distance=self.distance,
+                        bump_channel=self.channel, normal_shadowing=self.shadowing, normal_lift=self.lift)
         return dict(normal_map=texture_id, normal_strength=self.strength, normal_space=self.space,
                     normal_convention=self.convention, normal_strength_mode=self.strength_mode,
                     normal_shadowing=self.shadowing, normal_lift=self.lift)
@@ -82,6 +93,8 @@ def _from_socket(name, socket, notes, correction=True):
     src = linked_node(socket)
     if src is None:
         return None, None
+    if src.type == "BUMP":
+        return _bump(name, src, notes, correction)
     if src.type != "NORMAL_MAP":
         notes.append(f"material '{name}': normal input from {src.bl_idname} (the surface normal)")
         return None, None
@@ -111,11 +124,57 @@ def _from_socket(name, socket, notes, correction=True):
     convention = str(getattr(src, "convention", "OPENGL")).upper()   # 5.x+ where present
     if convention not in ("OPENGL", "DIRECTX"):
         convention = "OPENGL"
-    modern = _blender_version() >= (4, 0, 0)
-    mode = "tangent" if modern else "blend"
-    shadowing = ("conty" if correction else "none") if modern else "chiang"
+    mode = "tangent" if _blender_version() >= (4, 0, 0) else "blend"
     return NormalMapSpec(key, strength, space, convention, str(getattr(src, "uv_map", "") or ""), mode,
-                         shadowing), image
+                         _shadowing(correction)), image
+
+
+def _shadowing(correction: bool) -> str:
+    """Cycles' shadowing of bent diffuse normals in this Blender version."""
+    if _blender_version() >= (4, 0, 0):
+        return "conty" if correction else "none"
+    return "chiang"
+
+
+def _constant_input(name, node, socket_name, fallback, notes) -> float:
+    sock = input_socket(node, socket_name)
+    if sock is None:
+        return fallback
+    if sock.is_linked:
+        notes.append(f"material '{name}': linked Bump {socket_name} (its constant value)")
+    v = float(sock.default_value)
+    if v != v:
+        notes.append(f"material '{name}': Bump {socket_name} is NaN ({fallback})")
+        return fallback
+    return v
+
+
+def _bump(name, src, notes, correction):
+    """A Bump node's NormalMapSpec (space 'BUMP'), or (None, None): the surface normal, noted."""
+    height = input_socket(src, "Height")
+    links = getattr(height, "links", ()) if height is not None else ()
+    tex = linked_node(height) if height is not None else None
+    if tex is None or tex.type != "TEX_IMAGE" or not links:
+        what = tex.bl_idname if tex is not None else "a constant"
+        notes.append(f"material '{name}': Bump height from {what} (the surface normal)")
+        return None, None
+    key, image = _texture(name, tex, notes)
+    if image is None or not _has_pixels(image):
+        notes.append(f"material '{name}': Bump without an image (the surface normal)")
+        return None, None
+    normal = input_socket(src, "Normal")
+    if normal is not None and normal.is_linked:
+        notes.append(f"material '{name}': a Bump's Normal input (the surface normal under the bump)")
+    if input_socket(src, "Filter Width") is None:
+        # Before 4.4 Cycles differences the height over a whole pixel's footprint.
+        notes.append(f"material '{name}': Bump slope at the point (Cycles before 4.4: over a pixel's footprint)")
+    channel = "alpha" if links[0].from_socket.name == "Alpha" else "gray"
+    strength = _constant_input(name, src, "Strength", 1.0, notes)
+    distance = _constant_input(name, src, "Distance", 1.0, notes)
+    if getattr(src, "invert", False):
+        distance = -distance
+    return NormalMapSpec(replace(key, alpha=True), strength, "BUMP", shadowing=_shadowing(correction),
+                         distance=distance, channel=channel), image
 
 
 def _has_pixels(image) -> bool:

@@ -670,6 +670,31 @@ def scene_normal_map(p):
 SCENES_SPEC.append(("normal_map", scene_normal_map, dict(direction=(-0.8, 0.3, -0.6), slope=0.6, mean_limit=0.005), 0))
 
 
+# The Bump node (the materials issue): one float height image of sine bumps (256 texels) on a
+# diffuse floor turned 30 degrees, and on a smooth Principled UV sphere (Strength 0.6, inverted),
+# raked by a low sun. Asserted from 4.4, whose Filter Width (0.1 pixel) makes Cycles' differences
+# the slope at the point, as TOYRT's; 3.4 differences the height over a whole pixel's footprint,
+# which shifts the bumps by half a pixel (reported; docs/render.md).
+def scene_bump(p):
+    heights = kit.height_image("heights", size=256, cycles=3)
+    floor = kit.diffuse("bumped_floor", (0.7, 0.7, 0.7))
+    kit.bump(floor, heights, distance=p["distance"])
+    kit.plane("floor", 4.0, floor).rotation_euler = (0.0, 0.0, np.radians(30.0))
+    ball = kit.principled_dielectric("bumped_ball", (0.6, 0.25, 0.1), 0.4)
+    kit.bump(ball, heights, strength=0.6, distance=0.1, invert=True)
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=32, ring_count=16, radius=0.6, location=(0.4, 0.3, 0.6))
+    sphere = bpy.context.active_object
+    sphere.data.polygons.foreach_set("use_smooth", np.ones(len(sphere.data.polygons), bool))
+    sphere.data.materials.append(ball)
+    kit.sun_light("sun", 3.0, p["direction"])
+    camera((0.0, -3.6, 2.6), (0, 0.2, 0.3))
+    kit.world((0.1, 0.12, 0.15))
+
+
+SCENES_SPEC.append(("bump", scene_bump, dict(direction=(-0.8, 0.3, -0.6), distance=0.25, mean_limit=0.005,
+                                             asserted_from=(4, 4, 0)), 0))
+
+
 # The world's ray visibility for glossy and transmission rays (issue 13): a mirror-like glossy ball
 # and a glass ball in a blue world, one of the two kinds of ray hidden from the world (in Cycles a
 # world hidden from glossy rays is black in reflections, one hidden from transmission rays black

@@ -2,8 +2,9 @@
 # tangents it exports (mesh_tangents.py): Blender's own MikkTSpace over the triangles TOYRT
 # renders. Tangents equal Mesh.calc_tangents on a quad mesh (which it accepts) and, on a mesh with
 # an n-gon (which it refuses), the closed form of a planar face with an affine UV map; the spec of
-# a Normal Map node (space, strength, UV map, 5.x+'s convention where it exists); bad input (no
-# image, a Bump node, no UV map) keeps the surface normal with a note, and F12 renders finite.
+# a Normal Map node (space, strength, UV map, 5.x+'s convention where it exists) and of a Bump
+# node; bad input (no image, a Bump without a height image, no UV map) keeps the surface normal
+# with a note, and F12 renders finite.
 # Cycles parity of the rendered result is tests/blender/test_cycles_parity.py's normal_map scene.
 #     blender -b --python-exit-code 1 --python tests/blender/test_normal_map.py
 import os
@@ -130,6 +131,31 @@ def test_normal_map_node_becomes_the_spec():
     check(spec is not None and spec.space == "OBJECT", f"Diffuse BSDF, object space: {spec}")
 
 
+def test_bump_node_becomes_the_spec():
+    from render_toyrt import materials
+    from render_toyrt.material_normal import tangent_uv_map
+
+    kit.clear_scene()
+    heights = kit.height_image("heights", size=16)
+    mat = kit.principled("bumped", (0.5, 0.5, 0.5))
+    node = kit.bump(mat, heights, strength=0.5, distance=0.2, invert=True)
+    c = materials.material_spec(mat)
+    b = c.spec.normal_map
+    check(b is not None and b.space == "BUMP" and abs(b.strength - 0.5) < 1e-6 and abs(b.distance + 0.2) < 1e-6
+          and b.channel == "gray" and b.texture.name == heights.name_full and c.normal_image == heights,
+          f"Principled Normal <- Bump (inverted) <- Image Texture Color: {b}")
+    args = c.spec.arguments(-1, -1, 7)
+    check(args.get("bump_map") == 7 and "normal_map" not in args and args["bump_distance"] == b.distance,
+          f"sent as a bump map: {args}")
+    check(tangent_uv_map(mat) is None, "a bump needs no tangents")
+    old = bpy.app.version < (4, 4, 0)
+    check(any("Bump slope at the point" in n for n in c.notes) == old,
+          f"noted only where Cycles differences over a pixel (before 4.4): {c.notes}")
+    tex = next(n for n in mat.node_tree.nodes if n.type == "TEX_IMAGE")
+    mat.node_tree.links.new(tex.outputs["Alpha"], node.inputs["Height"])
+    check(materials.material_spec(mat).spec.normal_map.channel == "alpha", "the height from the Alpha output")
+
+
 def test_bad_input_keeps_the_surface_normal_with_a_note_and_renders():
     from render_toyrt import materials
 
@@ -147,7 +173,8 @@ def test_bad_input_keeps_the_surface_normal_with_a_note_and_renders():
     nodes, links = bump.node_tree.nodes, bump.node_tree.links
     links.new(nodes.new("ShaderNodeBump").outputs["Normal"], nodes["Diffuse BSDF"].inputs["Normal"])
     c = materials.material_spec(bump)
-    check(c.spec.normal_map is None and any("ShaderNodeBump" in n for n in c.notes), f"a Bump node: noted {c.notes}")
+    check(c.spec.normal_map is None and any("Bump height from a constant" in n for n in c.notes),
+          f"a Bump node without a height: noted {c.notes}")
 
     kit.plane("floor", 4.0, kit.diffuse("floor"))
     named = kit.diffuse("named_uv")
@@ -196,6 +223,7 @@ def test_a_normal_map_added_between_renders_is_seen_by_the_next():
 
 
 run_script([test_tangents_equal_calc_tangents_on_a_quad_mesh, test_tangents_of_a_mesh_with_an_ngon_are_the_closed_form,
-            test_normal_map_node_becomes_the_spec, test_bad_input_keeps_the_surface_normal_with_a_note_and_renders,
+            test_normal_map_node_becomes_the_spec, test_bump_node_becomes_the_spec,
+            test_bad_input_keeps_the_surface_normal_with_a_note_and_renders,
             test_a_normal_map_added_between_renders_is_seen_by_the_next],
            "normal_map", TMP)
