@@ -129,7 +129,7 @@ template <bool kBurley>
   const CosineDirection c = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings);
   Vec3 tr(1.0f);
   if (glm::dot(at.ng, c.wi) > 0.0f && c.cos > 0.0f &&
-      path_passes(scene, Ray{at.origin, 0.0f, c.wi, kInfinity}, settings.transparent_max_bounces, tr))
+      path_passes(scene, Ray{at.origin, 0.0f, c.wi, kInfinity}, settings.transparent_max_bounces, tr, kVisibleDiffuse))
     sum += diffuse_f<kBurley>(at, retro, c.wi) * environment_radiance(env, image, c.wi) * tr *
            mis_cos_over_pdf(c.cos, c.cos * kInvPi, environment_pdf(env, c.wi));
   return sum;
@@ -168,8 +168,8 @@ template <bool kBurley>
   const Vec3 wi = c.wi;
   if (glm::dot(at.ng, wi) <= 0.0f || c.cos <= 0.0f) return sum;
   Vec3 tr(1.0f);  // a cosine ray is a path ray: it passes cut-outs (render/transparent_walk.h)
-  const Hit hit =
-      nearest_past_cut_outs(scene, Ray{at.origin, 0.0f, wi, kInfinity}, settings.transparent_max_bounces, tr);
+  const Hit hit = nearest_past_cut_outs(scene, Ray{at.origin, 0.0f, wi, kInfinity}, settings.transparent_max_bounces,
+                                        tr, kVisibleDiffuse);
   const int32_t m = hit.found() ? material_of(scene, hit) : -1;
   if (m < 0 || size_t(m) >= scene.emission().size() || !scene.emission()[size_t(m)].emits()) return sum;
   const MaterialEmission& e = scene.emission()[size_t(m)];
@@ -230,9 +230,9 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     // albedo L when nothing blocks it, exactly. A BSDF-sampled ray: every object stops it.
     const Vec3 wi = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings).wi;
     Vec3 tr(1.0f);
-    if (glm::dot(ng, wi) > 0.0f &&
-        (kCutOuts ? path_passes(scene, Ray{origin, 0.0f, wi, kInfinity}, settings.transparent_max_bounces, tr)
-                  : !scene.occluded(Ray{origin, 0.0f, wi, kInfinity})))
+    if (glm::dot(ng, wi) > 0.0f && (kCutOuts ? path_passes(scene, Ray{origin, 0.0f, wi, kInfinity},
+                                                           settings.transparent_max_bounces, tr, kVisibleDiffuse)
+                                             : !scene.occluded(Ray{origin, 0.0f, wi, kInfinity}, kVisibleDiffuse)))
       sum += diffuse_f<kBurley>(at, retro, wi) * world.background * tr * kPi;  // f = albedo / pi
   }
   if (scene.any_emission()) sum += emission_lighting<kBurley>(scene, at, retro, s.p, pixel, sample, settings);
@@ -264,6 +264,11 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
                                    const IntegratorSettings& settings) {
   const float u = sobol_owen_1d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 8), settings.seed);
   return pick_mixed(scene.mixes(), scene.textures(), material, MixPoint{uv, wo, ns, !front}, u);
+}
+
+// The instances a path ray of this kind sees (Instance::visibility).
+uint8_t seen_by(RayKind kind) {
+  return kind == RayKind::Camera ? kVisibleCamera : kind == RayKind::Glossy ? kVisibleGlossy : kVisibleTransmission;
 }
 
 // The kind of ray that leaves a surface along wi, on the side of ng the path came from: a
@@ -301,7 +306,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
   for (int depth = first_depth;; ++depth) {
     const IntegratorSettings& settings = kCutOuts ? cut.settings() : path_settings;
     const int bounce = kCutOuts ? depth - cut.crossed() : depth;  // crossings are not bounces
-    const Hit hit = scene.intersect(ray);
+    const Hit hit = scene.intersect(ray, seen_by(kind));
     Vec3 lamps(0.0f);  // the lamps this ray sees: the Emission pass's at the camera ray
     if (!world.lights.empty()) {
       const float length = glm::length(ray.dir);

@@ -33,17 +33,19 @@ Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng) {
   return Ray{origin, 0.0f, to_end, 1.0f};
 }
 
-Vec3 transmittance_walk(const Scene& scene, const Ray& ray, int budget, bool casters_only, uint64_t blockers) {
+Vec3 transmittance_walk(const Scene& scene, const Ray& ray, int budget, bool casters_only, uint64_t blockers,
+                        uint8_t seen_by) {
   // Light arrives when the walk ends without meeting an opaque surface (or one cut-out too many).
   Vec3 tr(1.0f);
-  return walk_to_opaque(scene, ray, budget, tr, casters_only, blockers).found() ? Vec3(0.0f) : tr;
+  return walk_to_opaque(scene, ray, budget, tr, casters_only, blockers, seen_by).found() ? Vec3(0.0f) : tr;
 }
 
-Hit walk_to_opaque(const Scene& scene, Ray ray, int budget, Vec3& tr, bool casters_only, uint64_t blockers) {
+Hit walk_to_opaque(const Scene& scene, Ray ray, int budget, Vec3& tr, bool casters_only, uint64_t blockers,
+                   uint8_t seen_by) {
   const std::vector<MaterialTransparency>& table = scene.transparency();
   for (int crossed = 0;; ++crossed) {
     if (ray.tnear > ray.tfar) return Hit{};
-    const Hit hit = casters_only ? scene.intersect_shadow_casters(ray, blockers) : scene.intersect(ray);
+    const Hit hit = casters_only ? scene.intersect_shadow_casters(ray, blockers) : scene.intersect(ray, seen_by);
     if (!hit.found()) return hit;
     const CrossedSurface s = crossed_surface(scene, hit);
     if (s.material < 0 || size_t(s.material) >= table.size() || !table[size_t(s.material)].transparent()) return hit;

@@ -37,7 +37,7 @@ Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng);
 // transparent surfaces pass. casters_only: a shadow ray (instances that cast shadows, among the
 // blocker sets `blockers` of light linking), else a path ray (every instance).
 [[gnu::noinline]] Vec3 transmittance_walk(const Scene& scene, const Ray& ray, int budget, bool casters_only,
-                                          uint64_t blockers = kAllLightSets);
+                                          uint64_t blockers = kAllLightSets, uint8_t seen_by = kVisibleAll);
 
 // At a surface with a transparent part: whether the path passes through. The transparent
 // closure is drawn on the uniform number u with probability its share of the weights, as Cycles
@@ -49,12 +49,13 @@ Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng);
 // The nearest hit along `ray` on a surface that is not cut out, multiplying `tr` by what the cut-
 // outs before it let through (0 past `budget` of them, or at one that lets nothing through: then
 // the hit is the one that blocked); nearest_past_cut_outs is scene.intersect(ray) when the scene
-// has no transparent material. casters_only: among the instances that cast shadows (in `blockers`).
+// has no transparent material. casters_only: among the instances that cast shadows (in `blockers`);
+// else among those path rays of the kinds `seen_by` see (RayVisibility).
 [[gnu::noinline]] Hit walk_to_opaque(const Scene& scene, Ray ray, int budget, Vec3& tr, bool casters_only = false,
-                                     uint64_t blockers = kAllLightSets);
-inline Hit nearest_past_cut_outs(const Scene& scene, const Ray& ray, int budget, Vec3& tr) {
-  if (!scene.any_transparency()) return scene.intersect(ray);
-  return walk_to_opaque(scene, ray, budget, tr);
+                                     uint64_t blockers = kAllLightSets, uint8_t seen_by = kVisibleAll);
+inline Hit nearest_past_cut_outs(const Scene& scene, const Ray& ray, int budget, Vec3& tr, uint8_t seen_by) {
+  if (!scene.any_transparency()) return scene.intersect(ray, seen_by);
+  return walk_to_opaque(scene, ray, budget, tr, false, kAllLightSets, seen_by);
 }
 
 // What a path knows of the cut-outs it crossed (the integrator's, for scenes with transparent
@@ -101,10 +102,11 @@ inline bool shadow_passes(const Scene& scene, const Ray& ray, int budget, Vec3& 
   return tr != Vec3(0.0f);
 }
 
-// The same for a BSDF-sampled ray that looks for the world: every object stops it but cut-outs.
-inline bool path_passes(const Scene& scene, const Ray& ray, int budget, Vec3& tr) {
-  if (!scene.any_transparency()) return !scene.occluded(ray);
-  tr *= transmittance_walk(scene, ray, budget, false);
+// The same for a BSDF-sampled ray that looks for the world: every object that rays of the kinds
+// `seen_by` see stops it, but cut-outs.
+inline bool path_passes(const Scene& scene, const Ray& ray, int budget, Vec3& tr, uint8_t seen_by) {
+  if (!scene.any_transparency()) return !scene.occluded(ray, seen_by);
+  tr *= transmittance_walk(scene, ray, budget, false, kAllLightSets, seen_by);
   return tr != Vec3(0.0f);
 }
 

@@ -8,6 +8,17 @@
 
 namespace toyrt {
 
+// Blender's Object ray visibility (visible_camera, visible_diffuse, visible_glossy,
+// visible_transmission) as bits: the kinds of path ray that see an instance. Shadow rays have
+// Instance::visible_shadow.
+enum RayVisibility : uint8_t {
+  kVisibleCamera = 1,
+  kVisibleDiffuse = 2,
+  kVisibleGlossy = 4,
+  kVisibleTransmission = 8,
+  kVisibleAll = 15,
+};
+
 struct Instance {
   uint32_t mesh = 0;
   Mat4 to_world{1.0f};   // object -> world, affine
@@ -21,6 +32,9 @@ struct Instance {
   // set whose lights it shadows; 0 for an object no light's collection names.
   uint8_t receiver_set = 0;
   uint8_t blocker_set = 0;
+  // The path rays that see it (RayVisibility bits); the ray API's queries see it regardless. An
+  // emissive instance hidden from diffuse rays lights no diffuse surface, as Cycles' mesh lights.
+  uint8_t visibility = kVisibleAll;
 };
 
 }  // namespace toyrt

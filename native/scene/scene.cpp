@@ -48,8 +48,8 @@ Mat4 Scene::checked_inverse(const Mat4& to_world) {
   return to_object;
 }
 
-uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world, bool visible_shadow, int receiver_set,
-                             int blocker_set) {
+uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world, bool visible_shadow, int receiver_set, int blocker_set,
+                             uint8_t visibility) {
   check_mesh_id(mesh);
   if (receiver_set < 0 || receiver_set >= kLightSets || blocker_set < 0 || blocker_set >= kLightSets)
     throw std::invalid_argument("light-linking set must be in [0, 64): receiver_set " + std::to_string(receiver_set) +
@@ -63,6 +63,7 @@ uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world, bool visible_sh
   inst.visible_shadow = visible_shadow;
   inst.receiver_set = uint8_t(receiver_set);
   inst.blocker_set = uint8_t(blocker_set);
+  inst.visibility = visibility & kVisibleAll;
   instances_.push_back(inst);
   committed_ = false;
   return uint32_t(instances_.size() - 1);
@@ -340,6 +341,8 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
   single_identity_ = instances_.size() == 1 && instances_[0].identity;
   all_cast_shadows_ =
       std::all_of(instances_.begin(), instances_.end(), [](const Instance& i) { return i.visible_shadow; });
+  all_visible_ =
+      std::all_of(instances_.begin(), instances_.end(), [](const Instance& i) { return i.visibility == kVisibleAll; });
   const auto gather_start = std::chrono::steady_clock::now();
   gather_emitters();
   stats_.emissive_triangles = emitters_.triangles.size();
@@ -361,8 +364,8 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-template <bool AnyHit, bool ShadowCastersOnly>
-bool Scene::trace(const Ray& ray, Hit& hit, uint64_t blockers) const {
+template <bool AnyHit, bool ShadowCastersOnly, bool Visibility>
+bool Scene::trace(const Ray& ray, Hit& hit, uint64_t blockers, uint8_t seen_by) const {
   if (!is_finite(ray.org) || !is_finite(ray.dir) || ray.dir == Vec3(0.0f) || std::isnan(ray.tnear) ||
       std::isnan(ray.tfar) || !(ray.tnear <= ray.tfar))
     return false;
@@ -371,6 +374,9 @@ bool Scene::trace(const Ray& ray, Hit& hit, uint64_t blockers) const {
     const Instance& inst = instances_[id];
     if constexpr (ShadowCastersOnly) {
       if (!inst.visible_shadow || !in_light_sets(blockers, inst.blocker_set)) return false;
+    }
+    if constexpr (Visibility) {
+      if (!(inst.visibility & seen_by)) return false;
     }
     const Mesh& mesh = *meshes_[inst.mesh];
     Vec3 org = ray.org, dir = ray.dir;
@@ -421,6 +427,17 @@ bool Scene::occluded(const Ray& ray) const {
 bool Scene::occluded_by_shadow_casters(const Ray& ray, uint64_t blockers) const {
   Hit unused;
   return trace<true, true>(ray, unused, blockers);
+}
+
+Hit Scene::intersect_visible(const Ray& ray, uint8_t seen_by) const {
+  Hit hit;
+  if (!trace<false, false, true>(ray, hit, kAllLightSets, seen_by)) hit = Hit{};
+  return hit;
+}
+
+bool Scene::occluded_visible(const Ray& ray, uint8_t seen_by) const {
+  Hit unused;
+  return trace<true, false, true>(ray, unused, kAllLightSets, seen_by);
 }
 
 Hit Scene::intersect_shadow_casters(const Ray& ray, uint64_t blockers) const {

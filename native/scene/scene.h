@@ -100,9 +100,9 @@ class Scene {
   // 0 0 0 1) or singular matrix.
   // `visible_shadow` false: the instance casts no shadow in a render (Instance::visible_shadow).
   // receiver_set / blocker_set: its light-linking sets (Instance; < kLightSets, else
-  // std::invalid_argument).
+  // std::invalid_argument). visibility: the path rays that see it (RayVisibility bits).
   uint32_t add_instance(int64_t mesh, const Mat4& to_world, bool visible_shadow = true, int receiver_set = 0,
-                        int blocker_set = 0);
+                        int blocker_set = 0, uint8_t visibility = kVisibleAll);
   // Edits for interactive updates (the viewport), each leaving the scene uncommitted; ids stay
   // valid. replace_mesh swaps a mesh's geometry and shading (its BVH is rebuilt by the next
   // commit, the instances placing it stay); set_instance_transform moves one instance (the next
@@ -156,6 +156,15 @@ class Scene {
   // non-finite origin, or tnear > tfar finds nothing.
   Hit intersect(const Ray& ray) const;
   bool occluded(const Ray& ray) const;
+  // The same for a path ray of the kinds `seen_by` (RayVisibility bits): instances hidden from
+  // them are passed. Inline, so that a scene where every instance is seen by every ray calls the
+  // plain queries (a flag test more).
+  Hit intersect(const Ray& ray, uint8_t seen_by) const {
+    return all_visible_ ? intersect(ray) : intersect_visible(ray, seen_by);
+  }
+  bool occluded(const Ray& ray, uint8_t seen_by) const {
+    return all_visible_ ? occluded(ray) : occluded_visible(ray, seen_by);
+  }
   // The render's shadow rays: occluded() by the instances that cast shadows. Inline, so that a
   // scene where every instance casts shadows calls occluded() as before (a flag test more).
   bool shadowed(const Ray& ray) const { return all_cast_shadows_ ? occluded(ray) : occluded_by_shadow_casters(ray); }
@@ -237,8 +246,10 @@ class Scene {
   size_t memory_bytes() const;
 
  private:
-  template <bool AnyHit, bool ShadowCastersOnly = false>
-  bool trace(const Ray& ray, Hit& hit, uint64_t blockers = kAllLightSets) const;
+  template <bool AnyHit, bool ShadowCastersOnly = false, bool Visibility = false>
+  bool trace(const Ray& ray, Hit& hit, uint64_t blockers = kAllLightSets, uint8_t seen_by = kVisibleAll) const;
+  Hit intersect_visible(const Ray& ray, uint8_t seen_by) const;
+  bool occluded_visible(const Ray& ray, uint8_t seen_by) const;
   bool occluded_by_shadow_casters(const Ray& ray, uint64_t blockers = kAllLightSets) const;
   // commit()'s work; throws BuildCancelled when *cancel turns true.
   void build(const CommitOptions& options, const std::atomic<bool>* cancel);
@@ -269,6 +280,7 @@ class Scene {
   Bvh top_;                       // over instances with a non-empty world box
   bool single_identity_ = false;  // one untransformed instance: skip the top level
   bool all_cast_shadows_ = true;  // no instance with visible_shadow off: shadowed() is occluded()
+  bool all_visible_ = true;       // every instance seen by every path ray: intersect(ray, kinds) is intersect(ray)
   bool committed_ = false;
   CommitStats stats_;
 };

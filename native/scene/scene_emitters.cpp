@@ -48,6 +48,9 @@ void Scene::gather_emitters() {
   std::vector<Vec3> means(textures_.size(), Vec3(-1.0f));  // per texture, once some emitter reads it
   for (size_t i = 0; i < instances_.size(); ++i) {
     const Instance& inst = instances_[i];
+    // Hidden from diffuse rays: no diffuse surface samples it (Cycles excludes such mesh lights;
+    // the diffuse cosine rays pass it too). Camera, glossy and glass rays still see it.
+    if (!(inst.visibility & kVisibleDiffuse)) continue;
     const Mesh& mesh = *meshes_[inst.mesh];
     const MeshShading& sh = shading_[inst.mesh];
     const std::vector<Vec3>& v = mesh.vertices();
