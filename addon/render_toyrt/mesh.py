@@ -62,6 +62,27 @@ def casts_shadow(inst, obj) -> bool:
     return bool(getattr(obj, "visible_shadow", True) and (parent is None or getattr(parent, "visible_shadow", True)))
 
 
+RAY_VISIBILITY = ("visible_camera", "visible_diffuse", "visible_glossy", "visible_transmission")
+
+
+def instance_flags(inst, obj, links) -> tuple:
+    """add_instance's keywords for one object instance, as a hashable tuple: casts_shadow, the
+    light-linking sets (links.instance_sets; (0, 0) without linking) and Object's ray visibility
+    (camera, diffuse, glossy, transmission; Blender 3.0+), each inherited from the instancer as in
+    Cycles (an instance is seen by a kind of ray when it and its instancer both are)."""
+    parent = inst.parent if inst.is_instance else None
+    seen = tuple(bool(getattr(obj, name, True) and (parent is None or getattr(parent, name, True)))
+                 for name in RAY_VISIBILITY)
+    sets = (0, 0) if links.empty else links.instance_sets(obj.name)
+    return (casts_shadow(inst, obj), *sets, *seen)
+
+
+def instance_arguments(flags: tuple) -> dict:
+    """instance_flags as add_instance's keywords."""
+    return dict(visible_shadow=flags[0], receiver_set=flags[1], blocker_set=flags[2],
+                **dict(zip(RAY_VISIBILITY, flags[3:])))
+
+
 def singular(matrix: np.ndarray) -> bool:
     """True when the core would refuse an instance's matrix: not finite, or (nearly) no volume,
     as an object scaled to zero along an axis has (a common way to hide an object in an

@@ -41,9 +41,10 @@ from .materials import ImageKey
 from .mesh import (
     RENDERABLE,
     ExportCancelled,
-    casts_shadow,
     evaluated_geometry,
     fingerprint,
+    instance_arguments,
+    instance_flags,
     mesh_key,
     singular,
     stop_if,
@@ -72,7 +73,7 @@ class SceneSync(MaterialSync):
         self.approximated: list[str] = []      # what the converters approximated (for one warning)
         self.meshes: dict[tuple, list] = {}    # mesh key -> [mesh id or -1, triangles, fingerprint]
         self.free_ids: list[int] = []          # emptied meshes, reused by the next new mesh
-        self.placed: list | None = []          # [(mesh id, matrix as bytes, visible_shadow)] in instance order
+        self.placed: list | None = []          # [(mesh id, matrix as bytes, mesh.instance_flags)] in instance order
         self.owner_keys: dict[int, tuple] = {}         # object pointer -> the mesh key it showed last
         self.owner_instances: dict[int, list] = {}     # object pointer -> its instance ids (plain objects)
         # Keyed by name, not pointer: a final render's depsgraph may hand out new copies of the same
@@ -266,8 +267,7 @@ class SceneSync(MaterialSync):
             if entry[0] >= 0:
                 if owner is not None and bake is None:
                     owners.setdefault(owner, []).append(len(placed))
-                flags = casts_shadow(inst, obj) if links.empty else (casts_shadow(inst, obj),
-                                                                     *links.instance_sets(obj.name))
+                flags = instance_flags(inst, obj, links)
                 placed.append((entry[0], _IDENTITY if bake is not None else matrix, flags))
                 tables.add(obj)
                 tri_instanced += entry[1]
@@ -383,12 +383,7 @@ class SceneSync(MaterialSync):
         else:
             self.scene.clear_instances()
             for mid, matrix, flags in placed:
-                # flags: visible_shadow, or with light linking (visible_shadow, receiver set, blocker set)
-                if isinstance(flags, tuple):
-                    self.scene.add_instance(mid, matrix, visible_shadow=flags[0], receiver_set=flags[1],
-                                            blocker_set=flags[2])
-                else:
-                    self.scene.add_instance(mid, matrix, visible_shadow=flags)
+                self.scene.add_instance(mid, matrix, **instance_arguments(flags))
             self.counters["instance_resets"] += 1
         self.placed = [(mid, matrix.tobytes(), shadow) for mid, matrix, shadow in placed]
 

@@ -699,6 +699,26 @@ SCENES_SPEC.append(("bump", scene_bump, dict(direction=(-0.8, 0.3, -0.6), distan
 # and a glass ball in a blue world, one of the two kinds of ray hidden from the world (in Cycles a
 # world hidden from glossy rays is black in reflections, one hidden from transmission rays black
 # through glass; camera and diffuse rays still see it).
+# Object ray visibility (the lights issue): an Emission panel hidden from the camera lights the
+# floor, a box and a glossy ball (Blender users' "invisible light plane"); a grey ball hidden from
+# diffuse rays lets the world's and the panel's diffuse light through to the floor (its lamp-free
+# shadow gone) while the camera sees it; a red box hidden from glossy rays is missing from the
+# glossy ball's reflection.
+def scene_ray_visibility(p):
+    kit.plane("floor", 6.0, kit.diffuse("floor", (0.7, 0.7, 0.7)))
+    panel = kit.plane("panel", 1.4, kit.emission("panel_glow", (1.0, 0.9, 0.75), p["strength"]), (0.0, 0.3, 2.0))
+    panel.rotation_euler = (np.pi, 0.0, 0.0)   # facing down
+    panel.visible_camera = False
+    kit.uv_sphere("shiny_ball", 0.45, (-0.6, 0.0, 0.45), kit.glossy("shiny", (0.9, 0.9, 0.9), 0.1))
+    kit.uv_sphere("ghost_ball", 0.4, (0.7, -0.2, 0.4), kit.diffuse("ghost", (0.5, 0.5, 0.5))).visible_diffuse = False
+    kit.box("unreflected", 0.5, (-1.4, -0.6, 0.25), kit.diffuse("red", (0.7, 0.15, 0.1))).visible_glossy = False
+    camera((0.0, -4.0, 1.8), (0, 0, 0.4))
+    kit.world((0.15, 0.2, 0.3))
+
+
+SCENES_SPEC.append(("ray_visibility", scene_ray_visibility, dict(strength=8.0, mean_limit=0.005), 8))
+
+
 def scene_world_visibility(p):
     kit.plane("floor", 6.0, checker("checker", 8, 0.15, 0.85), uv_repeat=4.0)
     kit.uv_sphere("mirror", 0.5, (-0.7, 0.0, 0.5), kit.glossy("shiny", (0.9, 0.9, 0.9), 0.15))

@@ -97,4 +97,44 @@ def objects_without_shadows():
     check(dark.max() < 1e-6 * lit.max(), f"the empty casting shadows, the ring is black again ({dark.max():.3g})")
 
 
-run_script([main, objects_without_shadows], "engine")
+def objects_hidden_from_the_camera():
+    """Object.visible_camera off (Ray Visibility > Camera): the 0.2 m square 0.75 m above the plane,
+    without shadows either, leaves the open plane's closed form in every pixel; casting shadows,
+    the camera sees through it to its shadow (black in the middle); under an empty hidden from the
+    camera an instance of it is hidden too (Cycles' instances inherit the instancer's visibility)."""
+    def render(name):
+        path = os.path.join(tempfile.mkdtemp(), name + ".exr")
+        bpy.context.scene.render.filepath = path
+        bpy.context.scene.render.image_settings.file_format = "OPEN_EXR"
+        bpy.ops.render.render(write_still=True)
+        return kit.read_image(path)[..., 0]
+
+    build_scene()
+    square = kit.plane("hidden", 0.2, kit.diffuse("hidden_white", (1, 1, 1)), location=(0, 0, 0.75))
+    lit = expected_image()
+    middle = np.s_[14:18, 14:18]
+    seen = render("seen")
+    check(seen[middle].min() > 0.0, "seen by the camera, the square is in the middle of the image")
+    square.visible_camera = False
+    square.visible_shadow = False
+    err = abs(render("hidden") - lit).max() / lit.max()
+    check(err < 0.01, f"hidden from the camera and casting no shadow: the open plane (max error {err:.4f})")
+    square.visible_shadow = True
+    through = render("hidden_casting")
+    check(through[middle].max() < 1e-6 * lit.max(),
+          f"the camera sees its shadow through it ({through[middle].max():.3g})")
+    square.visible_camera = square.visible_shadow = True
+    group = bpy.data.collections.new("hidden_group")
+    for coll in square.users_collection:
+        coll.objects.unlink(square)
+    group.objects.link(square)
+    empty = kit.link(bpy.data.objects.new("hidden_instancer", None))
+    empty.instance_type = "COLLECTION"
+    empty.instance_collection = group
+    empty.visible_camera = False
+    empty.visible_shadow = False
+    err = abs(render("instanced_hidden") - lit).max() / lit.max()
+    check(err < 0.01, f"an instance under an empty hidden from the camera is hidden too (max error {err:.4f})")
+
+
+run_script([main, objects_without_shadows, objects_hidden_from_the_camera], "engine")
