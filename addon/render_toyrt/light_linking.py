@@ -147,8 +147,9 @@ def _entries(collection) -> tuple[tuple[str, str], ...]:
 
 
 def read_links(depsgraph) -> LinkSets:
-    """The scene's light linking (Blender 4.0+; an empty LinkSets on 3.x or without links).
-    Emissive meshes with linking collections are not linked emitters in TOYRT: noted."""
+    """The scene's light linking (Blender 4.0+; an empty LinkSets on 3.x or without links). Any
+    object's collections count (a lamp's, or an emissive object's receiver collection); an
+    emissive object's blocker collection is not followed in TOYRT: noted."""
     emitters, notes = [], []
     for obj in depsgraph.objects:
         ll = getattr(obj, "light_linking", None)
@@ -157,10 +158,11 @@ def read_links(depsgraph) -> LinkSets:
         receivers, blockers = ll.receiver_collection, ll.blocker_collection
         if receivers is None and blockers is None:
             continue
-        if obj.type != "LIGHT":
-            notes.append(f"object '{obj.name}': light linking of an emissive object (ignored: it lights "
-                         "and is shadowed by every object)")
-            continue
+        if obj.type != "LIGHT" and blockers is not None:
+            notes.append(f"object '{obj.name}': shadow linking of an emissive object (every object shadows it)")
+            blockers = None
+            if receivers is None:
+                continue
         emitters.append(Emitter(obj.name,
                                 _entries(receivers) if receivers is not None else None,
                                 receivers.name_full if receivers is not None else None,

@@ -18,6 +18,8 @@ from itertools import chain
 
 import numpy as np
 
+from .light_linking import ALL
+
 # The object types whose evaluated geometry is a mesh (to_mesh).
 RENDERABLE = frozenset({"MESH", "CURVE", "SURFACE", "FONT", "META"})
 
@@ -67,20 +69,21 @@ RAY_VISIBILITY = ("visible_camera", "visible_diffuse", "visible_glossy", "visibl
 
 def instance_flags(inst, obj, links) -> tuple:
     """add_instance's keywords for one object instance, as a hashable tuple: casts_shadow, the
-    light-linking sets (links.instance_sets; (0, 0) without linking) and Object's ray visibility
+    light-linking sets (links.instance_sets; (0, 0) without linking), the receiver sets it lights
+    as an emitter (its own receiver collection's; all without one) and Object's ray visibility
     (camera, diffuse, glossy, transmission; Blender 3.0+), each inherited from the instancer as in
     Cycles (an instance is seen by a kind of ray when it and its instancer both are)."""
     parent = inst.parent if inst.is_instance else None
     seen = tuple(bool(getattr(obj, name, True) and (parent is None or getattr(parent, name, True)))
                  for name in RAY_VISIBILITY)
-    sets = (0, 0) if links.empty else links.instance_sets(obj.name)
+    sets = (0, 0, ALL) if links.empty else (*links.instance_sets(obj.name), links.receiver_sets.get(obj.name, ALL))
     return (casts_shadow(inst, obj), *sets, *seen)
 
 
 def instance_arguments(flags: tuple) -> dict:
     """instance_flags as add_instance's keywords."""
     return dict(visible_shadow=flags[0], receiver_set=flags[1], blocker_set=flags[2],
-                **dict(zip(RAY_VISIBILITY, flags[3:])))
+                emitter_receiver_sets=flags[3], **dict(zip(RAY_VISIBILITY, flags[4:])))
 
 
 def singular(matrix: np.ndarray) -> bool:

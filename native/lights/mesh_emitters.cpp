@@ -180,7 +180,7 @@ LightSample sample_emitters(const MeshEmitters& emitters, const Vec3& p, const V
       s.point = p + s.distance * s.wi;
       s.pdf = width / float(st.solid_angle);
       s.radiance = t.radiance;
-      if (where != nullptr && t.textured) *where = EmitterPoint{i, barycentrics(t, s.point)};
+      if (where != nullptr) *where = EmitterPoint{i, t.textured ? barycentrics(t, s.point) : Vec2(0.0f)};
       s.point = offset_ray_origin(s.point, cos_light > 0.0f ? t.normal : -t.normal);
       return s;
     }

@@ -63,8 +63,8 @@ struct EmissiveTriangle {
   bool textured = false;
 };
 
-// Where sample_emitters() landed: the triangle's index and the point's barycentrics (b.x along
-// e1, b.y along e2), for the emission of a textured triangle.
+// Where sample_emitters() landed: the triangle's index and, for a textured triangle, the point's
+// barycentrics (b.x along e1, b.y along e2), for its emission.
 struct EmitterPoint {
   size_t index = 0;
   Vec2 b{0.0f};

@@ -341,6 +341,7 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
            py::arg("visible_shadow") = Instance{}.visible_shadow, py::arg("receiver_set") = 0,
            py::arg("blocker_set") = 0, py::arg("visible_camera") = true, py::arg("visible_diffuse") = true,
            py::arg("visible_glossy") = true, py::arg("visible_transmission") = true,
+           py::arg("emitter_receiver_sets") = kAllLightSets,
            "Places mesh `mesh` again with a (4, 4) row-major affine world matrix; returns the instance id.\n"
            "visible_shadow: Blender's Object.visible_shadow; False, the instance casts no shadow in a render\n"
            "(its light-sampled shadow rays pass it), while camera, glossy and glass rays and the ray queries\n"
@@ -348,7 +349,9 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
            "lamps light it when their receiver_sets has bit receiver_set, and it shadows lamps whose\n"
            "blocker_sets has bit blocker_set (add_light). visible_camera / visible_diffuse / visible_glossy /\n"
            "visible_transmission: Blender's Object ray visibility; False, render rays of that kind pass it (an\n"
-           "emitter hidden from diffuse rays lights no diffuse surface); the ray queries see it regardless.")
+           "emitter hidden from diffuse rays lights no diffuse surface); the ray queries see it regardless.\n"
+           "emitter_receiver_sets: where its materials emit, the receiver sets it lights (light linking of an\n"
+           "emissive object; all bits: every object), as add_light's receiver_sets.")
       .def("commit", &PyScene::commit, py::arg("builder") = builder_name(CommitOptions{}.builder),
            py::arg("threads") = CommitOptions{}.threads, py::arg("expected_rays") = py::none(),
            py::arg("should_cancel") = py::none(),

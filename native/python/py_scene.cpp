@@ -34,12 +34,14 @@ void PyScene::replace_mesh(int64_t mesh, py::handle vertices, py::handle triangl
 
 uint32_t PyScene::add_instance(int64_t mesh, py::handle transform, bool visible_shadow, int receiver_set,
                                int blocker_set, bool visible_camera, bool visible_diffuse, bool visible_glossy,
-                               bool visible_transmission) {
+                               bool visible_transmission, uint64_t light_receivers) {
   const Mat4 m = to_matrix(transform, "transform");
   const uint8_t visibility =
       uint8_t((visible_camera ? kVisibleCamera : 0) | (visible_diffuse ? kVisibleDiffuse : 0) |
               (visible_glossy ? kVisibleGlossy : 0) | (visible_transmission ? kVisibleTransmission : 0));
-  return write([&] { return scene_.add_instance(mesh, m, visible_shadow, receiver_set, blocker_set, visibility); });
+  return write([&] {
+    return scene_.add_instance(mesh, m, visible_shadow, receiver_set, blocker_set, visibility, light_receivers);
+  });
 }
 
 void PyScene::set_instance_transform(int64_t instance, py::handle transform) {

@@ -25,7 +25,8 @@ class PyScene {
   void replace_mesh(int64_t mesh, py::handle vertices, py::handle triangles, py::handle normals, py::handle uvs,
                     py::handle material_ids, py::handle tangents);
   uint32_t add_instance(int64_t mesh, py::handle transform, bool visible_shadow, int receiver_set, int blocker_set,
-                        bool visible_camera, bool visible_diffuse, bool visible_glossy, bool visible_transmission);
+                        bool visible_camera, bool visible_diffuse, bool visible_glossy, bool visible_transmission,
+                        uint64_t light_receivers);
   void set_instance_transform(int64_t instance, py::handle transform);
   void clear_instances();
 

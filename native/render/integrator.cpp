@@ -140,9 +140,11 @@ template <bool kBurley>
 // triangle chosen by power, and one cosine ray that collects the emission it hits. The cosine ray wins beside a large
 // emitter (a floor under a glowing ball, which the power-chosen triangle rarely finds well) and is the only strategy
 // for emitters, or sides of them, that shadow rays do not sample (emission sampling None, Front, Back).
+// Light linking of emissive objects: a triangle whose object does not light the receiver's set
+// adds nothing (it stays in the selection: the other triangles' estimates keep their mean).
 template <bool kBurley>
 [[gnu::noinline]] Vec3 emission_lighting(const Scene& scene, const DiffusePoint& at, const BurleyDiffuse* retro,
-                                         const Vec3& p, uint32_t pixel, uint32_t sample,
+                                         const Vec3& p, uint8_t receiver, uint32_t pixel, uint32_t sample,
                                          const IntegratorSettings& settings) {
   const MeshEmitters& emitters = scene.emitters();
   Vec3 sum(0.0f);
@@ -153,6 +155,9 @@ template <bool kBurley>
         &where);
     if (ls.valid() && emitters.triangles[where.index].textured)  // its image, where the sample landed
       ls.radiance = scene.emitted_at(emitters.keys[where.index], where.b);
+    if (ls.valid() &&
+        !in_light_sets(scene.instance(uint32_t(emitters.keys[where.index] >> 32)).light_receivers, receiver))
+      ls.pdf = 0.0f;  // its object does not light this receiver
     if (ls.valid()) {
       const float cos_s = glm::dot(at.ns, ls.wi);
       Vec3 tr(1.0f);
@@ -172,6 +177,7 @@ template <bool kBurley>
                                         tr, kVisibleDiffuse);
   const int32_t m = hit.found() ? material_of(scene, hit) : -1;
   if (m < 0 || size_t(m) >= scene.emission().size() || !scene.emission()[size_t(m)].emits()) return sum;
+  if (!in_light_sets(scene.instance(uint32_t(hit.instance)).light_receivers, receiver)) return sum;
   const MaterialEmission& e = scene.emission()[size_t(m)];
   const uint64_t key = uint64_t(uint32_t(hit.instance)) << 32 | uint64_t(uint32_t(hit.prim));
   const Vec3 radiance = e.texture < 0 ? e.radiance : scene.emitted_at(key, Vec2(hit.u, hit.v));
@@ -235,7 +241,8 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
                                              : !scene.occluded(Ray{origin, 0.0f, wi, kInfinity}, kVisibleDiffuse)))
       sum += diffuse_f<kBurley>(at, retro, wi) * world.background * tr * kPi;  // f = albedo / pi
   }
-  if (scene.any_emission()) sum += emission_lighting<kBurley>(scene, at, retro, s.p, pixel, sample, settings);
+  if (scene.any_emission())
+    sum += emission_lighting<kBurley>(scene, at, retro, s.p, s.receiver_set, pixel, sample, settings);
   const std::vector<Light>& lights = world.lights;
   if (settings.light_sampling != LightSampling::One || lights.size() == 1) {
     for (size_t j = 0; j < lights.size(); ++j) add(j, 1.0f, 1 + uint32_t(j));
@@ -342,7 +349,11 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     }
     // A camera or specular ray sees an emitting surface's radiance (both sides, as Cycles' mesh
     // lights); its BSDF (black for a pure Emission shader) still scatters below.
-    if (scene.any_emission() && s.material >= 0 && size_t(s.material) < materials.size()) {
+    // Light linking: an emissive object not linked to the receiver set of the ray's last vertex
+    // shows no emission there, as Cycles' mesh lights; camera rays see it regardless (unlike a
+    // lamp: measured, parity emitter_linking).
+    if (scene.any_emission() && s.material >= 0 && size_t(s.material) < materials.size() &&
+        (kind == RayKind::Camera || in_light_sets(scene.instance(uint32_t(hit.instance)).light_receivers, receiver))) {
       const Vec3 glow = emitted(scene.emission()[size_t(s.material)], scene.textures(), s.uv);
       radiance += throughput * glow;
       if (first) first->emission += glow;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/bbox.h"
+#include "lights/light_linking.h"
 
 #include <cstdint>
 
@@ -35,6 +36,9 @@ struct Instance {
   // The path rays that see it (RayVisibility bits); the ray API's queries see it regardless. An
   // emissive instance hidden from diffuse rays lights no diffuse surface, as Cycles' mesh lights.
   uint8_t visibility = kVisibleAll;
+  // As an emitter (its materials emit): the receiver sets it lights (light linking of an
+  // emissive object, Blender 4.0+); all by default.
+  uint64_t light_receivers = kAllLightSets;
 };
 
 }  // namespace toyrt

@@ -49,7 +49,7 @@ Mat4 Scene::checked_inverse(const Mat4& to_world) {
 }
 
 uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world, bool visible_shadow, int receiver_set, int blocker_set,
-                             uint8_t visibility) {
+                             uint8_t visibility, uint64_t light_receivers) {
   check_mesh_id(mesh);
   if (receiver_set < 0 || receiver_set >= kLightSets || blocker_set < 0 || blocker_set >= kLightSets)
     throw std::invalid_argument("light-linking set must be in [0, 64): receiver_set " + std::to_string(receiver_set) +
@@ -64,6 +64,7 @@ uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world, bool visible_sh
   inst.receiver_set = uint8_t(receiver_set);
   inst.blocker_set = uint8_t(blocker_set);
   inst.visibility = visibility & kVisibleAll;
+  inst.light_receivers = light_receivers;
   instances_.push_back(inst);
   committed_ = false;
   return uint32_t(instances_.size() - 1);

@@ -101,8 +101,10 @@ class Scene {
   // `visible_shadow` false: the instance casts no shadow in a render (Instance::visible_shadow).
   // receiver_set / blocker_set: its light-linking sets (Instance; < kLightSets, else
   // std::invalid_argument). visibility: the path rays that see it (RayVisibility bits).
+  // light_receivers: as an emitter, the receiver sets it lights (Instance::light_receivers).
   uint32_t add_instance(int64_t mesh, const Mat4& to_world, bool visible_shadow = true, int receiver_set = 0,
-                        int blocker_set = 0, uint8_t visibility = kVisibleAll);
+                        int blocker_set = 0, uint8_t visibility = kVisibleAll,
+                        uint64_t light_receivers = kAllLightSets);
   // Edits for interactive updates (the viewport), each leaving the scene uncommitted; ids stay
   // valid. replace_mesh swaps a mesh's geometry and shading (its BVH is rebuilt by the next
   // commit, the instances placing it stay); set_instance_transform moves one instance (the next

@@ -767,6 +767,34 @@ def scene_light_linking(p):
 SCENES_SPEC.append(("light_linking", scene_light_linking, dict(from_version=(4, 0, 0), mean_limit=0.005), 0))
 
 
+# Light linking of an emissive object (4.0+): a warm Emission panel whose receiver collection
+# excludes a red box (lit by the cool panel alone), and a cool panel whose collection includes
+# only the box; the camera (receiver set 0) sees neither panel's emission where its collection
+# leaves set 0 out: the cool one.
+def scene_emitter_linking(p):
+    kit.plane("floor", 8.0, kit.diffuse("white", (0.8, 0.8, 0.8)))
+    red = kit.box("red_box", 0.6, (-0.6, 0.2, 0.3), kit.diffuse("red", (0.7, 0.2, 0.1)))
+    kit.box("grey_box", 0.6, (0.8, 0.0, 0.3), kit.diffuse("grey", (0.5, 0.5, 0.5)))
+    warm = kit.plane("warm_panel", 1.0, kit.emission("warm", (1.0, 0.8, 0.6), 12.0), (0.8, -0.8, 1.8))
+    warm.rotation_euler = (np.radians(150), 0.0, 0.0)
+    cool = kit.plane("cool_panel", 0.8, kit.emission("cool", (0.4, 0.6, 1.0), 12.0), (-1.6, -0.4, 1.2))
+    cool.rotation_euler = (np.radians(140), np.radians(-30), 0.0)
+
+    def linking(name, obj, state):
+        coll = bpy.data.collections.new(name)
+        coll.objects.link(obj)
+        coll.collection_objects[0].light_linking.link_state = state
+        return coll
+
+    warm.light_linking.receiver_collection = linking("warm_receivers", red, "EXCLUDE")
+    cool.light_linking.receiver_collection = linking("cool_receivers", red, "INCLUDE")
+    camera((0.0, -5.5, 3.5), (0, 0, 0.2))
+    kit.world((0.02, 0.02, 0.02))
+
+
+SCENES_SPEC.append(("emitter_linking", scene_emitter_linking, dict(from_version=(4, 0, 0), mean_limit=0.005), 0))
+
+
 # ---- Cycles ------------------------------------------------------------------------------------
 
 def render_cycles(scene, path):

@@ -135,3 +135,32 @@ def test_the_later_entry_for_an_object_wins_and_blockers_are_computed_apart():
     assert links.receiver_sets["l"] == ALL & ~(1 << a)
     w = links.blocker_set["wall"]
     assert links.blocker_sets["l"] == ALL & ~(1 << w) and links.instance_sets("wall") == (0, w)
+
+
+def test_an_emissive_object_lights_only_the_receiver_sets_it_is_linked_to():
+    """Emissive objects link as lamps do (emitter_receiver_sets). A 1 m emissive square 0.5 m over
+    the floor's point (set 1), and a brighter one beside it whose sets leave out set 1: the point
+    gets the first square's pi L F alone; with the second linked too it gets more. The camera sees
+    an emitter whatever its sets (as Cycles' camera rays see mesh lights)."""
+    from test_mesh_emitters import grid, square_irradiance_over_radiance
+
+    def scene(second_sets):
+        s = toyrt.Scene()
+        floor(s, receiver_set=1)
+        s.add_material("diffuse", color=(0.0, 0.0, 0.0), emission=(2.0, 2.0, 2.0))
+        s.add_material("diffuse", color=(0.0, 0.0, 0.0), emission=(20.0, 20.0, 20.0))
+        for material, x, sets in ((1, 0.0, ALL), (2, 1.5, second_sets)):
+            v, t = grid(1, 1.0, 0.5)
+            mid = s.add_mesh(v + np.float32([x, 0, 0]), t, material_ids=material, instance=False)
+            s.add_instance(mid, np.eye(4), emitter_receiver_sets=sets)
+        s.commit()
+        return s
+
+    under = camera_above(height=0.25, size=0.002, resolution=2)
+    expected = 0.8 * 2.0 * square_irradiance_over_radiance(1.0, 0.5) / math.pi
+    got = scene(ALL & ~(1 << 1)).render(under, samples=2048)[..., 0].mean()
+    assert abs(got - expected) < 0.01 * expected
+    assert scene(ALL).render(under, samples=256)[..., 0].mean() > 1.2 * expected
+    over_second = camera_above(height=5.0, size=0.002, resolution=2)
+    over_second["matrix_world"][0, 3] = 1.5
+    np.testing.assert_allclose(scene(ALL & ~1).render(over_second, samples=4)[..., :3], 20.0, rtol=1e-6)
