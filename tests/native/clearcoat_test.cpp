@@ -5,6 +5,7 @@
 // clearcoat lobe: added beside the rest, nothing below attenuated.
 #include "materials/clearcoat.h"
 #include "hemisphere.h"
+#include "material_fixtures.h"
 #include "materials/fresnel.h"
 #include "materials/glossy_lobe.h"
 #include "materials/principled.h"
@@ -15,16 +16,11 @@
 #include <vector>
 
 using namespace toyrt;
+using toyrt::testing::args;
 using toyrt::testing::direction;
+using toyrt::testing::kContext;
 
 namespace {
-
-const std::vector<Texture> kNoTextures;
-const MaterialContext kContext{&kNoTextures};
-
-Params args(std::initializer_list<std::pair<std::string, Params::Value>> values) {
-  return Params(std::vector<std::pair<std::string, Params::Value>>(values));
-}
 
 // A Blender 3.x Principled as the add-on sends it, with Clearcoat `coat`.
 Principled principled_3x(float coat, float coat_roughness) {

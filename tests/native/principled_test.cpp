@@ -9,6 +9,7 @@
 // under that pick averages to the closures' mixed-pdf estimator (render/closure_pick.h).
 #include "materials/principled.h"
 #include "hemisphere.h"
+#include "material_fixtures.h"
 #include "materials/coat.h"
 #include "materials/fresnel.h"
 #include "materials/glossy.h"
@@ -25,17 +26,13 @@
 #include <vector>
 
 using namespace toyrt;
+using toyrt::testing::args;
 using toyrt::testing::direction;
 using toyrt::testing::hemisphere_integral;
+using toyrt::testing::kContext;
 
 namespace {
 
-const std::vector<Texture> kNoTextures;
-const MaterialContext kContext{&kNoTextures};
-
-Params args(std::initializer_list<std::pair<std::string, Params::Value>> values) {
-  return Params(std::vector<std::pair<std::string, Params::Value>>(values));
-}
 Principled principled(const Params& params) { return Principled::from_params(params); }
 
 // A hit on the plane z = 0 seen from wo.

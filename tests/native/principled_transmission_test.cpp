@@ -4,6 +4,7 @@
 // the opaque material unchanged; in between, over the lobe-choice numbers, the glass is drawn
 // with probability (1 - Metallic) Transmission, the metal with Metallic, and the base keeps its
 // weight (1 - Metallic)(1 - Transmission) in expectation; bad values are refused or clamped.
+#include "material_fixtures.h"
 #include "materials/principled.h"
 #include "materials/refraction.h"
 
@@ -13,10 +14,10 @@
 #include <vector>
 
 using namespace toyrt;
+using toyrt::testing::kNoTextures;
 
 namespace {
 
-const std::vector<Texture> kNoTextures;
 using Args = std::vector<std::pair<std::string, Params::Value>>;
 
 Principled principled(Args args) { return Principled::from_params(Params(std::move(args))); }

@@ -21,18 +21,23 @@ def floor(s, **sets):
     s.add_instance(mid, np.eye(4), **sets)
 
 
+def linked_lamp_alone(radius, commit=True):
+    """The floor in receiver set 1 under the one lamp the tests link to it: 100 W at (0, 0, 2)."""
+    s = toyrt.Scene()
+    floor(s, receiver_set=1)
+    s.add_light("POINT", position=(0, 0, 2), power=100.0, radius=radius)
+    if commit:
+        s.commit()
+    return s
+
+
 def test_a_plane_linked_to_one_of_two_lights_renders_as_under_that_light_alone():
     """Two point lights (radius 0) over a floor in receiver set 1; the second lamp's receiver
     sets exclude set 1: the image is the first lamp's alone, sample for sample, and its centre
     pixel the closed form albedo / pi x P / (4 pi d^2)."""
     cam = camera_above(size=0.02, resolution=1)
-    alone = toyrt.Scene()
-    floor(alone, receiver_set=1)
-    alone.add_light("POINT", position=(0, 0, 2), power=100.0, radius=0.0)
-    alone.commit()
-    linked = toyrt.Scene()
-    floor(linked, receiver_set=1)
-    linked.add_light("POINT", position=(0, 0, 2), power=100.0, radius=0.0)
+    alone = linked_lamp_alone(0.0)
+    linked = linked_lamp_alone(0.0, commit=False)
     linked.add_light("POINT", position=(0.5, 0, 1), power=300.0, radius=0.0, receiver_sets=ALL & ~(1 << 1))
     linked.commit()
     want = alone.render(cam, samples=4)
@@ -59,10 +64,7 @@ def test_through_the_light_tree_the_lamps_not_linked_to_a_floor_are_never_picked
     scene selects through its light tree, which never enters a cluster of unlinked lamps, so the
     one lamp is picked with probability 1 and the image is that lamp's alone, sample for sample."""
     cam = camera_above(size=1.0, resolution=8)
-    alone = toyrt.Scene()
-    floor(alone, receiver_set=1)
-    alone.add_light("POINT", position=(0, 0, 2), power=100.0, radius=0.1)
-    alone.commit()
+    alone = linked_lamp_alone(0.1)
     many = toyrt.Scene()
     floor(many, receiver_set=1)
     rng = np.random.default_rng(3)
