@@ -164,8 +164,9 @@ def test_principled_emission_is_seen_as_colour_times_strength():
 
 def test_a_lamp_whose_receiver_collection_excludes_the_floor_does_not_light_it():
     """Light linking (4.0+): a second lamp whose receiver collection EXCLUDEs the floor leaves the
-    image as the first lamp's alone (both radius 0: no noise), and an emissive plane with a
-    receiver collection is noted (not linked). Blender 3.x has no light linking: nothing to test."""
+    image as the first lamp's alone (both radius 0: no noise); an emissive plane's receiver
+    collection links it as a lamp's (no note), its blocker collection is noted (not followed).
+    Blender 3.x has no light linking: nothing to test."""
     if "light_linking" not in bpy.types.Object.bl_rna.properties.keys():
         check(True, "no light linking in this Blender (3.x): nothing is read")
         return
@@ -180,11 +181,14 @@ def test_a_lamp_whose_receiver_collection_excludes_the_floor_does_not_light_it()
     result, linked, _ = render("linking_linked")
     glow = kit.plane("glow", 0.5, kit.emission("glow", (1.0, 1.0, 1.0), 1.0), (3.0, 3.0, 1.0))
     glow.light_linking.receiver_collection = receivers
+    _, receiver_notes = notes_of_export()
+    glow.light_linking.blocker_collection = receivers
     _, notes = notes_of_export()
     same = alone is not None and linked is not None and np.allclose(linked, alone, rtol=1e-6, atol=0)
-    check(result_alone == result == {"FINISHED"} and same and "glow" in notes and "light linking" in notes,
-          f"the excluded lamp adds nothing to the floor ({same}); the emissive plane's linking is noted "
-          f"({'glow' in notes})")
+    check(result_alone == result == {"FINISHED"} and same and "glow" not in receiver_notes
+          and "glow" in notes and "shadow linking" in notes,
+          f"the excluded lamp adds nothing to the floor ({same}); the emissive plane's receivers are followed "
+          f"({'glow' not in receiver_notes}), its blockers noted ({'glow' in notes})")
 
 
 def test_light_linking_edits_reach_the_viewport_as_a_fresh_export():
