@@ -295,9 +295,24 @@ def _diffuse(color):
     return MaterialSpec("diffuse", color=color), None
 
 
+# From this version Cycles' default surface (an object or slot without a material) is a Principled
+# BSDF with its defaults, no longer a Diffuse BSDF of 0.8 grey: measured on 5.0 (bit for bit the
+# same image as an explicit default Principled; 0.9 % darker than the Diffuse on the torus_file
+# parity scene) and seen in a 4.5-era Cycles source; 3.4 has the Diffuse. 4.0-4.4 are not verified.
+DEFAULT_SURFACE_PRINCIPLED_FROM = (4, 5, 0)
+
+
+def _default_surface():
+    """Cycles' default surface in this Blender version, as (MaterialSpec, image)."""
+    if _blender_version() < DEFAULT_SURFACE_PRINCIPLED_FROM:
+        return _diffuse(DEFAULT_GREY)
+    return MaterialSpec("principled", color=DEFAULT_GREY, ior=1.5, roughness=0.5, specular_ior_level=0.5,
+                        shadowing="correlated", multiscatter=True, layered=True), None
+
+
 def _convert(mat, notes):
     if mat is None:
-        return _diffuse(DEFAULT_GREY)
+        return _default_surface()
     name = mat.name
     if not getattr(mat, "use_nodes", False) or mat.node_tree is None:
         # Cycles renders a node-less material as a diffuse of its viewport colour.

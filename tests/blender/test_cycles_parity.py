@@ -345,10 +345,9 @@ SCENES_SPEC = [
     # horizon and lighting the floor and the box.
     ("hdri_sky", scene_hdri, dict(sun=(0.6, 0.8, 60.0), strength=1.5, rotation=(0.0, 0.0, 0.7),
                                   camera=(0.0, -6.0, 2.0)), 0),
-    # Cycles 4.x/5.x renders this file's torus 2.6 % darker than 3.4 does, with no difference on
-    # simpler scenes with the same lights (docs/parity-blender-5.0.md): measured and reported
-    # there, asserted on 3.4 only until the cause is found.
-    ("torus_file", scene_torus_file, dict(file=TORUS_FILE.name, asserted_before=(4, 0, 0)), 0),
+    # The torus has no material: Cycles' default surface, a Diffuse BSDF on 3.4 and a default
+    # Principled BSDF on 5.0 (materials.DEFAULT_SURFACE_PRINCIPLED_FROM; docs/parity-blender-5.0.md).
+    ("torus_file", scene_torus_file, dict(file=TORUS_FILE.name), 0),
     # Glossy roughness sweeps (GGX; the mean limit 0.5 %, the materials issue's), under a spherical
     # point lamp and a rectangular area lamp; glossy bounces 8, diffuse bounces 0.
     ("glossy_sweep_point", scene_glossy_sweep, dict(roughness=[0.05, 0.2, 0.4, 0.7, 1.0], color=(0.9, 0.75, 0.5),
