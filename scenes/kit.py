@@ -177,17 +177,25 @@ def cut_out(name, color, image, kind="mix"):
     return mat
 
 
-def normal_map(mat, image, strength=1.0, space="TANGENT", uv_map="", shader=None):
-    """Wire an Image Texture of `image` (Non-Color data) through a Normal Map node (`space`,
-    `strength`, `uv_map`: '' for the render-active UV map) into the Normal input of `shader` (the
-    node linked to the material's output when None). Returns the Normal Map node."""
-    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+def _shader_and_image(mat, image, shader):
+    """(the shader node: `shader`, or the one linked to the material's output when None; a new
+    Image Texture node of `image`, bilinear and repeating)."""
+    nodes = mat.node_tree.nodes
     if shader is None:
         out = next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
         shader = out.inputs["Surface"].links[0].from_node
     tex = nodes.new("ShaderNodeTexImage")
     tex.image = image
     tex.interpolation, tex.extension = "Linear", "REPEAT"
+    return shader, tex
+
+
+def normal_map(mat, image, strength=1.0, space="TANGENT", uv_map="", shader=None):
+    """Wire an Image Texture of `image` (Non-Color data) through a Normal Map node (`space`,
+    `strength`, `uv_map`: '' for the render-active UV map) into the Normal input of `shader` (the
+    node linked to the material's output when None). Returns the Normal Map node."""
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    shader, tex = _shader_and_image(mat, image, shader)
     node = nodes.new("ShaderNodeNormalMap")
     node.space, node.uv_map = space, uv_map
     node.inputs["Strength"].default_value = strength
@@ -201,12 +209,7 @@ def bump(mat, image, strength=1.0, distance=1.0, invert=False, shader=None):
     Normal input of `shader` (the node linked to the material's output when None). Returns the
     Bump node."""
     nodes, links = mat.node_tree.nodes, mat.node_tree.links
-    if shader is None:
-        out = next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
-        shader = out.inputs["Surface"].links[0].from_node
-    tex = nodes.new("ShaderNodeTexImage")
-    tex.image = image
-    tex.interpolation, tex.extension = "Linear", "REPEAT"
+    shader, tex = _shader_and_image(mat, image, shader)
     node = nodes.new("ShaderNodeBump")
     node.invert = invert
     node.inputs["Strength"].default_value = strength

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from .materials import ImageKey, _blender_version, _texture, input_socket, linked_node, output_node
+from .materials import ImageKey, _blender_version, _constant, _texture, input_socket, linked_node, output_node
 
 # The shaders whose Normal input is honoured.
 BSDFS = frozenset({"BSDF_PRINCIPLED", "BSDF_DIFFUSE", "BSDF_GLOSSY", "BSDF_ANISOTROPIC", "BSDF_GLASS",
@@ -136,19 +136,6 @@ def _shadowing(correction: bool) -> str:
     return "chiang"
 
 
-def _constant_input(name, node, socket_name, fallback, notes) -> float:
-    sock = input_socket(node, socket_name)
-    if sock is None:
-        return fallback
-    if sock.is_linked:
-        notes.append(f"material '{name}': linked Bump {socket_name} (its constant value)")
-    v = float(sock.default_value)
-    if v != v:
-        notes.append(f"material '{name}': Bump {socket_name} is NaN ({fallback})")
-        return fallback
-    return v
-
-
 def _bump(name, src, notes, correction):
     """A Bump node's NormalMapSpec (space 'BUMP'), or (None, None): the surface normal, noted."""
     height = input_socket(src, "Height")
@@ -169,8 +156,8 @@ def _bump(name, src, notes, correction):
         # Before 4.4 Cycles differences the height over a whole pixel's footprint.
         notes.append(f"material '{name}': Bump slope at the point (Cycles before 4.4: over a pixel's footprint)")
     channel = "alpha" if links[0].from_socket.name == "Alpha" else "gray"
-    strength = _constant_input(name, src, "Strength", 1.0, notes)
-    distance = _constant_input(name, src, "Distance", 1.0, notes)
+    strength = _constant(name, input_socket(src, "Strength"), "Bump Strength", 1.0, notes)
+    distance = _constant(name, input_socket(src, "Distance"), "Bump Distance", 1.0, notes)
     if getattr(src, "invert", False):
         distance = -distance
     return NormalMapSpec(replace(key, alpha=True), strength, "BUMP", shadowing=_shadowing(correction),

@@ -743,18 +743,21 @@ SCENES_SPEC.append(("world_hidden_from_transmission", scene_world_visibility,
 # receiver collection EXCLUDEs it) and not shadowed by the other (its blocker collection EXCLUDEs
 # that one), and a fill lamp that lights only the first box (an INCLUDE entry: the floor and the
 # other box are left unlit by it).
+def linking(name, obj, state):
+    """A new collection holding `obj` with link state `state` (INCLUDE / EXCLUDE): a light-linking
+    receiver or blocker collection."""
+    coll = bpy.data.collections.new(name)
+    coll.objects.link(obj)
+    coll.collection_objects[0].light_linking.link_state = state
+    return coll
+
+
 def scene_light_linking(p):
     kit.plane("floor", 8.0, kit.diffuse("white", (0.8, 0.8, 0.8)))
     unlit = kit.box("unlit_by_key", 0.6, (-0.8, 0.2, 0.3), kit.diffuse("red", (0.7, 0.2, 0.1)))
     no_shadow = kit.box("no_key_shadow", 0.6, (0.8, 0.0, 0.3), kit.diffuse("grey", (0.5, 0.5, 0.5)))
     key = kit.point_light("key", (1.5, -1.5, 2.5), 500.0, radius=0.1)
     fill = kit.point_light("fill", (-2.0, -1.0, 1.5), 200.0, color=(0.4, 0.6, 1.0), radius=0.1)
-
-    def linking(name, obj, state):
-        coll = bpy.data.collections.new(name)
-        coll.objects.link(obj)
-        coll.collection_objects[0].light_linking.link_state = state
-        return coll
 
     key.light_linking.receiver_collection = linking("key_receivers", unlit, "EXCLUDE")
     key.light_linking.blocker_collection = linking("key_blockers", no_shadow, "EXCLUDE")
@@ -778,12 +781,6 @@ def scene_emitter_linking(p):
     warm.rotation_euler = (np.radians(150), 0.0, 0.0)
     cool = kit.plane("cool_panel", 0.8, kit.emission("cool", (0.4, 0.6, 1.0), 12.0), (-1.6, -0.4, 1.2))
     cool.rotation_euler = (np.radians(140), np.radians(-30), 0.0)
-
-    def linking(name, obj, state):
-        coll = bpy.data.collections.new(name)
-        coll.objects.link(obj)
-        coll.collection_objects[0].light_linking.link_state = state
-        return coll
 
     warm.light_linking.receiver_collection = linking("warm_receivers", red, "EXCLUDE")
     cool.light_linking.receiver_collection = linking("cool_receivers", red, "INCLUDE")

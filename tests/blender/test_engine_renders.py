@@ -52,6 +52,27 @@ def main():
     check("camera" in (run.stdout + run.stderr).lower(), "the error says what is wrong")
 
 
+def render_red(name):
+    """F12's operator into an EXR still: the red channel, rows from the bottom."""
+    path = os.path.join(tempfile.mkdtemp(), name + ".exr")
+    bpy.context.scene.render.filepath = path
+    bpy.context.scene.render.image_settings.file_format = "OPEN_EXR"
+    bpy.ops.render.render(write_still=True)
+    return kit.read_image(path)[..., 0]
+
+
+def instanced_by_an_empty(obj, group_name, empty_name):
+    """Moves `obj` into a new collection placed by a new empty (a collection instance); the empty."""
+    group = bpy.data.collections.new(group_name)
+    for coll in obj.users_collection:
+        coll.objects.unlink(obj)
+    group.objects.link(obj)
+    empty = kit.link(bpy.data.objects.new(empty_name, None))
+    empty.instance_type = "COLLECTION"
+    empty.instance_collection = group
+    return empty
+
+
 def objects_without_shadows():
     """Object.visible_shadow off: a 0.2 m square 0.75 m above the plane, under the point light at
     1 m, shades a 0.8 m square of the plane, of which the camera sees all but the middle 0.2 m
@@ -63,11 +84,7 @@ def objects_without_shadows():
     ring = (np.maximum(abs(x), abs(y)) > 0.15) & (np.maximum(abs(x), abs(y)) < 0.35)
 
     def ring_of(name):
-        path = os.path.join(tempfile.mkdtemp(), name + ".exr")
-        bpy.context.scene.render.filepath = path
-        bpy.context.scene.render.image_settings.file_format = "OPEN_EXR"
-        bpy.ops.render.render(write_still=True)
-        return kit.read_image(path)[..., 0][ring]
+        return render_red(name)[ring]
 
     build_scene()
     blocker = kit.plane("blocker", 0.2, kit.diffuse("blocker_white", (1, 1, 1)), location=(0, 0, 0.75))
@@ -81,13 +98,7 @@ def objects_without_shadows():
 
     # The same square in a collection placed by an empty; the square casts shadows, the empty not.
     blocker.visible_shadow = True
-    group = bpy.data.collections.new("shadowless_group")
-    for coll in blocker.users_collection:
-        coll.objects.unlink(blocker)
-    group.objects.link(blocker)
-    empty = kit.link(bpy.data.objects.new("instancer", None))
-    empty.instance_type = "COLLECTION"
-    empty.instance_collection = group
+    empty = instanced_by_an_empty(blocker, "shadowless_group", "instancer")
     empty.visible_shadow = False
     inherited = ring_of("instanced")
     err = abs(inherited - lit).max() / lit.max()
@@ -102,38 +113,25 @@ def objects_hidden_from_the_camera():
     without shadows either, leaves the open plane's closed form in every pixel; casting shadows,
     the camera sees through it to its shadow (black in the middle); under an empty hidden from the
     camera an instance of it is hidden too (Cycles' instances inherit the instancer's visibility)."""
-    def render(name):
-        path = os.path.join(tempfile.mkdtemp(), name + ".exr")
-        bpy.context.scene.render.filepath = path
-        bpy.context.scene.render.image_settings.file_format = "OPEN_EXR"
-        bpy.ops.render.render(write_still=True)
-        return kit.read_image(path)[..., 0]
-
     build_scene()
     square = kit.plane("hidden", 0.2, kit.diffuse("hidden_white", (1, 1, 1)), location=(0, 0, 0.75))
     lit = expected_image()
     middle = np.s_[14:18, 14:18]
-    seen = render("seen")
+    seen = render_red("seen")
     check(seen[middle].min() > 0.0, "seen by the camera, the square is in the middle of the image")
     square.visible_camera = False
     square.visible_shadow = False
-    err = abs(render("hidden") - lit).max() / lit.max()
+    err = abs(render_red("hidden") - lit).max() / lit.max()
     check(err < 0.01, f"hidden from the camera and casting no shadow: the open plane (max error {err:.4f})")
     square.visible_shadow = True
-    through = render("hidden_casting")
+    through = render_red("hidden_casting")
     check(through[middle].max() < 1e-6 * lit.max(),
           f"the camera sees its shadow through it ({through[middle].max():.3g})")
     square.visible_camera = square.visible_shadow = True
-    group = bpy.data.collections.new("hidden_group")
-    for coll in square.users_collection:
-        coll.objects.unlink(square)
-    group.objects.link(square)
-    empty = kit.link(bpy.data.objects.new("hidden_instancer", None))
-    empty.instance_type = "COLLECTION"
-    empty.instance_collection = group
+    empty = instanced_by_an_empty(square, "hidden_group", "hidden_instancer")
     empty.visible_camera = False
     empty.visible_shadow = False
-    err = abs(render("instanced_hidden") - lit).max() / lit.max()
+    err = abs(render_red("instanced_hidden") - lit).max() / lit.max()
     check(err < 0.01, f"an instance under an empty hidden from the camera is hidden too (max error {err:.4f})")
 
 

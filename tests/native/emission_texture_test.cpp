@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "render_fixtures.h"
+#include "test_scenes.h"
 
 using namespace toyrt;
 using namespace toyrt::testing;
@@ -29,26 +30,12 @@ Texture band_image() {
 
 // An emitting square [-1, 1]^2 at height z, `side` x `side` quads, uv = ((x + 1) / 2, (y + 1) / 2).
 void add_square(Scene& scene, float z, int side, int32_t material) {
-  std::vector<Vec3> v;
-  std::vector<Triangle> t;
-  std::vector<Vec2> uv_of;
-  const float cell = 2.0f / float(side);
-  for (int i = 0; i <= side; ++i)
-    for (int j = 0; j <= side; ++j) {
-      v.emplace_back(-1.0f + float(i) * cell, -1.0f + float(j) * cell, z);
-      uv_of.emplace_back(float(i) / float(side), float(j) / float(side));
-    }
-  const auto at = [&](int i, int j) { return uint32_t(i * (side + 1) + j); };
-  for (int i = 0; i < side; ++i)
-    for (int j = 0; j < side; ++j) {
-      t.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
-      t.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-    }
+  const GridData g = square_grid(side, 0.0f, z, 1.0f);
   MeshShading sh;
-  sh.material_ids.assign(t.size(), material);
-  for (const Triangle& tri : t)
-    for (uint32_t k : {tri.x, tri.y, tri.z}) sh.corner_uvs.push_back(uv_of[k]);
-  scene.add_instance(scene.add_mesh(v, t, sh), Mat4(1.0f));
+  sh.material_ids.assign(g.mesh.triangles.size(), material);
+  for (const Triangle& tri : g.mesh.triangles)
+    for (uint32_t k : {tri.x, tri.y, tri.z}) sh.corner_uvs.push_back(g.uvs[k]);
+  scene.add_instance(scene.add_mesh(g.mesh.vertices, g.mesh.triangles, sh), Mat4(1.0f));
 }
 
 // One pixel of an orthographic camera at (x, 0, z) looking down.

@@ -12,6 +12,7 @@
 
 #include "light_estimates.h"
 #include "render_fixtures.h"
+#include "test_scenes.h"
 
 #include <gtest/gtest.h>
 
@@ -232,20 +233,10 @@ TEST(EmitterTree, ItsVarianceUnderOneCornerOfALargeEmitterIsFarBelowThePowerCdfs
 
 // A square emitter of half-width `half` centred at (x, 0, z), tiled into side x side quads.
 void add_emissive_square(Scene& scene, int side, float x, float z, float half, int32_t material) {
-  std::vector<Vec3> v;
-  std::vector<Triangle> t;
-  const float cell = 2.0f * half / float(side);
-  for (int i = 0; i <= side; ++i)
-    for (int j = 0; j <= side; ++j) v.emplace_back(x - half + float(i) * cell, -half + float(j) * cell, z);
-  const auto at = [&](int i, int j) { return uint32_t(i * (side + 1) + j); };
-  for (int i = 0; i < side; ++i)
-    for (int j = 0; j < side; ++j) {
-      t.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
-      t.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-    }
+  const GridData g = square_grid(side, x, z, half);
   MeshShading sh;
-  sh.material_ids.assign(t.size(), material);
-  scene.add_instance(scene.add_mesh(v, t, sh), Mat4(1.0f));
+  sh.material_ids.assign(g.mesh.triangles.size(), material);
+  scene.add_instance(scene.add_mesh(g.mesh.vertices, g.mesh.triangles, sh), Mat4(1.0f));
 }
 
 TEST(EmitterTree, TheSceneBuildsItAtCommitForManySpreadTrianglesAndTheRenderKeepsItsMean) {

@@ -12,6 +12,23 @@ namespace {
 constexpr float kPi = 3.14159265358979f;
 }
 
+GridData square_grid(int side, float x, float z, float half) {
+  GridData g;
+  const float cell = 2.0f * half / float(side);
+  for (int i = 0; i <= side; ++i)
+    for (int j = 0; j <= side; ++j) {
+      g.mesh.vertices.emplace_back(x - half + float(i) * cell, -half + float(j) * cell, z);
+      g.uvs.emplace_back(float(i) / float(side), float(j) / float(side));
+    }
+  const auto at = [&](int i, int j) { return uint32_t(i * (side + 1) + j); };
+  for (int i = 0; i < side; ++i)
+    for (int j = 0; j < side; ++j) {
+      g.mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      g.mesh.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  return g;
+}
+
 MeshData uv_sphere(int rings, int segments, float radius, float bumps) {
   MeshData m;
   auto r_at = [&](float theta, float phi) {

@@ -4,6 +4,7 @@
 
 #include "core/ray.h"
 #include "geometry/mesh.h"
+#include "sampling/warp.h"
 
 #include <cstdint>
 #include <vector>
@@ -15,6 +16,14 @@ struct MeshData {
   std::vector<Triangle> triangles;
   size_t triangle_count() const { return triangles.size(); }
 };
+
+// A square of side 2 half at height z, centred on (x, 0, z), facing up, as side x side quads of two
+// triangles; uvs: per vertex, (0, 0) to (1, 1) across the square.
+struct GridData {
+  MeshData mesh;
+  std::vector<Vec2> uvs;
+};
+GridData square_grid(int side, float x, float z, float half);
 
 // Closed UV sphere with shared vertices: `rings` latitude bands, `segments` longitudes; each
 // pole is one vertex shared by a fan of `segments` triangles. 2 * segments * (rings - 1) triangles.
