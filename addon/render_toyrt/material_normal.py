@@ -98,16 +98,10 @@ def _from_socket(name, socket, notes, correction=True):
     if src.type != "NORMAL_MAP":
         notes.append(f"material '{name}': normal input from {src.bl_idname} (the surface normal)")
         return None, None
-    color = input_socket(src, "Color")
-    tex = linked_node(color) if color is not None else None
-    if tex is None or tex.type != "TEX_IMAGE":
-        what = tex.bl_idname if tex is not None else "a constant colour"
-        notes.append(f"material '{name}': Normal Map colour from {what} (the surface normal)")
+    found = _image_on(name, input_socket(src, "Color"), "Normal Map colour", "Normal Map", notes)
+    if found is None:
         return None, None
-    key, image = _texture(name, tex, notes)
-    if image is None or not _has_pixels(image):
-        notes.append(f"material '{name}': Normal Map without an image (the surface normal)")
-        return None, None
+    key, image, _ = found
     strength_socket = input_socket(src, "Strength")
     strength = 1.0
     if strength_socket is not None:
@@ -129,6 +123,22 @@ def _from_socket(name, socket, notes, correction=True):
                          _shadowing(correction)), image
 
 
+def _image_on(name, socket, what, node_label, notes):
+    """(key, image, output name) of the Image Texture linked to `socket`, or None (noted): linked
+    to another node or to nothing, or an image that does not load."""
+    links = getattr(socket, "links", ()) if socket is not None else ()
+    tex = linked_node(socket) if socket is not None else None
+    if tex is None or tex.type != "TEX_IMAGE" or not links:
+        source = tex.bl_idname if tex is not None else "a constant"
+        notes.append(f"material '{name}': {what} from {source} (the surface normal)")
+        return None
+    key, image = _texture(name, tex, notes)
+    if image is None or not _has_pixels(image):
+        notes.append(f"material '{name}': {node_label} without an image (the surface normal)")
+        return None
+    return key, image, links[0].from_socket.name
+
+
 def _shadowing(correction: bool) -> str:
     """Cycles' shadowing of bent diffuse normals in this Blender version."""
     if _blender_version() >= (4, 0, 0):
@@ -138,24 +148,17 @@ def _shadowing(correction: bool) -> str:
 
 def _bump(name, src, notes, correction):
     """A Bump node's NormalMapSpec (space 'BUMP'), or (None, None): the surface normal, noted."""
-    height = input_socket(src, "Height")
-    links = getattr(height, "links", ()) if height is not None else ()
-    tex = linked_node(height) if height is not None else None
-    if tex is None or tex.type != "TEX_IMAGE" or not links:
-        what = tex.bl_idname if tex is not None else "a constant"
-        notes.append(f"material '{name}': Bump height from {what} (the surface normal)")
+    found = _image_on(name, input_socket(src, "Height"), "Bump height", "Bump", notes)
+    if found is None:
         return None, None
-    key, image = _texture(name, tex, notes)
-    if image is None or not _has_pixels(image):
-        notes.append(f"material '{name}': Bump without an image (the surface normal)")
-        return None, None
+    key, image, output = found
     normal = input_socket(src, "Normal")
     if normal is not None and normal.is_linked:
         notes.append(f"material '{name}': a Bump's Normal input (the surface normal under the bump)")
     if input_socket(src, "Filter Width") is None:
         # Before 4.4 Cycles differences the height over a whole pixel's footprint.
         notes.append(f"material '{name}': Bump slope at the point (Cycles before 4.4: over a pixel's footprint)")
-    channel = "alpha" if links[0].from_socket.name == "Alpha" else "gray"
+    channel = "alpha" if output == "Alpha" else "gray"
     strength = _constant(name, input_socket(src, "Strength"), "Bump Strength", 1.0, notes)
     distance = _constant(name, input_socket(src, "Distance"), "Bump Distance", 1.0, notes)
     if getattr(src, "invert", False):

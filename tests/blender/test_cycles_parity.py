@@ -646,6 +646,19 @@ def scene_cut_out(p):
 SCENES_SPEC.append(("cut_out", scene_cut_out, dict(direction=(0.35, 0.25, -1.0), pane=(0.9, 0.55, 0.3),
                                                    mean_limit=0.005), 0))
 
+def raked_ball_stage(ball, direction):
+    """The normal-map and bump scenes' stage beside their floor: a smooth UV sphere (Blender's
+    primitive, so it has UVs) of material `ball`, a low sun from `direction`, the camera, a dim
+    world."""
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=32, ring_count=16, radius=0.6, location=(0.4, 0.3, 0.6))
+    sphere = bpy.context.active_object
+    sphere.data.polygons.foreach_set("use_smooth", np.ones(len(sphere.data.polygons), bool))
+    sphere.data.materials.append(ball)
+    kit.sun_light("sun", 3.0, direction)
+    camera((0.0, -3.6, 2.6), (0, 0.2, 0.3))
+    kit.world((0.1, 0.12, 0.15))
+
+
 def scene_normal_map(p):
     # Normal maps (the materials issue): one generated tangent-space map of sine bumps (float,
     # Non-Color) on a diffuse floor turned 30 degrees about Z (its tangents turn with it), and on a
@@ -657,13 +670,7 @@ def scene_normal_map(p):
     kit.plane("floor", 4.0, floor).rotation_euler = (0.0, 0.0, np.radians(30.0))
     ball = kit.principled_dielectric("bumpy_ball", (0.6, 0.25, 0.1), 0.4)
     kit.normal_map(ball, bumps, strength=0.6)
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=32, ring_count=16, radius=0.6, location=(0.4, 0.3, 0.6))
-    sphere = bpy.context.active_object
-    sphere.data.polygons.foreach_set("use_smooth", np.ones(len(sphere.data.polygons), bool))
-    sphere.data.materials.append(ball)
-    kit.sun_light("sun", 3.0, p["direction"])
-    camera((0.0, -3.6, 2.6), (0, 0.2, 0.3))
-    kit.world((0.1, 0.12, 0.15))
+    raked_ball_stage(ball, p["direction"])
 
 
 SCENES_SPEC.append(("normal_map", scene_normal_map, dict(direction=(-0.8, 0.3, -0.6), slope=0.6, mean_limit=0.005), 0))
@@ -681,13 +688,7 @@ def scene_bump(p):
     kit.plane("floor", 4.0, floor).rotation_euler = (0.0, 0.0, np.radians(30.0))
     ball = kit.principled_dielectric("bumped_ball", (0.6, 0.25, 0.1), 0.4)
     kit.bump(ball, heights, strength=0.6, distance=0.1, invert=True)
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=32, ring_count=16, radius=0.6, location=(0.4, 0.3, 0.6))
-    sphere = bpy.context.active_object
-    sphere.data.polygons.foreach_set("use_smooth", np.ones(len(sphere.data.polygons), bool))
-    sphere.data.materials.append(ball)
-    kit.sun_light("sun", 3.0, p["direction"])
-    camera((0.0, -3.6, 2.6), (0, 0.2, 0.3))
-    kit.world((0.1, 0.12, 0.15))
+    raked_ball_stage(ball, p["direction"])
 
 
 SCENES_SPEC.append(("bump", scene_bump, dict(direction=(-0.8, 0.3, -0.6), distance=0.25, mean_limit=0.005,
