@@ -11,7 +11,8 @@ namespace toyrt {
 
 DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& ng, const DielectricLobe& lobe,
                                  uint32_t pixel, uint32_t sample, uint32_t light_dim, uint32_t lobe_dim,
-                                 uint32_t side_dim, const IntegratorSettings& settings, uint8_t receiver_set) {
+                                 uint32_t side_dim, uint32_t emitter_dim, const IntegratorSettings& settings,
+                                 uint8_t receiver_set) {
   DielectricStep step;
   const Vec3 above = offset_ray_origin(p, ng), below = offset_ray_origin(p, -ng);
   const World& world = scene.world();
@@ -40,6 +41,13 @@ DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& 
     const float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, e.pdf);
     step.radiance += e.f * ls.radiance * tr * (std::abs(cos_i) * w / ls.pdf);
   }
+  const LobeVertex lv{nullptr, &lobe, p, ng, above, below};
+  if (scene.any_emission())
+    step.radiance += lobe_emitter_lighting(scene, lv, sobol_owen_2d(pixel, sample, emitter_dim, settings.seed),
+                                           settings, receiver_set);
+  if (samples_environment_at_lobes(world))
+    step.radiance +=
+        lobe_environment_lighting(scene, lv, sobol_owen_2d(pixel, sample, emitter_dim + 1, settings.seed), settings);
   const BsdfSample g = dielectric_sample(lobe, sobol_owen_2d(pixel, sample, lobe_dim, settings.seed),
                                          sobol_owen_1d(pixel, sample, side_dim, settings.seed));
   if (!(g.pdf > 0.0f)) return step;

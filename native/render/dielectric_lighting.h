@@ -2,8 +2,9 @@
 // one shadow-ray sample each from the side's own offset origin, weighted by the power heuristic
 // against the lobe's sampling, then the continuation the lobe draws (a reflection or a
 // transmission), whose ray collects the same lamps with the complementary weight (the
-// integrator's visible_lights). As glossy_lighting.h: only lamps are light-sampled, every lamp
-// once; the world and emissive meshes are found by the continuation ray alone.
+// integrator's visible_lights). As glossy_lighting.h: every lamp once, and one emissive triangle
+// and one direction of the environment map (dimensions emitter_dim and emitter_dim + 1) from
+// either side, whose light the continuation ray finds with the complementary weight.
 #pragma once
 
 #include "materials/dielectric_lobe.h"
@@ -14,7 +15,7 @@
 
 namespace toyrt {
 
-// radiance: the lamps' light at p; wi, weight (f |cos| / pdf), pdf: the continuation (pdf 0: the
+// radiance: the sampled light at p; wi, weight (f |cos| / pdf), pdf: the continuation (pdf 0: the
 // path ends); origin: its ray's origin, offset to the side it leaves into.
 struct DielectricStep {
   Vec3 radiance{0.0f};
@@ -29,6 +30,7 @@ struct DielectricStep {
 [[gnu::noinline]] DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& ng,
                                                    const DielectricLobe& lobe, uint32_t pixel, uint32_t sample,
                                                    uint32_t light_dim, uint32_t lobe_dim, uint32_t side_dim,
-                                                   const IntegratorSettings& settings, uint8_t receiver_set = 0);
+                                                   uint32_t emitter_dim, const IntegratorSettings& settings,
+                                                   uint8_t receiver_set = 0);
 
 }  // namespace toyrt

@@ -30,7 +30,8 @@ struct SurfaceHit {
   Vec3 ns;  // unit shading normal, world space
   Vec2 uv{0.0f};
   int32_t material = -1;
-  uint8_t receiver_set = 0;  // the instance's light-linking receiver set (lights/light_linking.h)
+  uint8_t receiver_set = 0;                  // the instance's light-linking receiver set (lights/light_linking.h)
+  uint64_t light_receivers = kAllLightSets;  // the sets its emission lights, if it emits (Instance)
 };
 
 // Out of line on purpose: inlined into trace_from (as GCC chose once nothing else called it) it
@@ -58,6 +59,7 @@ struct SurfaceHit {
   if (!sh.corner_uvs.empty()) s.uv = w * sh.corner_uvs[c] + hit.u * sh.corner_uvs[c + 1] + hit.v * sh.corner_uvs[c + 2];
   if (!sh.material_ids.empty()) s.material = sh.material_ids[size_t(hit.prim)];
   s.receiver_set = inst.receiver_set;
+  s.light_receivers = inst.light_receivers;
   return s;
 }
 
@@ -153,11 +155,11 @@ template <bool kBurley>
     LightSample ls = sample_emitters(
         emitters, p, at.ns, sobol_owen_2d(pixel, sample, vertex_dimension(at.depth, kDimsPerVertex - 3), settings.seed),
         &where);
-    if (ls.valid() && emitters.triangles[where.index].textured)  // its image, where the sample landed
-      ls.radiance = scene.emitted_at(emitters.keys[where.index], where.b);
     if (ls.valid() &&
         !in_light_sets(scene.instance(uint32_t(emitters.keys[where.index] >> 32)).light_receivers, receiver))
-      ls.pdf = 0.0f;  // its object does not light this receiver
+      ls.pdf = 0.0f;                                                  // its object does not light this receiver
+    else if (ls.valid() && emitters.triangles[where.index].textured)  // its image, where the sample landed
+      ls.radiance = scene.emitted_at(emitters.keys[where.index], where.b);
     if (ls.valid()) {
       const float cos_s = glm::dot(at.ns, ls.wi);
       Vec3 tr(1.0f);
@@ -180,7 +182,8 @@ template <bool kBurley>
   if (!in_light_sets(scene.instance(uint32_t(hit.instance)).light_receivers, receiver)) return sum;
   const MaterialEmission& e = scene.emission()[size_t(m)];
   const uint64_t key = uint64_t(uint32_t(hit.instance)) << 32 | uint64_t(uint32_t(hit.prim));
-  const Vec3 radiance = e.texture < 0 ? e.radiance : scene.emitted_at(key, Vec2(hit.u, hit.v));
+  const Vec3 radiance =
+      e.texture < 0 ? e.radiance : emitted(e, scene.textures(), scene.emitter_uv(key, Vec2(hit.u, hit.v)));
   // Not among the sampled triangles (emission sampling None): the cosine ray alone finds it.
   const int64_t index = emitters.index_of(key);
   float pl = 0.0f;
@@ -307,6 +310,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
   // the throughput for what the next vertex scatters; `throughput` serves the light the ray sees.
   bool picked = false;
   Vec3 picked_throughput(0.0f);
+  LobeOrigin lobe_from;  // after a glossy or rough dielectric vertex: where it sampled emitters and the map from
   RayKind kind = first_kind;
   uint8_t receiver = first_receiver;             // the light-linking receiver set of the ray's last vertex (0: camera)
   CutOutPath cut(path_settings, first_crossed);  // kCutOuts only (render/transparent_walk.h)
@@ -328,7 +332,10 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
       const Vec3 seen = env.active()
                             ? environment_radiance(env, scene.textures()[size_t(env.texture)], glm::normalize(ray.dir))
                             : world.background;
-      radiance += throughput * seen;
+      // The map a glossy or rough dielectric vertex also sampled: the lobe's share of it (render/glossy_lighting.h).
+      const float w =
+          lobe_from.on && env.active() ? lobe_environment_hit_weight(scene, bsdf_pdf, glm::normalize(ray.dir)) : 1.0f;
+      radiance += throughput * seen * w;
       if (first) first->environment = seen;  // Cycles' Environment pass: the world seen directly
       break;
     }
@@ -353,9 +360,14 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     // shows no emission there, as Cycles' mesh lights; camera rays see it regardless (unlike a
     // lamp: measured, parity emitter_linking).
     if (scene.any_emission() && s.material >= 0 && size_t(s.material) < materials.size() &&
-        (kind == RayKind::Camera || in_light_sets(scene.instance(uint32_t(hit.instance)).light_receivers, receiver))) {
+        (kind == RayKind::Camera || in_light_sets(s.light_receivers, receiver))) {
       const Vec3 glow = emitted(scene.emission()[size_t(s.material)], scene.textures(), s.uv);
-      radiance += throughput * glow;
+      // An emitter a glossy or rough dielectric vertex also sampled: the lobe's share of its light.
+      const float w = lobe_from.on ? lobe_emitter_hit_weight(
+                                         scene, lobe_from, bsdf_pdf, -wo,
+                                         uint64_t(uint32_t(hit.instance)) << 32 | uint64_t(uint32_t(hit.prim)), s.p)
+                                   : 1.0f;
+      radiance += throughput * glow * w;
       if (first) first->emission += glow;
     }
     if constexpr (kCutOuts) {
@@ -368,6 +380,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
       if (throughput == Vec3(0.0f)) break;
     }
     if (light_only) break;
+    lobe_from.on = false;  // set again below by a glossy or rough dielectric vertex
     // A Mix or Add Shader: one of its materials, drawn by weight (materials/material_mix.h), out
     // of line and only in scenes that have one. Its slot's emission, cut-out and normal map were
     // applied above.
@@ -423,9 +436,9 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
                                                   : direct_lighting<false, kCutOuts>(scene, s, ng, ns, sc.f, nullptr,
                                                                                      depth, pixel, sample, settings));
             const Vec3 origin = offset_ray_origin(s.p, ng);
-            const GlossyStep g =
-                glossy_vertex(scene, s.p, origin, ng, sc.glossy, pixel, sample, vertex_dimension(depth, 1),
-                              vertex_dimension(depth, kDimsPerVertex - 5), settings, s.receiver_set);
+            const GlossyStep g = glossy_vertex(scene, s.p, origin, ng, sc.glossy, pixel, sample,
+                                               vertex_dimension(depth, 1), vertex_dimension(depth, kDimsPerVertex - 5),
+                                               vertex_dimension(depth, kDimsPerVertex - 10), settings, s.receiver_set);
             radiance += throughput * g.radiance;
             if (!(g.pdf > 0.0f)) return false;
             if (sc.glossy_pick > 0.0f) {
@@ -435,6 +448,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             }
             throughput *= g.weight;
             bsdf_pdf = g.pdf;
+            lobe_from = LobeOrigin{s.p, sc.glossy.frame.n, true};  // LobeVertex::tree_normal()
             light_only = bounce >= settings.max_specular_depth;
             kind = RayKind::Glossy;
             receiver = s.receiver_set;
@@ -444,14 +458,15 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
           if (sc.kind == Scatter::Kind::Dielectric) {
             // Lamps on both sides, then a reflection or a transmission: as a glossy vertex, with
             // the side chosen on the lobe-choice dimension.
-            const DielectricStep g =
-                dielectric_vertex(scene, s.p, ng, sc.dielectric, pixel, sample, vertex_dimension(depth, 1),
-                                  vertex_dimension(depth, kDimsPerVertex - 5),
-                                  vertex_dimension(depth, kDimsPerVertex - 6), settings, s.receiver_set);
+            const DielectricStep g = dielectric_vertex(
+                scene, s.p, ng, sc.dielectric, pixel, sample, vertex_dimension(depth, 1),
+                vertex_dimension(depth, kDimsPerVertex - 5), vertex_dimension(depth, kDimsPerVertex - 6),
+                vertex_dimension(depth, kDimsPerVertex - 10), settings, s.receiver_set);
             radiance += throughput * g.radiance;
             if (!(g.pdf > 0.0f)) return false;
             throughput *= g.weight;
             bsdf_pdf = g.pdf;
+            lobe_from = LobeOrigin{s.p, Vec3(0.0f), true};  // LobeVertex::tree_normal()
             light_only = bounce >= settings.max_specular_depth;
             kind = kind_towards(g.wi, ng);
             receiver = s.receiver_set;

@@ -223,6 +223,35 @@ def scene_hdri(p):
     camera(p["camera"], (0, 0, 0.3))
 
 
+def glossy_row(roughness, color):
+    """A row of Glossy BSDF (GGX) balls at the given roughness values, centred on the origin."""
+    for i, rough in enumerate(roughness):
+        x = (i - (len(roughness) - 1) / 2) * 0.9
+        kit.uv_sphere(f"ball{i}", 0.4, (x, 0.0, 0.4), kit.glossy(f"glossy{i}", color, rough))
+
+
+def scene_emitters_glossy(p):
+    # Glossy balls lit by emissive meshes alone: a panel over the row and a small glowing ball
+    # beside it. Each glossy vertex samples an emissive triangle beside its lobe's ray (MIS), as
+    # Cycles samples mesh lights at every vertex.
+    kit.plane("floor", 8.0, kit.diffuse("floor", (0.6, 0.6, 0.6)))
+    panel = kit.plane("panel", 1.0, kit.emission("glow", (1.0, 0.85, 0.6), p["strength"]), (-0.6, 0.9, 1.8))
+    panel.rotation_euler = (2.6, 0.3, 0.0)  # facing the row, down and forwards
+    kit.uv_sphere("glowing_ball", 0.2, (1.3, -0.9, 0.2), kit.emission("ball_glow", (0.2, 0.5, 1.0), 3.0))
+    glossy_row(p["roughness"], p["color"])
+    camera((0.0, -4.5, 1.6), (0, 0, 0.35))
+    kit.world((0, 0, 0))
+
+
+def scene_hdri_glossy(p):
+    # Glossy balls in the HDRI world with its small bright sun: each glossy vertex samples the map
+    # beside its lobe's ray (MIS).
+    kit.plane("floor", 8.0, kit.diffuse("floor", (0.6, 0.6, 0.6)))
+    kit.environment_world(sky_image(128, 64, *p["sun"]), p["strength"], p["rotation"])
+    glossy_row(p["roughness"], p["color"])
+    camera((0.0, -4.5, 1.6), (0, 0, 0.35))
+
+
 def ball_row_stage(lamp="point"):
     """The material-ball scenes' shared stage: the grey floor, a round point lamp or a rectangular
     area lamp, the camera looking along the row, no world."""
@@ -240,9 +269,7 @@ def scene_glossy_sweep(p):
     # (the spheres reflect it and each other: glossy chains ending on the floor's direct light),
     # under one lamp the sharp balls show as a highlight.
     ball_row_stage(p["lamp"])
-    for i, rough in enumerate(p["roughness"]):
-        x = (i - (len(p["roughness"]) - 1) / 2) * 0.9
-        kit.uv_sphere(f"ball{i}", 0.4, (x, 0.0, 0.4), kit.glossy(f"glossy{i}", p["color"], rough))
+    glossy_row(p["roughness"], p["color"])
 
 
 def scene_metal_sweep(p):
@@ -341,6 +368,13 @@ SCENES_SPEC = [
     # (combined with emitter sampling by MIS where both apply). Noisier: 8x the samples.
     ("emitter_not_sampled", scene_emitters, dict(strength=6.0, sampling="NONE", glass=False,
                                                  camera=(0.5, -5.5, 3.0), sample_factor=8), 0),
+    # Glossy balls (GGX, roughness 0.05 to 1) lit by emissive meshes alone, and by the HDRI world:
+    # glossy vertices sample emitters and the map as they sample lamps (docs/lights.md).
+    ("emitters_glossy", scene_emitters_glossy, dict(roughness=[0.05, 0.2, 0.5, 1.0], color=(0.9, 0.75, 0.5),
+                                                    strength=8.0, mean_limit=0.005, sample_factor=4), 8),
+    ("hdri_glossy", scene_hdri_glossy, dict(roughness=[0.05, 0.2, 0.5, 1.0], color=(0.9, 0.75, 0.5),
+                                            sun=(0.6, 0.8, 60.0), strength=1.5, rotation=(0.0, 0.0, 0.7),
+                                            mean_limit=0.005, sample_factor=2), 8),
     # An HDRI world with a small bright sun, turned by a Mapping node; seen by the camera above the
     # horizon and lighting the floor and the box.
     ("hdri_sky", scene_hdri, dict(sun=(0.6, 0.8, 60.0), strength=1.5, rotation=(0.0, 0.0, 0.7),

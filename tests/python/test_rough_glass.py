@@ -7,7 +7,9 @@ al.'s BSDF (GGX, separable masking, the Fresnel term on the microfacet):
   - a constant world: found by the continuation ray alone, on both sides: the lobe's albedo A (GGX
     and Beckmann; Glass 4.0+, 3.x's Fresnel-weighted pair, Refraction);
   - a square lamp above, the world black: NEE and the reflected ray under MIS, R over the lamp;
-  - the same lamp below, facing up: NEE and the transmitted ray through the plane, T over it."""
+  - the same lamp below, facing up: NEE and the transmitted ray through the plane, T over it;
+  - the lamp's square as an emissive mesh, sampled or not, and a uniform environment map: the
+    emitter and map samples on either side under MIS (render/glossy_lighting.h, LobeVertex)."""
 import numpy as np
 import pytest
 import toyrt
@@ -138,3 +140,46 @@ def test_a_lamp_seen_in_or_through_rough_glass_matches_the_quadrature(side):
     got = render_mean(plane(lamp=side))
     assert want > 0.02 * radiance   # the lamp lights the pixel through this side of the lobe (R ~ 4 %)
     assert got == pytest.approx(want, rel=3e-3)
+
+
+def plane_under_emitter(side, sampling, kind="glass"):
+    """The plane with the lamp's square as an Emission surface of the lamp's radiance instead."""
+    s = toyrt.Scene()
+    s.background = (0.0, 0.0, 0.0)
+    s.add_material("glass", ior=ETA, roughness=ROUGHNESS, distribution="ggx", fresnel="microfacet")
+    L = LAMP_POWER / (4 * LAMP_SIZE * LAMP_SIZE)
+    s.add_material("diffuse", color=(0.0, 0.0, 0.0), emission=(L, L, L), emission_sampling=sampling)
+    h = 50.0
+    s.add_mesh(np.array([[-h, -h, 0], [h, -h, 0], [h, h, 0], [-h, h, 0]], np.float32), [[0, 1, 2], [0, 2, 3]],
+               material_ids=0)
+    a, z = LAMP_SIZE / 2, -LAMP_HEIGHT if side == "below" else LAMP_HEIGHT
+    s.add_mesh(np.array([[-a, -a, z], [a, -a, z], [a, a, z], [-a, a, z]], np.float32), [[0, 1, 2], [0, 2, 3]],
+               material_ids=1)
+    s.commit()
+    return s
+
+
+@pytest.mark.parametrize("side", ["above", "below"])
+def test_an_emitter_seen_in_or_through_rough_glass_matches_the_quadrature_sampled_or_not(side):
+    # The rough dielectric vertex samples an emissive triangle on either side beside its lobe
+    # (render/glossy_lighting.h, LobeVertex); not sampled (None), the lobe's ray alone finds it.
+    # The camera sits below the square (which emits on both sides), looking down at the plane.
+    w, dw = sphere_grid()
+    want = LAMP_POWER / (4 * LAMP_SIZE * LAMP_SIZE) * float(
+        np.sum(np.where(sees_lamp(w, side == "below"), lobe_times_cos(w), 0.0) * dw))
+    cam = camera_above(height=2.0, size=0.02, resolution=16)
+    sampled = plane_under_emitter(side, "AUTO").render(cam, samples=256, max_specular_depth=4)[..., 0]
+    alone = plane_under_emitter(side, "NONE").render(cam, samples=256, max_specular_depth=4)[..., 0]
+    assert sampled.mean() == pytest.approx(want, rel=3e-3)
+    assert alone.mean() == pytest.approx(want, rel=0.02)
+
+
+def test_a_uniform_map_through_and_in_rough_glass_is_the_lobes_albedo():
+    # The map is sampled on both sides of the dielectric vertex and shares with the lobe by MIS;
+    # the constant world of the same radiance (the lobe alone) gives the same albedo.
+    w, dw = sphere_grid()
+    albedo = float(np.sum(lobe_times_cos(w) * dw))
+    s = plane()
+    s.set_environment(s.add_texture(np.full((16, 32, 3), 1.0, np.float32), srgb=False))
+    s.commit()
+    assert render_mean(s) == pytest.approx(albedo, rel=2e-3)
