@@ -2,7 +2,8 @@
 // one shadow-ray sample each from the side's own offset origin, weighted by the power heuristic
 // against the lobe's sampling, then the continuation the lobe draws (a reflection or a
 // transmission), whose ray collects the same lamps with the complementary weight (the
-// integrator's visible_lights). As glossy_lighting.h: every lamp once, and one emissive triangle
+// integrator's visible_lights). As glossy_lighting.h: every lamp once (or one picked on
+// emitter_dim - 1 where picks_one_lamp()), and one emissive triangle
 // and one direction of the environment map (dimensions emitter_dim and emitter_dim + 1) from
 // either side, whose light the continuation ray finds with the complementary weight.
 #pragma once

@@ -1,5 +1,6 @@
 #include "render/glossy_lighting.h"
 
+#include "lights/light_selector.h"
 #include "render/transparent_walk.h"
 #include "sampling/sobol_owen.h"
 
@@ -9,31 +10,39 @@ namespace toyrt {
 
 Vec3 glossy_direct_lighting(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng,
                             const GlossyLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t first_dim,
-                            const IntegratorSettings& settings, uint8_t receiver_set) {
+                            uint32_t pick_dim, const IntegratorSettings& settings, uint8_t receiver_set) {
   const World& world = scene.world();
   Vec3 sum(0.0f);
-  for (size_t j = 0; j < world.lights.size(); ++j) {
+  auto add = [&](size_t j, float select_probability, uint32_t dim) {
     // The lamps a glossy reflection shows are those visible to specular rays (Cycles' glossy
     // ray visibility), for their light as for their image.
     const LightVisibility v = world.light_visibility[j];
     // Light linking: a lamp that does not light this object adds nothing (lights/light_linking.h).
-    if (!v.specular || !in_light_sets(v.receiver_sets, receiver_set)) continue;
+    if (!v.specular || !in_light_sets(v.receiver_sets, receiver_set)) return;
     const LightSample ls =
-        sample_light(world.lights[j], p, sobol_owen_2d(pixel, sample, first_dim + uint32_t(j), settings.seed),
-                     settings.area_sampling);
-    if (!ls.valid() || glm::dot(ng, ls.wi) <= 0.0f) continue;
+        sample_light(world.lights[j], p, sobol_owen_2d(pixel, sample, dim, settings.seed), settings.area_sampling);
+    if (!ls.valid() || glm::dot(ng, ls.wi) <= 0.0f) return;
     const BsdfEval e = evaluate_lobe(lobe, ls.wi);
     const float cos_i = glm::dot(lobe.frame.n, ls.wi);
-    if (cos_i <= 0.0f || e.f == Vec3(0.0f)) continue;
+    if (cos_i <= 0.0f || e.f == Vec3(0.0f)) return;
     Vec3 tr(1.0f);  // what cut-outs on the way let through
     if (v.shadow) {
       const Ray shadow =
           std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
-      if (!shadow_passes(scene, shadow, settings.transparent_max_bounces, tr, v.blocker_sets)) continue;
+      if (!shadow_passes(scene, shadow, settings.transparent_max_bounces, tr, v.blocker_sets)) return;
     }
     // A delta lamp cannot be hit by the continuation ray: its sample is the only strategy.
-    const float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, e.pdf);
-    sum += e.f * ls.radiance * tr * (cos_i * w / ls.pdf);
+    const float pdf = ls.pdf * select_probability;
+    const float w = ls.delta ? 1.0f : power_heuristic(pdf, e.pdf);
+    sum += e.f * ls.radiance * tr * (cos_i * w / pdf);
+  };
+  if (picks_one_lamp(world, settings)) {
+    const LightSelector selector(world.lights, scene.light_tree(), scene.light_receiver_sets());
+    const LightSelection pick =
+        selector.select(p, lobe.frame.n, sobol_owen_1d(pixel, sample, pick_dim, settings.seed), receiver_set);
+    if (pick.found()) add(size_t(pick.index), pick.probability, first_dim);
+  } else {
+    for (size_t j = 0; j < world.lights.size(); ++j) add(j, 1.0f, first_dim + uint32_t(j));
   }
   return sum;
 }
@@ -113,7 +122,8 @@ GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, 
                          uint32_t pixel, uint32_t sample, uint32_t light_dim, uint32_t lobe_dim, uint32_t emitter_dim,
                          const IntegratorSettings& settings, uint8_t receiver_set) {
   GlossyStep step;
-  step.radiance = glossy_direct_lighting(scene, p, origin, ng, lobe, pixel, sample, light_dim, settings, receiver_set);
+  step.radiance = glossy_direct_lighting(scene, p, origin, ng, lobe, pixel, sample, light_dim, emitter_dim - 1,
+                                         settings, receiver_set);
   const LobeVertex v{&lobe, nullptr, p, ng, origin, origin};
   if (scene.any_emission())
     step.radiance += lobe_emitter_lighting(scene, v, sobol_owen_2d(pixel, sample, emitter_dim, settings.seed), settings,

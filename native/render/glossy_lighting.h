@@ -1,13 +1,14 @@
-// Light arriving at a glossy vertex (materials/glossy_lobe.h): one shadow-ray sample per lamp,
+// Light arriving at a glossy vertex (materials/glossy_lobe.h): shadow-ray samples of the lamps,
 // one emissive triangle and one direction of the environment map, each weighted by the power
 // heuristic against the lobe's own sampling, whose continuation ray collects the same light with
-// the complementary weight (the integrator's visible_lights for lamps, lobe_emitter_hit_weight and
-// lobe_environment_hit_weight for emitters and the map; a rough dielectric vertex,
-// render/dielectric_lighting.h, shares the emitter and map parts through LobeVertex). Every lamp is sampled (no
-// one-light selection) so that the weight a lamp seen by the continuation ray needs is its own pdf, not a selection
-// probability; the triangle is chosen as diffuse vertices choose it, and its selection probability is part of
-// emitter_pdf(). A constant world is found by the continuation ray alone (weight 1): the lobe samples it better than a
-// uniform direction would.
+// the complementary weight (the integrator's visible_lights for lamps, lobe_emitter_hit_weight
+// and lobe_environment_hit_weight for emitters and the map; a rough dielectric vertex,
+// render/dielectric_lighting.h, shares the emitter and map parts through LobeVertex).
+// A few lamps are each sampled; many (picks_one_lamp) give one, chosen by the light selector at
+// the lobe's normal, and its selection probability is then part of its pdf on both sides of the
+// MIS (visible_lights.h, LampChoice). The triangle is chosen as diffuse vertices choose it, and
+// its selection probability is part of emitter_pdf(). A constant world is found by the
+// continuation ray alone (weight 1): the lobe samples it better than a uniform direction would.
 #pragma once
 
 #include "materials/dielectric_lobe.h"
@@ -26,11 +27,18 @@ inline float power_heuristic(float pdf, float other) {
   return a > 0.0f ? a / (a + b) : 0.0f;
 }
 
+// Whether a lobe vertex samples one lamp chosen by the light selector (settings' light_sampling
+// resolved to One, as diffuse vertices do: many lamps) instead of every lamp.
+inline bool picks_one_lamp(const World& world, const IntegratorSettings& settings) {
+  return settings.light_sampling == LightSampling::One && world.lights.size() > 1;
+}
+
 // p: the hit point; origin: its shadow-ray origin (offset along ng); ng: the geometric normal on
-// wo's side. Lamp j draws its sample from Sobol-Owen dimension first_dim + j.
+// wo's side. Lamp j draws its sample from Sobol-Owen dimension first_dim + j; where
+// picks_one_lamp(), the lamp chosen on dimension pick_dim (1D) draws from first_dim.
 Vec3 glossy_direct_lighting(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng,
                             const GlossyLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t first_dim,
-                            const IntegratorSettings& settings, uint8_t receiver_set = 0);
+                            uint32_t pick_dim, const IntegratorSettings& settings, uint8_t receiver_set = 0);
 
 // A vertex with a lobe, as the emitter and map samples see it: a glossy lobe (one side, above
 // the true surface) or a rough dielectric's (both sides; a direction below leaves by refraction).
@@ -85,11 +93,11 @@ struct LobeOrigin {
 [[gnu::noinline]] float lobe_environment_hit_weight(const Scene& scene, float bsdf_pdf, const Vec3& wi);
 
 // A glossy vertex's whole work: its lamps' light (glossy_direct_lighting, lamp j from dimension
-// light_dim + j), an emitter sample (dimension emitter_dim) and a map sample (emitter_dim + 1)
-// where the scene has them, and the continuation the lobe draws from dimension lobe_dim:
-// direction, weight f cos / pdf and pdf (0: the path ends, the sample left below the geometric
-// surface). Out of line, so the integrator's loop, which a Lambert-only scene runs, stays the
-// size it was.
+// light_dim + j, or the one lamp picked on emitter_dim - 1), an emitter sample (dimension
+// emitter_dim) and a map sample (emitter_dim + 1) where the scene has them, and the continuation
+// the lobe draws from dimension lobe_dim: direction, weight f cos / pdf and pdf (0: the path
+// ends, the sample left below the geometric surface). Out of line, so the integrator's loop,
+// which a Lambert-only scene runs, stays the size it was.
 struct GlossyStep {
   Vec3 radiance{0.0f};
   Vec3 wi{0.0f};

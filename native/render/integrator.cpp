@@ -310,6 +310,9 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
   // the throughput for what the next vertex scatters; `throughput` serves the light the ray sees.
   bool picked = false;
   Vec3 picked_throughput(0.0f);
+  // The selector a lobe vertex picked its lamp by (picks_one_lamp), for the weight of the lamp
+  // its continuation ray finds.
+  const LightSelector lamp_selector(world.lights, scene.light_tree(), scene.light_receiver_sets());
   LobeOrigin lobe_from;  // after a glossy or rough dielectric vertex: where it sampled emitters and the map from
   RayKind kind = first_kind;
   uint8_t receiver = first_receiver;             // the light-linking receiver set of the ray's last vertex (0: camera)
@@ -321,8 +324,11 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     Vec3 lamps(0.0f);  // the lamps this ray sees: the Emission pass's at the camera ray
     if (!world.lights.empty()) {
       const float length = glm::length(ray.dir);
-      lamps = visible_lights(world, ray.org, ray.dir / length, ray.tnear * length, std::min(hit.t, ray.tfar) * length,
-                             !hit.found(), bounce == 0, settings.area_sampling, bsdf_pdf, receiver);
+      lamps = visible_lights(
+          world, scene.lamp_bvh(), ray.org, ray.dir / length, ray.tnear * length, std::min(hit.t, ray.tfar) * length,
+          !hit.found(), bounce == 0, settings.area_sampling, bsdf_pdf, receiver,
+          lobe_from.on && picks_one_lamp(world, settings) ? LampChoice{&lamp_selector, lobe_from.p, lobe_from.n}
+                                                          : LampChoice{});
       radiance += throughput * lamps;
     }
     if (!hit.found()) {

@@ -356,6 +356,7 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
     const auto tree_start = std::chrono::steady_clock::now();
     light_tree_ = world_.lights.size() > kLightTreeFrom ? LightTree(world_.lights) : LightTree{};
     if (light_tree_.node_count() > 0) light_tree_.set_receiver_sets(light_reach_);
+    lamp_bvh_ = world_.lights.size() >= kLampBvhFrom ? build_lamp_bvh(world_.lights) : LampBvh{};
     light_tree_current_ = true;
     stats_.light_tree_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tree_start).count();
@@ -510,7 +511,7 @@ size_t Scene::memory_bytes() const {
   bytes += materials_.capacity() * sizeof(Material) + emission_.capacity() * sizeof(MaterialEmission) +
            normal_maps_.capacity() * sizeof(MaterialNormalMap) + mixes_.capacity() * sizeof(MaterialMix) +
            transparency_.capacity() * sizeof(MaterialTransparency) + world_.lights.capacity() * sizeof(Light);
-  return bytes + light_tree_.memory_bytes();
+  return bytes + light_tree_.memory_bytes() + lamp_bvh_.memory_bytes();
 }
 
 }  // namespace toyrt

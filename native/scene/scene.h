@@ -14,6 +14,7 @@
 #include "core/cancel_poll.h"
 #include "core/ray.h"
 #include "geometry/mesh.h"
+#include "lights/lamp_bvh.h"
 #include "lights/light_selector.h"
 #include "lights/mesh_emitters.h"
 #include "materials/emission.h"
@@ -241,6 +242,9 @@ class Scene {
   // Per light, the receiver sets whose diffuse surfaces it lights (its light-linking receiver
   // sets, none when it is hidden from diffuse rays), for the light selection; null when every
   // light lights every receiver (no linking: the selection checks nothing).
+  // The BVH over the lamps' shapes for the rays that see lamps (lights/lamp_bvh.h): built at
+  // commit from kLampBvhFrom lamps, else empty.
+  const LampBvh& lamp_bvh() const { return lamp_bvh_; }
   const uint64_t* light_receiver_sets() const { return light_reach_.empty() ? nullptr : light_reach_.data(); }
   // Triangles stored (each mesh counted once) and placed (each instance counting its mesh).
   size_t stored_triangle_count() const;
@@ -276,6 +280,7 @@ class Scene {
   std::vector<Texture> textures_;
   World world_;
   LightTree light_tree_;               // over world_.lights when light_tree_current_
+  LampBvh lamp_bvh_;                   // over world_.lights when light_tree_current_
   bool light_tree_current_ = false;    // add_light and clear_lights reset it, commit() rebuilds
   std::vector<uint64_t> light_reach_;  // light_receiver_sets(), parallel to world_.lights, or empty
   std::vector<Instance> instances_;
