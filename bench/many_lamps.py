@@ -8,9 +8,9 @@ import argparse
 import json
 import os
 import statistics
-import subprocess
-import sys
 import time
+
+from interleaved import modules_from, run_interleaved
 
 
 def child(lamps):
@@ -56,16 +56,8 @@ def main():
     if args.child:
         child(lamps)
         return
-    here = os.path.dirname(os.path.abspath(__file__))
-    modules = [m.split("=", 1) for m in args.module] or [["new", os.path.join(here, "..", "build", "python")]]
-    runs = {name: [] for name, _ in modules}
-    for r in range(args.repeats):
-        for name, directory in modules:
-            env = dict(os.environ, PYTHONPATH=directory)
-            res = subprocess.run([sys.executable, __file__, "--child", "--lamps", args.lamps], env=env,
-                                 capture_output=True, text=True, check=True)
-            runs[name].append(json.loads(res.stdout.strip().splitlines()[-1]))
-            print(f"repeat {r + 1}/{args.repeats} {name} done", file=sys.stderr, flush=True)
+    modules = modules_from(args.module, os.path.dirname(os.path.abspath(__file__)))
+    runs = run_interleaved(__file__, modules, args.repeats, ["--lamps", args.lamps])
     print("| scene | " + " | ".join(f"{name} s | {name} mean" for name, _ in modules) + " |")
     print("|---|" + "---|---|" * len(modules))
     for key in runs[modules[0][0]][0]:

@@ -12,9 +12,9 @@ import json
 import os
 import resource
 import statistics
-import subprocess
-import sys
 import time
+
+from interleaved import modules_from, run_interleaved
 
 SIZES = [(200, 150), (800, 600)]
 # Quads per side: 2 * 708^2 = 1,002,528 triangles.
@@ -94,17 +94,8 @@ def main():
     if args.child:
         child(SIZES)
         return
-    here = os.path.dirname(os.path.abspath(__file__))
-    modules = [m.split("=", 1) for m in args.module] or [["build", os.path.join(here, "..", "build", "python")]]
-    runs = {name: [] for name, _ in modules}
-    for r in range(args.repeats):
-        for name, path in modules:  # interleaved: each repeat runs every module once
-            env = dict(os.environ, PYTHONPATH=path)
-            done = subprocess.run([sys.executable, __file__, "--child"], env=env, capture_output=True, text=True)
-            if done.returncode != 0:
-                sys.exit(f"{name}: {done.stderr[-2000:]}")
-            runs[name].append(json.loads(done.stdout.strip().splitlines()[-1]))
-            print(f"repeat {r + 1}/{args.repeats} {name}: {runs[name][-1]}", file=sys.stderr)
+    modules = modules_from(args.module, os.path.dirname(os.path.abspath(__file__)))
+    runs = run_interleaved(__file__, modules, args.repeats)
     print(f"median of {args.repeats}: render() wall time (its minimum, and the process's CPU time, on a shared"
           " machine); peak RSS growth during a render. 1 sample, threads=2")
     for name, _ in modules:
