@@ -15,24 +15,25 @@
 
 namespace toyrt {
 
-// The radiance of the lights a camera (depth 0) or specular ray passes before distance `limit`
-// (in units of the unit direction), of those visible to that kind of ray. Lights are not
-// surfaces: as in Cycles, a ray that sees one goes on, so what is behind a light (another light,
-// a surface, the world) adds to it. A light at infinity (a sun, at FLT_MAX) is part of the world:
-// seen by a ray that leaves the scene (`escaped`), whatever the camera's clip end. bsdf_pdf > 0:
-// the ray was drawn by a glossy lobe with that density, and each lamp takes its power-heuristic
-// weight against the lamp sample glossy_direct_lighting took there (of the lamp `choice` picked). receiver: the
-// light-linking receiver set of the surface the ray left, as Cycles links a lamp a reflection finds to the reflecting
-// object; a camera ray has no object and, as in Cycles, counts as set 0 (so a lamp that lights only included objects is
-// not seen by the camera either). How the vertex a ray left sampled the lamps: each of them (selector null), or one
-// picked by `selector` at (p, n) (glossy_lighting.h, picks_one_lamp), whose probability a lamp the ray finds then
-// multiplies into its pdf.
+// How the vertex a ray left sampled the lamps: each of them (selector null), or one picked by
+// `selector` at (p, n) (glossy_lighting.h, picks_one_lamp), whose probability a lamp the ray
+// finds then multiplies into its pdf.
 struct LampChoice {
   const LightSelector* selector = nullptr;
   Vec3 p{0.0f}, n{0.0f};
 };
 
-// `lamps`: the scene's lamp BVH (lights/lamp_bvh.h), or empty: every lamp is tested.
+// The radiance of the lights a camera (depth 0) or specular ray passes before distance `limit`
+// (in units of the unit direction), of those visible to that kind of ray. Lights are not
+// surfaces: as in Cycles, a ray that sees one goes on, so what is behind a light (another light,
+// a surface, the world) adds to it. A light at infinity (a sun, at FLT_MAX) is part of the world:
+// seen by a ray that leaves the scene (`escaped`), whatever the camera's clip end. bsdf_pdf > 0:
+// the ray was drawn by a glossy or rough dielectric lobe with that density, and each lamp takes
+// its power-heuristic weight against the lamp sample that vertex took (of the lamp `choice`
+// picked). receiver: the light-linking receiver set of the surface the ray left, as Cycles links
+// a lamp a reflection finds to the reflecting object; a camera ray has no object and, as in
+// Cycles, counts as set 0 (so a lamp that lights only included objects is not seen by the camera
+// either). `lamps`: the scene's lamp BVH (lights/lamp_bvh.h), or empty: every lamp is tested.
 inline Vec3 visible_lights(const World& world, const LampBvh& lamps, const Vec3& org, const Vec3& unit_dir, float from,
                            float limit, bool escaped, bool camera, AreaSampling area_sampling, float bsdf_pdf,
                            uint8_t receiver, const LampChoice& choice = {}) {
