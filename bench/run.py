@@ -30,6 +30,8 @@ SCENES = [
     # Issue 14's glossy reflections (Principled, metal, Glossy BSDF): paths through the lobes. Mitsuba
     # has no integrator restricted to this transport, nor Cycles' Principled model.
     ("glossy", "glossy", {}, 8, False),
+    # The map and an emissive panel seen in the glossy balls: sampled at each glossy vertex.
+    ("glossy_hdri", "glossy_hdri", {}, 8, False),
 ]
 METHODS = [["solid_angle", "all"], ["solid_angle", "one"], ["area", "all"], ["area", "one"]]
 # Features switched on one at a time on the seed's Cornell box (scenes/bench/cornell.py).
