@@ -8,45 +8,6 @@
 
 namespace toyrt {
 
-Vec3 glossy_direct_lighting(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng,
-                            const GlossyLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t first_dim,
-                            uint32_t pick_dim, const IntegratorSettings& settings, uint8_t receiver_set) {
-  const World& world = scene.world();
-  Vec3 sum(0.0f);
-  auto add = [&](size_t j, float select_probability, uint32_t dim) {
-    // The lamps a glossy reflection shows are those visible to specular rays (Cycles' glossy
-    // ray visibility), for their light as for their image.
-    const LightVisibility v = world.light_visibility[j];
-    // Light linking: a lamp that does not light this object adds nothing (lights/light_linking.h).
-    if (!v.specular || !in_light_sets(v.receiver_sets, receiver_set)) return;
-    const LightSample ls =
-        sample_light(world.lights[j], p, sobol_owen_2d(pixel, sample, dim, settings.seed), settings.area_sampling);
-    if (!ls.valid() || glm::dot(ng, ls.wi) <= 0.0f) return;
-    const BsdfEval e = evaluate_lobe(lobe, ls.wi);
-    const float cos_i = glm::dot(lobe.frame.n, ls.wi);
-    if (cos_i <= 0.0f || e.f == Vec3(0.0f)) return;
-    Vec3 tr(1.0f);  // what cut-outs on the way let through
-    if (v.shadow) {
-      const Ray shadow =
-          std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
-      if (!shadow_passes(scene, shadow, settings.transparent_max_bounces, tr, v.blocker_sets)) return;
-    }
-    // A delta lamp cannot be hit by the continuation ray: its sample is the only strategy.
-    const float pdf = ls.pdf * select_probability;
-    const float w = ls.delta ? 1.0f : power_heuristic(pdf, e.pdf);
-    sum += e.f * ls.radiance * tr * (cos_i * w / pdf);
-  };
-  if (picks_one_lamp(world, settings)) {
-    const LightSelector selector(world.lights, scene.light_tree(), scene.light_receiver_sets());
-    const LightSelection pick =
-        selector.select(p, lobe.frame.n, sobol_owen_1d(pixel, sample, pick_dim, settings.seed), receiver_set);
-    if (pick.found()) add(size_t(pick.index), pick.probability, first_dim);
-  } else {
-    for (size_t j = 0; j < world.lights.size(); ++j) add(j, 1.0f, first_dim + uint32_t(j));
-  }
-  return sum;
-}
-
 LobeAnswer lobe_towards(const LobeVertex& v, const Vec3& wi) {
   LobeAnswer a;
   if (v.glossy) {
@@ -65,6 +26,44 @@ LobeAnswer lobe_towards(const LobeVertex& v, const Vec3& wi) {
   a.origin = side > 0.0f ? v.above : v.below;
   a.seen_by = side > 0.0f ? kVisibleGlossy : kVisibleTransmission;
   return a;
+}
+
+Vec3 lobe_lamp_lighting(const Scene& scene, const LobeVertex& v, uint32_t pixel, uint32_t sample, uint32_t first_dim,
+                        uint32_t pick_dim, const IntegratorSettings& settings, uint8_t receiver_set) {
+  const World& world = scene.world();
+  Vec3 sum(0.0f);
+  auto add = [&](size_t j, float select_probability, uint32_t dim) {
+    // The lamps a glossy reflection or a glass shows are those visible to specular rays (Cycles'
+    // glossy and transmission visibility, one flag here), for their light as for their image.
+    const LightVisibility lamp = world.light_visibility[j];
+    // Light linking: a lamp that does not light this object adds nothing (lights/light_linking.h).
+    if (!lamp.specular || !in_light_sets(lamp.receiver_sets, receiver_set)) return;
+    const LightSample ls =
+        sample_light(world.lights[j], v.p, sobol_owen_2d(pixel, sample, dim, settings.seed), settings.area_sampling);
+    if (!ls.valid()) return;
+    const LobeAnswer a = lobe_towards(v, ls.wi);
+    if (a.e.f == Vec3(0.0f)) return;
+    Vec3 tr(1.0f);  // what cut-outs on the way let through
+    if (lamp.shadow) {
+      // A light at infinity (the sun) is left along wi; the others end where the sample is.
+      const Ray shadow = std::isinf(ls.distance) ? Ray{a.origin, 0.0f, ls.wi, kInfinity}
+                                                 : Ray{a.origin, 0.0f, ls.point - a.origin, 1.0f};
+      if (!shadow_passes(scene, shadow, settings.transparent_max_bounces, tr, lamp.blocker_sets)) return;
+    }
+    // A delta lamp cannot be hit by the continuation ray: its sample is the only strategy.
+    const float pdf = ls.pdf * select_probability;
+    const float w = ls.delta ? 1.0f : power_heuristic(pdf, a.e.pdf);
+    sum += a.e.f * ls.radiance * tr * (a.cos * w / pdf);
+  };
+  if (picks_one_lamp(world, settings)) {
+    const LightSelector selector(world.lights, scene.light_tree(), scene.light_receiver_sets());
+    const LightSelection pick =
+        selector.select(v.p, v.tree_normal(), sobol_owen_1d(pixel, sample, pick_dim, settings.seed), receiver_set);
+    if (pick.found()) add(size_t(pick.index), pick.probability, first_dim);
+  } else {
+    for (size_t j = 0; j < world.lights.size(); ++j) add(j, 1.0f, first_dim + uint32_t(j));
+  }
+  return sum;
 }
 
 Vec3 lobe_emitter_lighting(const Scene& scene, const LobeVertex& v, const Vec2& u, const IntegratorSettings& settings,
@@ -122,9 +121,8 @@ GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, 
                          uint32_t pixel, uint32_t sample, uint32_t light_dim, uint32_t lobe_dim, uint32_t emitter_dim,
                          const IntegratorSettings& settings, uint8_t receiver_set) {
   GlossyStep step;
-  step.radiance = glossy_direct_lighting(scene, p, origin, ng, lobe, pixel, sample, light_dim, emitter_dim - 1,
-                                         settings, receiver_set);
   const LobeVertex v{&lobe, nullptr, p, ng, origin, origin};
+  step.radiance = lobe_lamp_lighting(scene, v, pixel, sample, light_dim, emitter_dim - 1, settings, receiver_set);
   if (scene.any_emission())
     step.radiance += lobe_emitter_lighting(scene, v, sobol_owen_2d(pixel, sample, emitter_dim, settings.seed), settings,
                                            receiver_set);

@@ -33,13 +33,6 @@ inline bool picks_one_lamp(const World& world, const IntegratorSettings& setting
   return settings.light_sampling == LightSampling::One && world.lights.size() > 1;
 }
 
-// p: the hit point; origin: its shadow-ray origin (offset along ng); ng: the geometric normal on
-// wo's side. Lamp j draws its sample from Sobol-Owen dimension first_dim + j; where
-// picks_one_lamp(), the lamp chosen on dimension pick_dim (1D) draws from first_dim.
-Vec3 glossy_direct_lighting(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng,
-                            const GlossyLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t first_dim,
-                            uint32_t pick_dim, const IntegratorSettings& settings, uint8_t receiver_set = 0);
-
 // A vertex with a lobe, as the emitter and map samples see it: a glossy lobe (one side, above
 // the true surface) or a rough dielectric's (both sides; a direction below leaves by refraction).
 struct LobeVertex {
@@ -62,6 +55,12 @@ struct LobeAnswer {
   uint8_t seen_by = 0;
 };
 LobeAnswer lobe_towards(const LobeVertex& v, const Vec3& wi);
+
+// The lamps' light at the vertex: lamp j draws its sample from Sobol-Owen dimension first_dim + j;
+// where picks_one_lamp(), the lamp chosen on dimension pick_dim (1D) at the tree_normal() draws
+// from first_dim. Lamps hidden from specular rays or not lighting the receiver set add nothing.
+Vec3 lobe_lamp_lighting(const Scene& scene, const LobeVertex& v, uint32_t pixel, uint32_t sample, uint32_t first_dim,
+                        uint32_t pick_dim, const IntegratorSettings& settings, uint8_t receiver_set);
 
 // One emissive triangle's light at the vertex (u: the emitter sample's two numbers), in scenes
 // with emission; triangles of objects hidden from the ray the lobe would send, or not lighting
@@ -92,7 +91,7 @@ struct LobeOrigin {
 // ... and of the environment map seen along wi (a ray that left the scene).
 [[gnu::noinline]] float lobe_environment_hit_weight(const Scene& scene, float bsdf_pdf, const Vec3& wi);
 
-// A glossy vertex's whole work: its lamps' light (glossy_direct_lighting, lamp j from dimension
+// A glossy vertex's whole work: its lamps' light (lobe_lamp_lighting, lamp j from dimension
 // light_dim + j, or the one lamp picked on emitter_dim - 1), an emitter sample (dimension
 // emitter_dim) and a map sample (emitter_dim + 1) where the scene has them, and the continuation
 // the lobe draws from dimension lobe_dim: direction, weight f cos / pdf and pdf (0: the path

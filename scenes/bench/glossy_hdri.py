@@ -7,24 +7,18 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the scene kit
-sys.path.insert(0, str(Path(__file__).resolve().parent))  # the hdri scene's sky
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # the glossy scene's balls, the hdri scene's sky
 import kit  # noqa: E402
+from glossy import ball_row  # noqa: E402
 from hdri import sky  # noqa: E402
 
 
 def build():
     scene = kit.clear_scene()
-    kit.plane("floor", 12.0, kit.diffuse("floor", (0.6, 0.6, 0.6)))
-    balls = [kit.principled_dielectric(f"principled{k}", (0.8, 0.25 + 0.12 * k, 0.15), r)
-             for k, r in enumerate((0.05, 0.15, 0.3, 0.5))]
-    balls.append(kit.metal("gold", (0.95, 0.7, 0.3), 0.2))
-    balls.append(kit.glossy("glossy", (0.8, 0.8, 0.8), 0.4))
-    for k, mat in enumerate(balls):
-        kit.uv_sphere(f"ball{k}", 0.42, (-2.25 + 0.9 * k, 0.0, 0.42), mat)
+    ball_row(glossy_roughness=0.4)
     panel = kit.plane("panel", 0.6, kit.emission("glow", (1.0, 0.9, 0.7), 20.0), (1.2, -1.2, 1.6))
     panel.rotation_euler = (2.4, 0.0, 0.4)
     kit.environment_world(sky(), 1.0, (0.0, 0.0, 0.4))
-    kit.camera((0.0, -5.0, 2.0), (0.0, 0.0, 0.35), lens=32)
     return scene
 
 
