@@ -25,7 +25,8 @@ Vec3 = tuple[float, float, float]
 class Visibility:
     """Blender's switches of a light object, as the core's add_light keywords."""
     visible_camera: bool = True
-    visible_specular: bool = True
+    visible_glossy: bool = True
+    visible_transmission: bool = True
     visible_diffuse: bool = True
     cast_shadow: bool = True
     # Light linking (4.0+, light_linking.py): masks of the receiver sets it lights and of the
@@ -35,8 +36,9 @@ class Visibility:
 
     def arguments(self) -> dict:
         linked = {k: getattr(self, k) for k in ("receiver_sets", "blocker_sets") if getattr(self, k) != (1 << 64) - 1}
-        return dict(visible_camera=self.visible_camera, visible_specular=self.visible_specular,
-                    visible_diffuse=self.visible_diffuse, cast_shadow=self.cast_shadow, **linked)
+        return dict(visible_camera=self.visible_camera, visible_glossy=self.visible_glossy,
+                    visible_transmission=self.visible_transmission, visible_diffuse=self.visible_diffuse,
+                    cast_shadow=self.cast_shadow, **linked)
 
 
 @dataclass(frozen=True)
@@ -110,17 +112,16 @@ LightSpec = PointLightSpec | AreaLightSpec | SpotLightSpec | SunLightSpec
 
 
 def light_visibility(obj) -> Visibility:
-    """The light object's ray visibility (Blender 3.0+; all on by default, as in Cycles; TOYRT's
-    specular rays are Cycles' glossy and transmission rays) and its shadow switch (3.x:
-    light.cycles.cast_shadow; 4.x+: light.use_shadow)."""
+    """The light object's ray visibility (Blender 3.0+; all on by default, as in Cycles) and its
+    shadow switch (3.x: light.cycles.cast_shadow; 4.x+: light.use_shadow)."""
     light = obj.data
     if hasattr(light, "use_shadow"):
         shadow = bool(light.use_shadow)
     else:
         shadow = bool(getattr(getattr(light, "cycles", None), "cast_shadow", True))
     return Visibility(visible_camera=bool(getattr(obj, "visible_camera", True)),
-                      visible_specular=bool(getattr(obj, "visible_glossy", True)
-                                            and getattr(obj, "visible_transmission", True)),
+                      visible_glossy=bool(getattr(obj, "visible_glossy", True)),
+                      visible_transmission=bool(getattr(obj, "visible_transmission", True)),
                       visible_diffuse=bool(getattr(obj, "visible_diffuse", True)),
                       cast_shadow=shadow)
 

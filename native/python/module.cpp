@@ -167,7 +167,8 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
   static const std::string light_doc =
       "Adds a light of Blender type `type` with its parameters as keywords; returns its id. Types:\n" +
       type_docs<Light>() +
-      "visible_camera / visible_specular: whether camera rays / rays through glass see the light itself;\n"
+      "visible_camera / visible_glossy / visible_transmission: whether camera rays / reflections / rays\n"
+      "through glass see the light itself (glossy and transmission: and whether those lobes are lit by it);\n"
       "visible_diffuse: whether it lights diffuse surfaces; cast_shadow: whether surfaces shadow it.\n"
       "receiver_sets / blocker_sets: light linking, 64-bit masks of the instances' receiver_set / blocker_set\n"
       "it lights / whose instances shadow it (all bits set: no linking; add_instance).\n"
@@ -219,51 +220,56 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
            "the bottom (Blender's Image.pixels order); srgb: decode from sRGB to linear, as Blender does.")
       .def(
           "add_light",
-          [](PyScene& self, const std::string& type, bool visible_camera, bool visible_specular, bool visible_diffuse,
-             bool cast_shadow, uint64_t receiver_sets, uint64_t blocker_sets, const py::kwargs& params) {
-            return self.add_light(
-                type, to_params(params),
-                {visible_camera, visible_specular, visible_diffuse, cast_shadow, receiver_sets, blocker_sets});
+          [](PyScene& self, const std::string& type, bool visible_camera, bool visible_glossy,
+             bool visible_transmission, bool visible_diffuse, bool cast_shadow, uint64_t receiver_sets,
+             uint64_t blocker_sets, const py::kwargs& params) {
+            return self.add_light(type, to_params(params),
+                                  {visible_camera, visible_glossy, visible_transmission, visible_diffuse, cast_shadow,
+                                   receiver_sets, blocker_sets});
           },
           py::arg("type"), py::arg("visible_camera") = LightVisibility{}.camera,
-          py::arg("visible_specular") = LightVisibility{}.specular,
+          py::arg("visible_glossy") = LightVisibility{}.glossy,
+          py::arg("visible_transmission") = LightVisibility{}.transmission,
           py::arg("visible_diffuse") = LightVisibility{}.diffuse, py::arg("cast_shadow") = LightVisibility{}.shadow,
           py::arg("receiver_sets") = kAllLightSets, py::arg("blocker_sets") = kAllLightSets, light_doc.c_str())
       .def(
           "add_point_light",
           [](PyScene& self, py::handle position, float power, py::handle color, float radius, bool visible_camera,
-             bool visible_specular) {
+             bool visible_glossy, bool visible_transmission) {
             Params p;
             p.set("position", to_vec3(position, "position")).set("power", double(power));
             p.set("color", to_vec3(color, "color")).set("radius", double(radius));
-            return self.add_light(PointLight::kType, p, {visible_camera, visible_specular});
+            return self.add_light(PointLight::kType, p, {visible_camera, visible_glossy, visible_transmission});
           },
           py::arg("position"), py::arg("power"), py::arg("color") = as_tuple(PointLight::Settings{}.color),
           py::arg("radius") = PointLight::Settings{}.radius, py::arg("visible_camera") = LightVisibility{}.camera,
-          py::arg("visible_specular") = LightVisibility{}.specular,
+          py::arg("visible_glossy") = LightVisibility{}.glossy,
+          py::arg("visible_transmission") = LightVisibility{}.transmission,
           "Adds a point light in Blender's units: power in watts, linear colour, radius in metres (0: hard shadows).\n"
-          "visible_camera / visible_specular: whether camera rays / rays through glass see the sphere itself.\n"
+          "visible_camera / visible_glossy / visible_transmission: whether camera rays / reflections / rays\n"
+          "through glass see the sphere itself.\n"
           "The same as add_light('POINT', ...).")
       .def(
           "add_area_light",
           [](PyScene& self, py::handle matrix, const std::string& shape, float size, py::handle size_y, float power,
-             py::handle color, float spread, bool visible_camera, bool visible_specular) {
+             py::handle color, float spread, bool visible_camera, bool visible_glossy, bool visible_transmission) {
             Params p;
             p.set("matrix", to_matrix(matrix, "matrix")).set("shape", shape).set("size", double(size));
             if (!size_y.is_none()) p.set("size_y", double(size_y.cast<float>()));
             p.set("power", double(power)).set("color", to_vec3(color, "color")).set("spread", double(spread));
-            return self.add_light(AreaLight::kType, p, {visible_camera, visible_specular});
+            return self.add_light(AreaLight::kType, p, {visible_camera, visible_glossy, visible_transmission});
           },
           py::arg("matrix"), py::arg("shape") = area_shape_name(AreaLight::Settings{}.shape),
           py::arg("size") = AreaLight::Settings{}.size, py::arg("size_y") = py::none(),
           py::arg("power") = AreaLight::Settings{}.power, py::arg("color") = as_tuple(AreaLight::Settings{}.color),
           py::arg("spread") = AreaLight::Settings{}.spread, py::arg("visible_camera") = LightVisibility{}.camera,
-          py::arg("visible_specular") = LightVisibility{}.specular,
+          py::arg("visible_glossy") = LightVisibility{}.glossy,
+          py::arg("visible_transmission") = LightVisibility{}.transmission,
           "Adds an area light in Blender's units: the light object's (4, 4) world matrix (it emits along its\n"
           "local -Z, one-sided), shape 'RECTANGLE', 'SQUARE', 'DISK' or 'ELLIPSE', size (and size_y) in metres,\n"
           "power in watts (radiance = power / (4 area), as Cycles), spread in radians (pi: none; the beam of a\n"
-          "soft box's slats, as Cycles). visible_camera / visible_specular: whether\n"
-          "camera rays / rays through glass see the light's surface (Cycles' defaults: both).\n"
+          "soft box's slats, as Cycles). visible_camera / visible_glossy / visible_transmission:\n"
+          "whether camera rays / reflections / rays through glass see the light's surface (Cycles' defaults: all).\n"
           "The same as add_light('AREA', ...).")
       .def_property("background", &PyScene::background, &PyScene::set_background,
                     "Radiance (linear RGB) of rays that leave the scene: the world colour.")

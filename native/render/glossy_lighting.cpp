@@ -33,16 +33,16 @@ Vec3 lobe_lamp_lighting(const Scene& scene, const LobeVertex& v, uint32_t pixel,
   const World& world = scene.world();
   Vec3 sum(0.0f);
   auto add = [&](size_t j, float select_probability, uint32_t dim) {
-    // The lamps a glossy reflection or a glass shows are those visible to specular rays (Cycles'
-    // glossy and transmission visibility, one flag here), for their light as for their image.
+    // A lamp lights a reflection or a refraction as it is seen by that kind of ray (Cycles'
+    // glossy and transmission visibility), for its light as for its image: checked by side below.
     const LightVisibility lamp = world.light_visibility[j];
     // Light linking: a lamp that does not light this object adds nothing (lights/light_linking.h).
-    if (!lamp.specular || !in_light_sets(lamp.receiver_sets, receiver_set)) return;
+    if (!(lamp.glossy || lamp.transmission) || !in_light_sets(lamp.receiver_sets, receiver_set)) return;
     const LightSample ls =
         sample_light(world.lights[j], v.p, sobol_owen_2d(pixel, sample, dim, settings.seed), settings.area_sampling);
     if (!ls.valid()) return;
     const LobeAnswer a = lobe_towards(v, ls.wi);
-    if (a.e.f == Vec3(0.0f)) return;
+    if (a.e.f == Vec3(0.0f) || !lamp.seen_by(a.seen_by)) return;
     Vec3 tr(1.0f);  // what cut-outs on the way let through
     if (lamp.shadow) {
       // A light at infinity (the sun) is left along wi; the others end where the sample is.

@@ -326,7 +326,8 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
       const float length = glm::length(ray.dir);
       lamps = visible_lights(
           world, scene.lamp_bvh(), ray.org, ray.dir / length, ray.tnear * length, std::min(hit.t, ray.tfar) * length,
-          !hit.found(), bounce == 0, settings.area_sampling, bsdf_pdf, receiver,
+          !hit.found(), bounce == 0 ? uint8_t(kVisibleCamera) : seen_by(kind), settings.area_sampling, bsdf_pdf,
+          receiver,
           lobe_from.on && picks_one_lamp(world, settings) ? LampChoice{&lamp_selector, lobe_from.p, lobe_from.n}
                                                           : LampChoice{});
       radiance += throughput * lamps;

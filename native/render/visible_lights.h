@@ -23,8 +23,9 @@ struct LampChoice {
   Vec3 p{0.0f}, n{0.0f};
 };
 
-// The radiance of the lights a camera (depth 0) or specular ray passes before distance `limit`
-// (in units of the unit direction), of those visible to that kind of ray. Lights are not
+// The radiance of the lights a camera, glossy or transmission ray (`ray`, one RayVisibility bit)
+// passes before distance `limit` (in units of the unit direction), of those visible to that kind
+// of ray. Lights are not
 // surfaces: as in Cycles, a ray that sees one goes on, so what is behind a light (another light,
 // a surface, the world) adds to it. A light at infinity (a sun, at FLT_MAX) is part of the world:
 // seen by a ray that leaves the scene (`escaped`), whatever the camera's clip end. bsdf_pdf > 0:
@@ -35,13 +36,13 @@ struct LampChoice {
 // Cycles, counts as set 0 (so a lamp that lights only included objects is not seen by the camera
 // either). `lamps`: the scene's lamp BVH (lights/lamp_bvh.h), or empty: every lamp is tested.
 inline Vec3 visible_lights(const World& world, const LampBvh& lamps, const Vec3& org, const Vec3& unit_dir, float from,
-                           float limit, bool escaped, bool camera, AreaSampling area_sampling, float bsdf_pdf,
+                           float limit, bool escaped, uint8_t ray, AreaSampling area_sampling, float bsdf_pdf,
                            uint8_t receiver, const LampChoice& choice = {}) {
   constexpr float kAtInfinity = std::numeric_limits<float>::max();
   Vec3 radiance(0.0f);
   auto see = [&](size_t j) {
     const LightVisibility v = world.light_visibility[j];
-    if (!(camera ? v.camera : v.specular)) return;
+    if (!v.seen_by(ray)) return;
     if (!in_light_sets(v.receiver_sets, receiver)) return;
     const LightEval e = evaluate_light(world.lights[j], org, unit_dir, area_sampling);
     if (!e.hit()) return;

@@ -5,6 +5,7 @@
 #include "lights/light.h"
 #include "lights/light_linking.h"
 #include "scene/environment.h"
+#include "scene/instance.h"
 
 #include <cstdint>
 #include <vector>
@@ -12,19 +13,29 @@
 namespace toyrt {
 
 // Per light, Blender's settings of the light object (all on by default, as in Cycles): whether
-// camera rays, and rays continuing through refraction or reflection, see the light itself (point
-// and spot lights of radius 0 and suns of angle 0 can never be seen); whether it lights diffuse
-// surfaces at all (the object's diffuse ray visibility); whether surfaces between it and a
-// point shadow it (Cycles 3.x light.cycles.cast_shadow, 4.x+ light.use_shadow).
+// camera rays, reflected (glossy) rays and refracted (transmission) rays see the light itself
+// (point and spot lights of radius 0 and suns of angle 0 can never be seen), and whether glossy and
+// transmission lobes are lit by it (Cycles excludes a light from the closures of the kinds it is
+// hidden from, for its sample as for its image); whether it lights diffuse surfaces at all (the
+// object's diffuse ray visibility); whether surfaces between it and a point shadow it (Cycles 3.x
+// light.cycles.cast_shadow, 4.x+ light.use_shadow).
 // Light linking (lights/light_linking.h): the receiver sets the light lights and the blocker sets
 // that shadow it; full masks (the default) link nothing.
 struct LightVisibility {
   bool camera = true;
-  bool specular = true;
+  bool glossy = true;
+  bool transmission = true;
   bool diffuse = true;
   bool shadow = true;
   uint64_t receiver_sets = kAllLightSets;
   uint64_t blocker_sets = kAllLightSets;
+
+  // Whether a path ray of kind `ray` (one RayVisibility bit of scene/instance.h) sees the light.
+  bool seen_by(uint8_t ray) const {
+    return ray == kVisibleCamera   ? camera
+           : ray == kVisibleGlossy ? glossy
+                                   : ray == kVisibleTransmission && transmission;
+  }
 };
 
 struct World {

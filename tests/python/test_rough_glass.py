@@ -89,7 +89,7 @@ def sees_lamp(w, below):
     return (z > 0) & (np.abs(x) < LAMP_SIZE / 2) & (np.abs(y) < LAMP_SIZE / 2)
 
 
-def plane(world=(0.0, 0.0, 0.0), lamp=None, kind="glass", distribution="ggx"):
+def plane(world=(0.0, 0.0, 0.0), lamp=None, kind="glass", distribution="ggx", **lamp_visibility):
     s = toyrt.Scene()
     s.background = world
     if kind == "refraction":
@@ -105,7 +105,8 @@ def plane(world=(0.0, 0.0, 0.0), lamp=None, kind="glass", distribution="ggx"):
         if lamp == "below":   # turned over: facing up
             m[1, 1] = m[2, 2] = -1.0
         m[2, 3] = -LAMP_HEIGHT if lamp == "below" else LAMP_HEIGHT
-        s.add_area_light(m, shape="SQUARE", size=LAMP_SIZE, power=LAMP_POWER, visible_camera=False)
+        s.add_area_light(m, shape="SQUARE", size=LAMP_SIZE, power=LAMP_POWER, visible_camera=False,
+                         **lamp_visibility)
     s.commit()
     return s
 
@@ -140,6 +141,21 @@ def test_a_lamp_seen_in_or_through_rough_glass_matches_the_quadrature(side):
     got = render_mean(plane(lamp=side))
     assert want > 0.02 * radiance   # the lamp lights the pixel through this side of the lobe (R ~ 4 %)
     assert got == pytest.approx(want, rel=3e-3)
+
+
+@pytest.mark.parametrize("side", ["above", "below"])
+def test_a_lamp_hidden_from_one_kind_of_ray_lights_only_the_other_side_of_rough_glass(side):
+    # The camera sees a lamp above the plane only by reflection (a glossy ray, Cycles' path
+    # flags) and one below only by refraction (a transmission ray). Hidden from that kind of ray,
+    # the lamp adds nothing, neither as the lobe's sample nor as what the lobe's ray finds (as
+    # Cycles excludes a light from the closures it is hidden from); hidden from the other kind,
+    # the image is the same as with the lamp seen by all.
+    kind = "visible_glossy" if side == "above" else "visible_transmission"
+    other = "visible_transmission" if side == "above" else "visible_glossy"
+    seen = render_mean(plane(lamp=side))
+    assert seen > 0.0
+    assert render_mean(plane(lamp=side, **{kind: False})) == 0.0
+    assert render_mean(plane(lamp=side, **{other: False})) == seen
 
 
 def plane_under_emitter(side, sampling, kind="glass"):
