@@ -11,6 +11,7 @@ Cycles changed a light's model between versions (a spot's cone edge, a sun's dis
 names the running version's model; point and spot lights follow use_soft_falloff (4.0+)."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -138,6 +139,12 @@ def light_spec(obj, matrix: np.ndarray) -> tuple[LightSpec | None, tuple[str, ..
     notes = []
     color = light_color(light)
     power = light_power(light, matrix)
+    # The core refuses these too, but without the object's name; a scene may hold hundreds of lights.
+    if not (math.isfinite(power) and power >= 0.0):
+        raise ValueError(f"light '{obj.name}': its power or strength must be finite and >= 0 "
+                         f"(TOYRT has no negative lights), got {float(light.energy):g}")
+    if not all(math.isfinite(c) for c in color):
+        raise ValueError(f"light '{obj.name}': its colour is not finite: {tuple(color)}")
     if getattr(light, "use_nodes", False):
         notes.append(f"light '{obj.name}': node setup (its colour and power)")
     visibility = light_visibility(obj)

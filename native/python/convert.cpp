@@ -14,6 +14,16 @@ py::array try_array(py::handle obj) {
   }
 }
 
+void throw_copy_failed(py::handle a, const char* name) {
+  const py::array source = try_array(a);
+  if (source && is_numeric(source)) {
+    const std::string what = std::string(name) + ": no memory for a copy of an array of shape " + shape_of(source);
+    PyErr_SetString(PyExc_MemoryError, what.c_str());
+    throw py::error_already_set();
+  }
+  throw py::type_error(std::string(name) + " must be an array of numbers");
+}
+
 bool is_numeric(const py::array& a) {
   const char k = a.dtype().kind();
   return k == 'f' || k == 'i' || k == 'u';
@@ -32,7 +42,7 @@ FloatArray as_points(py::handle obj, const char* name) {
     throw py::type_error(std::string(name) + " must hold numbers, not dtype " + std::string(py::str(a.dtype())));
   if (a.ndim() != 2 || a.shape(1) != 3)
     throw py::value_error(std::string(name) + " must have shape (N, 3), got " + shape_of(a));
-  return FloatArray::ensure(a);
+  return contiguous<float>(a, name);
 }
 
 FloatArray as_point_grid(py::handle obj, const char* name, std::vector<py::ssize_t>& leading) {
@@ -43,8 +53,8 @@ FloatArray as_point_grid(py::handle obj, const char* name, std::vector<py::ssize
   if (a.ndim() < 2 || a.shape(a.ndim() - 1) != 3)
     throw py::value_error(std::string(name) + " must have shape (N, 3) or (..., 3), got " + shape_of(a));
   leading.assign(a.shape(), a.shape() + a.ndim() - 1);
-  if (a.ndim() == 2) return FloatArray::ensure(a);
-  return FloatArray::ensure(a.attr("reshape")(-1, 3));
+  if (a.ndim() == 2) return contiguous<float>(a, name);
+  return contiguous<float>(a.attr("reshape")(-1, 3), name);
 }
 
 py::array shaped(const py::array& a, const std::vector<py::ssize_t>& leading) {
@@ -70,10 +80,10 @@ std::vector<Triangle> to_triangles(py::handle obj) {
     throw py::type_error("triangles must be an integer array (vertex indices), not dtype " +
                          std::string(py::str(a.dtype())));
   if (a.ndim() != 2 || a.shape(1) != 3) throw py::value_error("triangles must have shape (M, 3), got " + shape_of(a));
-  auto idx = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+  auto idx = contiguous<int64_t>(a, "triangles");
   if (kind == 'u' && a.itemsize() == 8) {
     // uint64 above 2^63 would wrap to negative int64: check the originals.
-    auto u = py::array_t<uint64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+    auto u = contiguous<uint64_t>(a, "triangles");
     for (py::ssize_t i = 0; i < u.size(); ++i)
       if (u.data()[i] > UINT32_MAX)
         throw py::value_error("triangle " + std::to_string(i / 3) + " has an index out of range");
@@ -98,7 +108,7 @@ Mat4 to_matrix(py::handle obj, const char* name) {
     throw py::type_error(std::string(name) + " must be a (4, 4) array of numbers (row-major world matrix)");
   if (a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4)
     throw py::value_error(std::string(name) + " must have shape (4, 4), got " + shape_of(a));
-  auto m = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+  auto m = contiguous<double>(a, name);
   Mat4 out;
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) out[c][r] = float(m.data()[4 * r + c]);
@@ -108,7 +118,7 @@ Mat4 to_matrix(py::handle obj, const char* name) {
 Vec3 to_vec3(py::handle obj, const char* name) {
   const py::array a = try_array(obj);
   if (!a || !is_numeric(a)) throw py::type_error(std::string(name) + " must be numbers");
-  auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+  auto d = contiguous<double>(a, name);
   if (d.size() != 3) throw py::value_error(std::string(name) + " must have 3 components");
   return Vec3(float(d.data()[0]), float(d.data()[1]), float(d.data()[2]));
 }
@@ -130,12 +140,12 @@ PerRay per_ray(py::handle obj, size_t count, const char* name) {
     if (!a || !is_numeric(a))
       throw py::type_error(std::string(name) + " must be a number or an array of numbers, one per ray");
     if (a.ndim() == 0) {
-      out.scalar = FloatArray::ensure(a).data()[0];
+      out.scalar = contiguous<float>(a, name).data()[0];
     } else {
       if (a.ndim() != 1 || size_t(a.shape(0)) != count)
         throw py::value_error(std::string(name) + " must be a number or have shape (" + std::to_string(count) +
                               ",), got " + shape_of(a));
-      out.storage = FloatArray::ensure(a);
+      out.storage = contiguous<float>(a, name);
       out.data = out.storage.data();
       out.stride = 1;
       return out;
@@ -153,7 +163,7 @@ MeshShading to_shading(size_t vertex_count, const std::vector<Triangle>& tris, p
   // Writes 3 m k floats to `out` (the shading vector's storage: one copy from numpy).
   auto corners = [&](py::handle obj, int k, const char* name, auto& vec) {
     const py::array raw = try_array(obj);
-    FloatArray a = raw && is_numeric(raw) ? FloatArray::ensure(raw) : FloatArray();
+    FloatArray a = raw && is_numeric(raw) ? contiguous<float>(raw, name) : FloatArray();
     if (!a) throw py::type_error(std::string(name) + " must be an array of numbers");
     const size_t floats = m * 3 * size_t(k);
     if (a.ndim() == 3 && size_t(a.shape(0)) == m && a.shape(1) == 3 && a.shape(2) == k) {
@@ -193,7 +203,7 @@ MeshShading to_shading(size_t vertex_count, const std::vector<Triangle>& tris, p
         throw py::type_error("material_ids must be an integer or an integer array of shape (M,)");
       if (a.ndim() != 1 || size_t(a.shape(0)) != m)
         throw py::value_error("material_ids must have shape (" + std::to_string(m) + ",), got " + shape_of(a));
-      auto ids = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+      auto ids = contiguous<int64_t>(a, "material_ids");
       sh.material_ids.resize(m);
       for (size_t t = 0; t < m; ++t) {
         if (ids.data()[t] < INT32_MIN || ids.data()[t] > INT32_MAX)
@@ -214,10 +224,10 @@ Texture to_texture(py::handle pixels, bool srgb) {
   const ColorEncoding enc = srgb ? ColorEncoding::Srgb : ColorEncoding::Linear;
   Texture t;
   if (a.dtype().kind() == 'u' && a.itemsize() == 1) {
-    auto b = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>::ensure(a);
+    auto b = contiguous<uint8_t>(a, "pixels");
     t = Texture::from_bytes(w, h, c, std::vector<uint8_t>(b.data(), b.data() + b.size()), enc);
   } else if (a.dtype().kind() == 'f') {
-    auto f = FloatArray::ensure(a);
+    auto f = contiguous<float>(a, "pixels");
     t = Texture::from_floats(w, h, c, std::vector<float>(f.data(), f.data() + f.size()), enc);
   } else {
     throw py::type_error("pixels must be float (0..1) or uint8, not dtype " + std::string(py::str(a.dtype())));

@@ -22,6 +22,18 @@ namespace toyrt::binding {
 namespace py = pybind11;
 using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 
+[[noreturn]] void throw_copy_failed(py::handle a, const char* name);
+// A C-contiguous copy (or view) of `a` as T. pybind11's ensure() answers a failed copy with a
+// null array and Python's error cleared; for an array of numbers that failure is an allocation
+// (a broadcast view of a terabyte, say), and a null array dereferenced here crashed Python. So
+// this raises MemoryError naming `name` instead, and TypeError for an array that holds no numbers.
+template <class T>
+py::array_t<T, py::array::c_style | py::array::forcecast> contiguous(py::handle a, const char* name) {
+  auto out = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
+  if (!out) throw_copy_failed(a, name);
+  return out;
+}
+
 // The object as a numpy array (converting lists and the like), or a null array when it cannot be.
 py::array try_array(py::handle obj);
 // Whether an array holds numbers (float, signed or unsigned integer).

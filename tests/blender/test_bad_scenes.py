@@ -274,6 +274,25 @@ def test_bad_glass():
     check(px is not None and np.isfinite(px).all() and px[..., :3].mean() > 0, "and the image is lit and finite")
 
 
+def test_bad_light_strength():
+    # A negative or NaN strength (Blender accepts both; Cycles renders negative light, TOYRT has
+    # none) or a NaN colour: F12 fails with an error naming the light, writes no image, and
+    # renders again once the light is mended.
+    basic_scene()
+    lamp = bpy.data.objects["lamp"]
+    for setting, value in (("energy", -100.0), ("energy", float("nan")), ("color", (1.0, float("nan"), 1.0))):
+        saved = tuple(getattr(lamp.data, setting)) if setting == "color" else getattr(lamp.data, setting)
+        setattr(lamp.data, setting, value)
+        result, px, _ = render(f"bad_light_{setting}")
+        message = str(result)
+        check(result != {"FINISHED"} and px is None and "'lamp'" in message
+              and ("power" in message if setting == "energy" else "colour" in message),
+              f"light {setting} {value}: F12 fails naming the light, no image: {message[:160]}")
+        setattr(lamp.data, setting, saved)
+    result, px, _ = render("bad_light_mended")
+    check(result == {"FINISHED"} and px is not None and px[..., :3].mean() > 0, "mended, the scene renders")
+
+
 def test_library_linked():
     # A library file holding a cube object with its mesh and material, written by this Blender.
     basic_scene()
@@ -346,6 +365,6 @@ def test_100k_objects():
 
 PARTS = [test_empty_scene, test_no_camera, test_edges_and_points_only, test_zero_scale, test_nan_vertices,
          test_far_from_origin, test_missing_image, test_unsupported_nodes, test_glossy_and_metal, test_bad_glass,
-         test_library_linked,
+         test_bad_light_strength, test_library_linked,
          test_100k_objects]
 run_script(PARTS, "bad scenes", TMP)

@@ -17,6 +17,7 @@ import sys
 import tempfile
 
 import bpy
+import mathutils
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -63,6 +64,87 @@ def test_sun_over_a_floor_gives_strength_cos_over_pi():
     got = float(px[..., 0].mean()) if px is not None else float("nan")
     check(result == {"FINISHED"} and abs(got - expected) <= 1e-4 * expected,
           f"a sun of 3 W/m^2 at {tilt} rad: pixel {got:.5f}, closed form {expected:.5f}")
+
+
+def sun_over_floor(name, tilt, **light_settings):
+    """The floor (albedo 0.8) under a hard sun `tilt` radians from the zenith, with the light's
+    `light_settings`: (F12's result, pixels, the sun's cosine on the floor as Blender placed it)."""
+    scene_with_floor(0.8)
+    sun = kit.sun_light("sun", 3.0, (math.sin(tilt), 0.0, -math.cos(tilt)), angle=0.0)
+    for key, value in light_settings.items():
+        setattr(sun.data, key, value)
+    bpy.context.view_layer.update()
+    towards = sun.matrix_world.to_3x3() @ mathutils.Vector((0.0, 0.0, -1.0))
+    cos = -towards.normalized().z
+    result, px, _ = render(name)
+    return result, px, cos
+
+
+def test_a_grazing_sun_gives_strength_cos_over_pi_on_every_pixel():
+    # Down to 0.01 degrees above the horizon: no pixel shadowed by the floor it leaves (the
+    # shadow ray runs almost along it), none lit too much, none NaN.
+    for degrees in (80.0, 89.0, 89.9, 89.99):
+        result, px, cos = sun_over_floor("grazing_sun", math.radians(degrees))
+        expected = 0.8 / math.pi * 3.0 * cos
+        got = px[..., 0] if px is not None else np.full(1, np.nan)
+        check(result == {"FINISHED"} and np.isfinite(px).all()
+              and np.abs(got / expected - 1.0).max() <= 1e-3,
+              f"a sun {degrees} degrees from the zenith: pixels {got.min():.4g}-{got.max():.4g}, "
+              f"closed form {expected:.4g}")
+
+
+def test_light_exposure_scales_by_two_to_its_power():
+    # Blender 4.0+: every light's power times 2^exposure, as Cycles.
+    scene_with_floor()
+    if not hasattr(bpy.data.lights.new("probe", "SUN"), "exposure"):
+        print("  skipped: this Blender's lights have no exposure (4.0+)")
+        return
+    result, px, cos = sun_over_floor("exposed_sun", 0.5, exposure=1.5)
+    expected = 0.8 / math.pi * 3.0 * cos * 2.0 ** 1.5
+    got = float(px[..., 0].mean()) if px is not None else float("nan")
+    check(result == {"FINISHED"} and abs(got / expected - 1.0) <= 1e-4,
+          f"a sun of exposure 1.5: pixel {got:.5f}, closed form {expected:.5f}")
+
+
+def test_light_temperature_renders_as_in_cycles():
+    # Blender 4.5+: the light's colour times its blackbody colour. Cycles is the oracle: a hard
+    # sun on a flat floor, direct light only, is exact at any sample count in both engines.
+    scene_with_floor()
+    if not hasattr(bpy.data.lights.new("probe", "SUN"), "use_temperature"):
+        print("  skipped: this Blender's lights have no temperature (4.5+)")
+        return
+    settings = dict(use_temperature=True, temperature=3200.0, color=(0.9, 1.0, 0.8))
+    result, px, _ = sun_over_floor("warm_sun", 0.5, **settings)
+    kit.cycles(bpy.context.scene, samples=4, specular_depth=0)
+    cycles_result, reference, _ = render("warm_sun_cycles")
+    got = px[..., :3].reshape(-1, 3).mean(0) if px is not None else np.full(3, np.nan)
+    want = reference[..., :3].reshape(-1, 3).mean(0) if reference is not None else np.full(3, np.nan)
+    check(result == cycles_result == {"FINISHED"} and np.allclose(got, want, rtol=1e-3)
+          and not np.allclose(want, want[0], rtol=0.05),
+          f"a 3200 K sun: TOYRT {np.round(got, 5)}, Cycles {np.round(want, 5)}")
+
+
+def test_a_principled_emitter_lights_the_floor_as_its_closed_form():
+    # A 1 m Principled square glowing L = colour x strength, 1 m over the floor and facing it: the
+    # floor's pixel under its centre is albedo / pi x L x (the square's E / L, four corner
+    # rectangles), found by sampling the emissive triangles.
+    scene_with_floor(0.8)
+    kit.toyrt(bpy.context.scene, samples=64, seed=0)
+    mat = kit.principled("glowing_panel", (0.0, 0.0, 0.0))
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    kit.input_of(bsdf, "Emission Color", "Emission").default_value = (1.0, 0.5, 0.25, 1.0)   # 4.0+ / 3.x
+    bsdf.inputs["Emission Strength"].default_value = 4.0
+    panel = kit.plane("panel", 1.0, mat, (0.0, 0.0, 1.0))
+    panel.rotation_euler = (math.pi, 0.0, 0.0)   # facing down
+    kit.camera((0.0, 0.0, 0.5), ortho_scale=0.01, clip=(0.01, 10.0))   # under the panel
+    x = 0.5   # half the side over the height
+    corner = x / math.sqrt(1 + x * x) * math.atan(x / math.sqrt(1 + x * x))
+    irradiance_over_radiance = 4 * corner
+    expected = 0.8 / math.pi * 4.0 * np.array([1.0, 0.5, 0.25]) * irradiance_over_radiance
+    result, px, _ = render("principled_panel")
+    got = px[..., :3].reshape(-1, 3).mean(0) if px is not None else np.full(3, np.nan)
+    check(result == {"FINISHED"} and np.allclose(got, expected, rtol=0.01),
+          f"under a glowing Principled square: {np.round(got, 4)}, closed form {np.round(expected, 4)}")
 
 
 def test_portal_is_not_a_light():
@@ -234,7 +316,10 @@ def test_light_linking_edits_reach_the_viewport_as_a_fresh_export():
           f"the excluded lamp drops out and comes back: mean {means}")
 
 
-PARTS = [test_sun_over_a_floor_gives_strength_cos_over_pi, test_portal_is_not_a_light,
+PARTS = [test_sun_over_a_floor_gives_strength_cos_over_pi,
+         test_a_grazing_sun_gives_strength_cos_over_pi_on_every_pixel, test_light_exposure_scales_by_two_to_its_power,
+         test_light_temperature_renders_as_in_cycles, test_a_principled_emitter_lights_the_floor_as_its_closed_form,
+         test_portal_is_not_a_light,
          test_shadow_switch_removes_the_shadow, test_missing_environment_image_is_magenta_with_one_note,
          test_non_finite_texels_are_noted_and_the_image_stays_finite, test_one_pixel_environment_is_a_uniform_world,
          test_a_world_hidden_from_the_camera_still_lights_the_floor,

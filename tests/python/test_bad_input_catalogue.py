@@ -353,6 +353,33 @@ def test_texture_of_16_bit_integers_is_refused_with_the_dtype():
     refused(lambda: toyrt.Scene().add_texture(np.zeros((2, 2, 3), np.uint16)), TypeError, "uint16")
 
 
+@pytest.mark.parametrize("dtype", [np.float32, np.uint8])
+def test_an_image_too_large_for_memory_is_a_memory_error_and_the_scene_keeps_its_textures(dtype):
+    # A broadcast view costs nothing, but its copy would take 0.5-1 TB: MemoryError naming the
+    # argument (the copy's null array was dereferenced before: a crash), and the scene goes on,
+    # the next texture taking the next id and the map still rendering.
+    s = toyrt.Scene()
+    first = s.add_texture(np.full((2, 4, 3), 0.5, np.float32), srgb=False)
+    huge = np.broadcast_to(dtype(1), (300_000, 400_000, 4))
+    refused(lambda: s.add_texture(huge), MemoryError, "pixels: no memory")
+    refused(lambda: s.set_texture(first, huge), MemoryError, "pixels: no memory")
+    assert s.add_texture(np.full((2, 4, 3), 0.5, np.float32), srgb=False) == first + 1
+    s.set_environment(first)
+    s.commit()
+    img = s.render({"type": "ORTHO", "ortho_scale": 1.0, "resolution_x": 2, "resolution_y": 2,
+                    "matrix_world": np.eye(4)}, samples=1)
+    np.testing.assert_allclose(img[..., :3], 0.5, rtol=1e-6)
+
+
+def test_rays_too_many_for_memory_are_a_memory_error():
+    s = toyrt.Scene()
+    s.add_mesh(np.float32([[0, 0, 0], [1, 0, 0], [0, 1, 0]]), [[0, 1, 2]])
+    s.commit()
+    rays = np.broadcast_to(np.float64(1), (10**11, 3))   # float64: a float32 copy is needed
+    refused(lambda: s.intersect(rays, rays), MemoryError, "no memory")
+    assert s.intersect(np.float32([[0.2, 0.2, 1]]), np.float32([[0, 0, -1]]))["t"][0] == 1.0
+
+
 def test_texture_with_nan_texels_is_refused():
     px = np.zeros((2, 2, 4), np.float32)
     px[1, 1, 2] = np.nan
