@@ -42,6 +42,15 @@ ECONOMY = [
     ("+ 2 point lights (the seed's scene)", dict(texture=True, glass=True, point_lights=2)),
     ("+ 16 more point lights", dict(texture=True, glass=True, point_lights=2, extra_lights=16)),
     ("+ 400 instances", dict(texture=True, glass=True, point_lights=2, extra_lights=16, instances=400)),
+    # The lights issue's additions: each step pays for its own sampling, nothing before it changes.
+    ("+ a constant grey world", dict(texture=True, glass=True, point_lights=2, extra_lights=16, instances=400,
+                                     world="constant")),
+    ("+ an HDRI map for the world instead", dict(texture=True, glass=True, point_lights=2, extra_lights=16,
+                                                 instances=400, world="map")),
+    ("+ a sun", dict(texture=True, glass=True, point_lights=2, extra_lights=16, instances=400, world="map",
+                     sun=True)),
+    ("+ an emissive panel", dict(texture=True, glass=True, point_lights=2, extra_lights=16, instances=400,
+                                 world="map", sun=True, emitter=True)),
 ]
 
 
