@@ -7,6 +7,7 @@
 // and colours have a defined result.
 #include "sampling/ggx.h"
 #include "hemisphere.h"
+#include "hemisphere_chi_square.h"
 #include "materials/glossy.h"
 #include "materials/material.h"
 #include "statistics.h"
@@ -21,6 +22,7 @@
 using namespace toyrt;
 using toyrt::testing::chi_square_quantile;
 using toyrt::testing::direction;
+using toyrt::testing::hemisphere_chi_square;
 using toyrt::testing::hemisphere_integral;
 using toyrt::testing::pooled_chi_square;
 using toyrt::testing::PooledChiSquare;
@@ -51,42 +53,18 @@ TEST(Ggx, PdfAtNormalIncidenceIntegratesToTheMassAboveTheHorizon) {
 }
 
 TEST(Ggx, SamplerMatchesItsPdfChiSquare) {
-  constexpr int kTheta = 24, kPhi = 48, kSub = 6, kSamples = 400000;
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
   for (float alpha : {0.2f, 0.5f, 1.0f}) {
     for (double theta_o : {0.0, 0.8, 1.4}) {
       const Vec3 wo = direction(theta_o, 0.3);
-      // Expected bin masses by quadrature of the pdf; the last bin is everything below the horizon.
-      std::vector<double> expected(kTheta * kPhi + 1, 0.0);
-      const double dt = 0.5 * M_PI / (kTheta * kSub), dp = 2.0 * M_PI / (kPhi * kSub);
-      double above = 0.0;
-      for (int i = 0; i < kTheta * kSub; ++i) {
-        const double theta = (i + 0.5) * dt;
-        for (int j = 0; j < kPhi * kSub; ++j) {
-          const Vec3 wi = direction(theta, (j + 0.5) * dp);
-          const double p = ggx_reflection_eval(alpha, GgxShadowing::Separable, wo, wi).pdf * std::sin(theta) * dt * dp;
-          expected[size_t((i / kSub) * kPhi + j / kSub)] += p * kSamples;
-          above += p;
-        }
+      const PooledChiSquare t = hemisphere_chi_square(
+          [&](const Vec2& u) {
+            const GgxSample s = ggx_reflection_sample(alpha, GgxShadowing::Separable, wo, u);
+            return s.pdf > 0.0f ? s.wi : Vec3(0.0f);
+          },
+          [&](const Vec3& wi) { return ggx_reflection_eval(alpha, GgxShadowing::Separable, wo, wi).pdf; });
+      if (t.pooled_expected < 5.0) {
+        EXPECT_LT(t.pooled_count, 20.0) << "samples where the pdf says there are none";
       }
-      expected.back() = std::max(0.0, 1.0 - above) * kSamples;
-      std::vector<double> counts(expected.size(), 0.0);
-      for (int k = 0; k < kSamples; ++k) {
-        const GgxSample s = ggx_reflection_sample(alpha, GgxShadowing::Separable, wo, Vec2(uniform(rng), uniform(rng)));
-        if (s.pdf <= 0.0f) {
-          counts.back() += 1.0;
-          continue;
-        }
-        const double theta = std::acos(std::clamp(double(s.wi.z), -1.0, 1.0));
-        double phi = std::atan2(double(s.wi.y), double(s.wi.x));
-        if (phi < 0.0) phi += 2.0 * M_PI;
-        const int i = std::min(kTheta - 1, int(theta / (0.5 * M_PI) * kTheta));
-        const int j = std::min(kPhi - 1, int(phi / (2.0 * M_PI) * kPhi));
-        counts[size_t(i * kPhi + j)] += 1.0;
-      }
-      const PooledChiSquare t = pooled_chi_square(counts, expected);
-      if (t.pooled_expected < 5.0) EXPECT_LT(t.pooled_count, 20.0) << "samples where the pdf says there are none";
       EXPECT_LT(t.chi2, chi_square_quantile(t.bins - 1, 1e-4)) << "alpha " << alpha << " theta_o " << theta_o;
     }
   }
