@@ -192,6 +192,25 @@ def test_missing_environment_image_is_magenta_with_one_note():
           f"a missing HDRI: the render finishes, the note names it, the sky is magenta ({r:.2f} {g:.2f} {b:.2f})")
 
 
+def test_unreadable_environment_image_is_magenta_with_one_note():
+    # The world's image file exists but holds no image Blender can decode (a .blend that refers to
+    # a file overwritten by something else): the world renders as a missing one does.
+    scene_with_floor()
+    path = os.path.join(TMP, "broken_sky.exr")
+    with open(path, "wb") as f:
+        f.write(b"this file holds no image\n" * 200)
+    image = bpy.data.images.new("broken_sky", 4, 2, float_buffer=True)
+    image.source = "FILE"
+    image.filepath = path
+    kit.environment_world(image)
+    kit.camera((0, 0, 0), rotation=(math.pi, 0, 0), ortho_scale=1.0)
+    _, notes = notes_of_export()
+    result, px, _ = render("broken_sky")
+    r, g, b = px[..., :3].reshape(-1, 3).mean(0) if px is not None else (0, 0, 0)
+    check(result == {"FINISHED"} and "broken_sky" in notes and "magenta" in notes and g == 0.0 and r > 0.5,
+          f"an unreadable HDRI: the render finishes, the note names it, the sky is magenta ({r:.2f} {g:.2f} {b:.2f})")
+
+
 def test_non_finite_texels_are_noted_and_the_image_stays_finite():
     scene_with_floor()
     sky = np.full((8, 16, 3), 0.5, np.float32)
@@ -321,6 +340,7 @@ PARTS = [test_sun_over_a_floor_gives_strength_cos_over_pi,
          test_light_temperature_renders_as_in_cycles, test_a_principled_emitter_lights_the_floor_as_its_closed_form,
          test_portal_is_not_a_light,
          test_shadow_switch_removes_the_shadow, test_missing_environment_image_is_magenta_with_one_note,
+         test_unreadable_environment_image_is_magenta_with_one_note,
          test_non_finite_texels_are_noted_and_the_image_stays_finite, test_one_pixel_environment_is_a_uniform_world,
          test_a_world_hidden_from_the_camera_still_lights_the_floor,
          test_principled_emission_is_seen_as_colour_times_strength,
