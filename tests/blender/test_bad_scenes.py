@@ -274,6 +274,28 @@ def test_bad_glass():
     check(px is not None and np.isfinite(px).all() and px[..., :3].mean() > 0, "and the image is lit and finite")
 
 
+def test_principled_ior_zero():
+    # A Principled BSDF whose IOR is 0 (Blender's socket allows it; no material has it): clamped to
+    # 1e-5 as Cycles clamps its IORs, one note naming the material, the render finite; with half
+    # Transmission, so its glass takes the IOR too.
+    clear_scene()
+    mat = kit.principled_dielectric("zero_ior", (0.8, 0.5, 0.3), 0.3)
+    bsdf = next(n for n in mat.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+    bsdf.inputs["IOR"].default_value = 0.0
+    kit.input_of(bsdf, "Transmission Weight", "Transmission").default_value = 0.5   # 4.0+ / 3.x
+    kit.plane("floor", 20.0, kit.diffuse("grey"))
+    kit.box("box", 1.5, (0.5, 0.3, 0.75), material=mat)
+    kit.point_light("lamp", (0, 0, 4), 300.0, radius=0.3)
+    kit.world((0.2, 0.2, 0.2))
+    camera()
+    result, px, log = render("principled_ior_zero")
+    warned = warnings_in(log)
+    w = warned[0] if warned else ""
+    check(result == {"FINISHED"} and len(warned) == 1 and "zero_ior" in w and "IOR" in w and "1e-05" in w,
+          f"a Principled of IOR 0: one note naming it and the clamp: {warned[:1]}")
+    check(px is not None and np.isfinite(px).all() and px[..., :3].mean() > 0, "and the image is lit and finite")
+
+
 def test_bad_light_strength():
     # A negative or NaN strength (Blender accepts both; Cycles renders negative light, TOYRT has
     # none) or a NaN colour: F12 fails with an error naming the light, writes no image, and
@@ -365,6 +387,6 @@ def test_100k_objects():
 
 PARTS = [test_empty_scene, test_no_camera, test_edges_and_points_only, test_zero_scale, test_nan_vertices,
          test_far_from_origin, test_missing_image, test_unsupported_nodes, test_glossy_and_metal, test_bad_glass,
-         test_bad_light_strength, test_library_linked,
+         test_principled_ior_zero, test_bad_light_strength, test_library_linked,
          test_100k_objects]
 run_script(PARTS, "bad scenes", TMP)
