@@ -48,6 +48,8 @@ def mix_of_diffuse_and_glossy(name, node, notes, convert):
             return None
         return replace(sd, color=tuple(wd * c for c in sd.color)), image
     wg, sg, _ = glossy[0]
+    if sg.multiscatter or sg.distribution != "ggx":
+        return None   # 'diffuse_glossy' is single-scatter GGX: the general mix keeps the glossy's own model
     return replace(sd, kind="diffuse_glossy", diffuse_weight=wd, glossy_color=tuple(wg * c for c in sg.color),
                    roughness=sg.roughness, shadowing=sg.shadowing), image
 

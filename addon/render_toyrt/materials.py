@@ -69,7 +69,7 @@ class MaterialSpec:
     emission_sampling: str = "AUTO"                           # Blender 4.x's names (3.x: AUTO or NONE)
     emission_texture: ImageKey | None = None                 # the emission colour's image (emission: its strength)
     fresnel: str = "microfacet"                              # 'glass': 4.0+'s per microfacet, 3.x's 'macro'
-    distribution: str = "ggx"                                # 'glass', 'refraction': or 'beckmann'
+    distribution: str = "ggx"                                # 'glossy', 'glass', 'refraction': or 'beckmann'
     # The part rays pass through (material_alpha.py, the core's materials/transparency.h): the
     # BSDF's weight `opacity` (or a texture's alpha or gray, 1 - it when inverted), the rest a
     # transparent closure of colour transparent_color. Every kind takes them.
@@ -110,6 +110,8 @@ class MaterialSpec:
             args.update(roughness=self.roughness, shadowing=self.shadowing)
         if self.kind in ("glossy", "principled"):
             args.update(multiscatter=self.multiscatter)
+        if self.kind == "glossy":
+            args.update(distribution=self.distribution)
         if self.kind in ("glass", "refraction"):                    # rough when roughness > 0
             args.update(roughness=self.roughness, shadowing=self.shadowing, distribution=self.distribution)
         if self.kind == "glass":
@@ -418,7 +420,7 @@ def _glossy_spec(name, color_sock, rough_sock, notes) -> MaterialSpec:
 
 
 def _glossy(name, node, notes):
-    """Blender's Glossy BSDF: GGX (Sharp in 3.x is roughness 0); other distributions as GGX."""
+    """Blender's Glossy BSDF: GGX or Beckmann (Sharp in 3.x is roughness 0); Ashikhmin-Shirley as GGX."""
     distribution = getattr(node, "distribution", "GGX")
     if distribution == "SHARP":
         rough = None
@@ -426,7 +428,7 @@ def _glossy(name, node, notes):
         rough = input_socket(node, "Roughness")
         if distribution == "MULTI_GGX" and _blender_version() < (4, 0, 0):   # 3.x's is a random walk
             notes.append(f"material '{name}': Multiscatter GGX (single-scatter GGX: darker at high roughness)")
-        elif distribution != "GGX":
+        elif distribution not in ("GGX", "BECKMANN", "MULTI_GGX"):
             notes.append(f"material '{name}': {distribution.title()} glossy distribution (GGX)")
     aniso = input_socket(node, "Anisotropy")
     if aniso is not None and (aniso.is_linked or aniso.default_value != 0.0):
@@ -434,6 +436,8 @@ def _glossy(name, node, notes):
     spec = _glossy_spec(name, input_socket(node, "Color"), rough, notes)
     if distribution == "MULTI_GGX" and _blender_version() >= (4, 0, 0):
         spec = replace(spec, multiscatter=True)
+    if distribution == "BECKMANN":
+        spec = replace(spec, distribution="beckmann")
     return (replace(spec, roughness=0.0) if rough is None else spec), None
 
 

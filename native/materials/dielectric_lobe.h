@@ -40,7 +40,6 @@
 namespace toyrt {
 
 enum class DielectricKind : uint8_t { Refraction, Glass, Glass3x };
-enum class MicrofacetDistribution : uint8_t { Ggx, Beckmann };
 
 struct DielectricLobe {
   Frame frame{Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};  // z: the shading normal on wo's side

@@ -8,11 +8,14 @@
 
 namespace toyrt {
 
-Glossy Glossy::make(const Vec3& color, float roughness, GgxShadowing shadowing, bool multiscatter) {
+Glossy Glossy::make(const Vec3& color, float roughness, GgxShadowing shadowing, bool multiscatter,
+                    MicrofacetDistribution distribution) {
   if (!std::isfinite(roughness)) throw std::invalid_argument("glossy: roughness must be finite");
   if (!is_finite(color) || glm::any(glm::lessThan(color, Vec3(0.0f))))
     throw std::invalid_argument("glossy: color must be finite and >= 0");
-  return Glossy{color, std::clamp(roughness, 0.0f, 1.0f), shadowing, multiscatter};
+  if (multiscatter && distribution != MicrofacetDistribution::Ggx)
+    throw std::invalid_argument("glossy: multiscatter is GGX's (Cycles has no Multiscatter Beckmann)");
+  return Glossy{color, std::clamp(roughness, 0.0f, 1.0f), shadowing, multiscatter, distribution};
 }
 
 GgxShadowing shadowing_from_params(const Params& params) {
@@ -24,8 +27,12 @@ GgxShadowing shadowing_from_params(const Params& params) {
 
 Glossy Glossy::from_params(const Params& params) {
   const Glossy d;
+  const std::string distribution = params.text("distribution", "ggx");
+  if (distribution != "ggx" && distribution != "beckmann")
+    throw std::invalid_argument("glossy: distribution must be 'ggx' or 'beckmann', not '" + distribution + "'");
   return make(params.color("color", d.color), float(params.number("roughness", d.roughness)),
-              shadowing_from_params(params), params.flag("multiscatter", d.multiscatter));
+              shadowing_from_params(params), params.flag("multiscatter", d.multiscatter),
+              distribution == "ggx" ? MicrofacetDistribution::Ggx : MicrofacetDistribution::Beckmann);
 }
 
 GlossyLobe oriented_lobe(const ShadingPoint& s, float roughness, GgxShadowing shadowing) {
@@ -43,6 +50,7 @@ GlossyLobe oriented_lobe(const ShadingPoint& s, float roughness, GgxShadowing sh
 
 Scatter scatter(const Glossy& m, const ShadingPoint& s, const MaterialContext&) {
   GlossyLobe lobe = oriented_lobe(s, m.roughness, m.shadowing);
+  lobe.distribution = m.distribution;
   // Cycles' Glossy BSDF has its colour in the closure's weight and takes it as the lobe's average
   // Fresnel for the energy compensation.
   lobe.tint = m.multiscatter ? m.color * multiscatter_scale(m.roughness, lobe.wo.z, m.color) : m.color;

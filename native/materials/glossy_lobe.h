@@ -9,6 +9,7 @@
 #include "core/math.h"
 #include "materials/clearcoat.h"
 #include "materials/fresnel.h"
+#include "sampling/beckmann.h"
 #include "sampling/frame.h"
 #include "sampling/ggx.h"
 
@@ -29,6 +30,7 @@ struct GlossyLobe {
   Vec3 tint{0.0f};  // the Fresnel term as Blender's Glossy BSDF has it: the colour, at every angle
   float alpha = kGgxMinAlpha;
   GgxShadowing shadowing = GgxShadowing::Separable;
+  MicrofacetDistribution distribution = MicrofacetDistribution::Ggx;  // Beckmann: the Glossy BSDF's choice
   // Blender 3.x's Principled Clearcoat: GTR1 with fixed masking, sampled as GGX with Cycles' pdf
   // (materials/clearcoat.h); shadowing is then unread.
   bool clearcoat = false;
@@ -69,14 +71,18 @@ struct BsdfSample {
 inline BsdfEval evaluate_lobe(const GlossyLobe& lobe, const Vec3& wi) {
   const Vec3 wi_local = lobe.frame.to_local(wi);
   const GgxEval e = lobe.clearcoat ? clearcoat_eval(lobe.alpha, lobe.wo, wi_local)
-                                   : ggx_reflection_eval(lobe.alpha, lobe.shadowing, lobe.wo, wi_local);
+                    : lobe.distribution == MicrofacetDistribution::Beckmann
+                        ? beckmann_reflection_eval(lobe.alpha, lobe.shadowing, lobe.wo, wi_local)
+                        : ggx_reflection_eval(lobe.alpha, lobe.shadowing, lobe.wo, wi_local);
   if (!(e.f > 0.0f)) return {Vec3(0.0f), e.pdf};
   return {lobe.tint * lobe_fresnel(lobe, wi_local) * e.f, e.pdf};
 }
 
 inline BsdfSample sample_lobe(const GlossyLobe& lobe, const Vec2& u) {
   const GgxSample s = lobe.clearcoat ? clearcoat_sample(lobe.alpha, lobe.wo, u)
-                                     : ggx_reflection_sample(lobe.alpha, lobe.shadowing, lobe.wo, u);
+                      : lobe.distribution == MicrofacetDistribution::Beckmann
+                          ? beckmann_reflection_sample(lobe.alpha, lobe.shadowing, lobe.wo, u)
+                          : ggx_reflection_sample(lobe.alpha, lobe.shadowing, lobe.wo, u);
   if (!(s.weight > 0.0f)) return {lobe.frame.to_world(s.wi), Vec3(0.0f), s.pdf};
   return {lobe.frame.to_world(s.wi), lobe.tint * lobe_fresnel(lobe, s.wi) * s.weight, s.pdf};
 }

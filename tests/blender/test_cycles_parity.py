@@ -223,11 +223,11 @@ def scene_hdri(p):
     camera(p["camera"], (0, 0, 0.3))
 
 
-def glossy_row(roughness, color):
-    """A row of Glossy BSDF (GGX) balls at the given roughness values, centred on the origin."""
+def glossy_row(roughness, color, distribution="GGX"):
+    """A row of Glossy BSDF balls (GGX, or `distribution`) at the given roughness values, centred on the origin."""
     for i, rough in enumerate(roughness):
         x = (i - (len(roughness) - 1) / 2) * 0.9
-        kit.uv_sphere(f"ball{i}", 0.4, (x, 0.0, 0.4), kit.glossy(f"glossy{i}", color, rough))
+        kit.uv_sphere(f"ball{i}", 0.4, (x, 0.0, 0.4), kit.glossy(f"glossy{i}", color, rough, distribution))
 
 
 def scene_emitters_glossy(p):
@@ -269,7 +269,7 @@ def scene_glossy_sweep(p):
     # (the spheres reflect it and each other: glossy chains ending on the floor's direct light),
     # under one lamp the sharp balls show as a highlight.
     ball_row_stage(p["lamp"])
-    glossy_row(p["roughness"], p["color"])
+    glossy_row(p["roughness"], p["color"], p.get("distribution", "GGX"))
 
 
 def scene_metal_sweep(p):
@@ -389,6 +389,10 @@ SCENES_SPEC = [
                                                     lamp="point", sample_factor=2), 8),
     ("glossy_sweep_area", scene_glossy_sweep, dict(roughness=[0.05, 0.2, 0.4, 0.7, 1.0], color=(0.9, 0.75, 0.5),
                                                    lamp="area", sample_factor=4), 8),
+    # The Glossy BSDF's Beckmann distribution (3.x separable masking, 4.0+ height-correlated).
+    ("glossy_sweep_beckmann", scene_glossy_sweep, dict(roughness=[0.05, 0.2, 0.4, 0.7, 1.0],
+                                                       color=(0.9, 0.75, 0.5), lamp="point", distribution="BECKMANN",
+                                                       sample_factor=2), 8),
     ("mix_diffuse_glossy", scene_diffuse_and_glossy, dict(balls=[(0.2, 0.3), (0.5, 0.3), (0.8, 0.3), (None, 0.1)],
                                                           sample_factor=4), 8),
     # Principled dielectrics: a roughness sweep under a point lamp, and Specular levels and tints
