@@ -501,6 +501,25 @@ def test_mix_shader():
           f"exactly one note, naming the Toon node: {notes}")
 
 
+def test_mix_of_diffuse_and_glossy_keeps_the_glossy_model():
+    """A Mix of a Diffuse and a GGX Glossy is 'diffuse_glossy' (single-scatter GGX); with the
+    Glossy in Beckmann, or in Multiscatter GGX on 4.0+ (its default there), the general 'mix',
+    whose glossy input keeps that model, not the diffuse_glossy's GGX."""
+    from render_toyrt import materials
+    clear_scene()
+    kinds = {}
+    for distribution in ("GGX", "BECKMANN", "MULTI_GGX"):
+        mat = kit.diffuse_and_glossy(f"mix_{distribution}", (0.5, 0.5, 0.5), (0.8, 0.8, 0.8), 0.6, fac=0.4)
+        next(n for n in mat.node_tree.nodes if n.type == "BSDF_GLOSSY").distribution = distribution
+        spec = materials.material_spec(mat).spec
+        glossy = spec.mix_inputs[1] if spec.kind == "mix" else None
+        kinds[distribution] = (spec.kind, glossy and glossy.distribution, glossy and glossy.multiscatter)
+    multiscatter_mix = bpy.app.version >= (4, 0, 0)
+    check(kinds["GGX"][0] == "diffuse_glossy" and kinds["BECKMANN"] == ("mix", "beckmann", False)
+          and kinds["MULTI_GGX"] == (("mix", "ggx", True) if multiscatter_mix else ("diffuse_glossy", None, None)),
+          f"Mix of Diffuse and Glossy by distribution: {kinds}")
+
+
 def test_principled_specular_layer():
     """A Principled BSDF with Metallic 0 becomes the 'principled' kind on each Blender as its Cycles
     shades it: 4.0+ keeps its IOR, Specular IOR Level and tint colour, layered over the base,
@@ -777,6 +796,7 @@ def test_command_line_range():
 
 PARTS = [test_counts_and_transforms, test_instancing_memory, test_missing_texture, test_emission_image,
          test_unsupported_node,
-         test_mix_shader, test_principled_specular_layer, test_principled_transmission, test_glass_color,
+         test_mix_shader, test_mix_of_diffuse_and_glossy_keeps_the_glossy_model, test_principled_specular_layer,
+         test_principled_transmission, test_glass_color,
          test_rough_glass_and_refraction, test_cancel, test_animation, test_command_line_range]
 run_script(PARTS, "export", TMP)
