@@ -30,8 +30,24 @@ inline vfloat splat(float x) {
   return vfloat{x, x, x, x, x, x, x, x};
 }
 // Lane-wise max / min that keep `acc` where `candidate` is NaN (see safe_max in core/math.h).
-inline vfloat max_keep(vfloat acc, vfloat candidate) { return candidate > acc ? candidate : acc; }
-inline vfloat min_keep(vfloat acc, vfloat candidate) { return candidate < acc ? candidate : acc; }
+// x86's maxps / minps answer exactly this (the first operand where the comparison holds, the
+// second otherwise, NaN included); written as the comparison, GCC emitted a compare and a blend
+// for some of them.
+inline vfloat max_keep(vfloat acc, vfloat candidate) {
+#if defined(__AVX__)
+  static_assert(kWidth == 8);
+  return reinterpret_cast<vfloat>(_mm256_max_ps(reinterpret_cast<__m256>(candidate), reinterpret_cast<__m256>(acc)));
+#else
+  return candidate > acc ? candidate : acc;
+#endif
+}
+inline vfloat min_keep(vfloat acc, vfloat candidate) {
+#if defined(__AVX__)
+  return reinterpret_cast<vfloat>(_mm256_min_ps(reinterpret_cast<__m256>(candidate), reinterpret_cast<__m256>(acc)));
+#else
+  return candidate < acc ? candidate : acc;
+#endif
+}
 // One bit per lane whose comparison result is true (all bits set).
 template <class V>
 inline uint32_t mask_of(V lanes) {

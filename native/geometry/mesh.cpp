@@ -142,12 +142,13 @@ void Mesh::finish(Bvh bvh, const std::vector<uint32_t>& valid) {
 }
 
 template <bool AnyHit>
-bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim) const {
+bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim,
+                 bool ray_checked) const {
   // A valid world ray can overflow in an instance's object space (a huge inverse scale): with a
   // NaN in every inverse direction component, each slab test keeps its NaN-free bounds, so even
   // the empty slots of a wide node "hit" and send the walk back to the root until its stack
   // overflows (found by tests/fuzz). Such a ray cannot hit anything here.
-  if (!is_finite(org) || !is_finite(dir) || dir == Vec3(0.0f)) return false;
+  if (!ray_checked && (!is_finite(org) || !is_finite(dir) || dir == Vec3(0.0f))) return false;
   const float segment_end = tfar;
   const RayBoxData box_ray = make_ray_box_data(org, dir);
   const WatertightRay tri_ray = make_watertight_ray(org, dir);
@@ -186,15 +187,15 @@ bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, flo
   return found;
 }
 
-bool Mesh::intersect(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v,
-                     int32_t& prim) const {
-  return trace<false>(org, dir, tnear, tfar, u, v, prim);
+bool Mesh::intersect(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim,
+                     bool ray_checked) const {
+  return trace<false>(org, dir, tnear, tfar, u, v, prim, ray_checked);
 }
 
-bool Mesh::occluded(const Vec3& org, const Vec3& dir, float tnear, float tfar) const {
+bool Mesh::occluded(const Vec3& org, const Vec3& dir, float tnear, float tfar, bool ray_checked) const {
   float u, v;
   int32_t prim;
-  return trace<true>(org, dir, tnear, tfar, u, v, prim);
+  return trace<true>(org, dir, tnear, tfar, u, v, prim, ray_checked);
 }
 
 size_t Mesh::memory_bytes() const {

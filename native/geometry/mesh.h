@@ -25,10 +25,13 @@ class Mesh {
   void build(BuilderKind kind = BuilderKind::Sah, const BuildConfig& config = {}, BuildStats* stats = nullptr);
   bool built() const { return built_; }
 
-  // Closest hit within [tnear, tfar): shrinks tfar and writes u, v, prim on a hit.
-  bool intersect(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim) const;
+  // Closest hit within [tnear, tfar): shrinks tfar and writes u, v, prim on a hit. ray_checked:
+  // the caller has already refused a ray with a non-finite or zero component (Scene does for the
+  // world ray, which an identity instance passes on unchanged), so the check is not made twice.
+  bool intersect(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim,
+                 bool ray_checked = false) const;
   // Any hit within [tnear, tfar).
-  bool occluded(const Vec3& org, const Vec3& dir, float tnear, float tfar) const;
+  bool occluded(const Vec3& org, const Vec3& dir, float tnear, float tfar, bool ray_checked = false) const;
 
   const std::vector<Vec3>& vertices() const { return vertices_; }
   const std::vector<Triangle>& triangles() const { return triangles_; }
@@ -47,7 +50,8 @@ class Mesh {
   void finish(Bvh bvh, const std::vector<uint32_t>& valid);
 
   template <bool AnyHit>
-  bool trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim) const;
+  bool trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim,
+             bool ray_checked) const;
 
   std::vector<Vec3> vertices_;
   std::vector<Triangle> triangles_;

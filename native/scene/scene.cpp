@@ -387,9 +387,9 @@ bool Scene::trace(const Ray& ray, Hit& hit, uint64_t blockers, uint8_t seen_by) 
       dir = glm::mat3(inst.to_object) * dir;
     }
     if constexpr (AnyHit) {
-      return mesh.occluded(org, dir, ray.tnear, t_max);
+      return mesh.occluded(org, dir, ray.tnear, t_max, inst.identity);
     } else {
-      if (!mesh.intersect(org, dir, ray.tnear, t_max, hit.u, hit.v, hit.prim)) return false;
+      if (!mesh.intersect(org, dir, ray.tnear, t_max, hit.u, hit.v, hit.prim, inst.identity)) return false;
       hit.instance = int32_t(id);
       return true;
     }
