@@ -166,8 +166,8 @@ void PyScene::set_environment(int64_t texture, py::handle strength, py::handle m
   // A (3, 3) rotation/scale, or a (4, 4) matrix whose upper-left 3x3 is used; None: identity.
   glm::mat3 m(1.0f);
   if (!matrix.is_none()) {
-    const py::array_t<double> a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(matrix);
-    if (!a || a.ndim() != 2 || a.shape(0) != a.shape(1) || (a.shape(0) != 3 && a.shape(0) != 4))
+    const auto a = contiguous<double>(matrix, "matrix");
+    if (a.ndim() != 2 || a.shape(0) != a.shape(1) || (a.shape(0) != 3 && a.shape(0) != 4))
       throw py::value_error("matrix must be None, a (3, 3) or a (4, 4) array");
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) m[c][r] = float(a.at(r, c));  // row-major in, GLM columns
@@ -268,8 +268,8 @@ AovRequest aov_request(py::handle passes, py::handle mist, py::handle object_ind
   }
   auto table = [](py::handle obj) {
     if (obj.is_none()) return std::vector<float>();
-    const FloatArray a = FloatArray::ensure(obj);
-    if (!a || a.ndim() != 1) throw py::value_error("render: a pass-index table must be a 1-D array of numbers");
+    const FloatArray a = contiguous<float>(obj, "render: a pass-index table");
+    if (a.ndim() != 1) throw py::value_error("render: a pass-index table must be a 1-D array of numbers");
     return std::vector<float>(a.data(), a.data() + a.size());
   };
   r.object_index = table(object_index);

@@ -25,9 +25,8 @@ struct LampChoice {
 
 // The radiance of the lights a camera, glossy or transmission ray (`ray`, one RayVisibility bit)
 // passes before distance `limit` (in units of the unit direction), of those visible to that kind
-// of ray. Lights are not
-// surfaces: as in Cycles, a ray that sees one goes on, so what is behind a light (another light,
-// a surface, the world) adds to it. A light at infinity (a sun, at FLT_MAX) is part of the world:
+// of ray. Lights are not surfaces: as in Cycles, a ray that sees one goes on, so what is behind a
+// light (another light, a surface, the world) adds to it. A light at infinity (a sun, at FLT_MAX) is part of the world:
 // seen by a ray that leaves the scene (`escaped`), whatever the camera's clip end. bsdf_pdf > 0:
 // the ray was drawn by a glossy or rough dielectric lobe with that density, and each lamp takes
 // its power-heuristic weight against the lamp sample that vertex took (of the lamp `choice`

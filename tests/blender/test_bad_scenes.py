@@ -226,17 +226,22 @@ def test_unsupported_nodes():
     check(px is not None and np.isfinite(px).all() and px[..., 1].mean() > 0, "and the image is lit")
 
 
+def box_stage(box_material, floor_material=None):
+    """A box of the material under test on a floor, a point lamp above, a grey world, the camera."""
+    kit.plane("floor", 20.0, floor_material or kit.diffuse("grey"))
+    kit.box("box", 1.5, (0.5, 0.3, 0.75), material=box_material)
+    kit.point_light("lamp", (0, 0, 4), 300.0, radius=0.3)
+    kit.world((0.2, 0.2, 0.2))
+    camera()
+
+
 def test_glossy_and_metal():
     clear_scene()
     # A Glossy BSDF in Multiscatter GGX (4.x/5.x's default; 3.x's random walk is approximated by
     # single scattering) and a Principled metal whose base colour is NaN: both render, finite, with
     # one note naming what was approximated.
-    kit.plane("floor", 20.0, kit.glossy("shiny", (0.9, 0.8, 0.6), 0.3, distribution="MULTI_GGX"))
     metal = kit.metal("nan_metal", (float("nan"), 0.5, 0.5), 0.4)
-    kit.box("box", 1.5, (0.5, 0.3, 0.75), material=metal)
-    kit.point_light("lamp", (0, 0, 4), 300.0, radius=0.3)
-    kit.world((0.2, 0.2, 0.2))
-    camera()
+    box_stage(metal, kit.glossy("shiny", (0.9, 0.8, 0.6), 0.3, distribution="MULTI_GGX"))
     result, px, log = render("glossy")
     warned = warnings_in(log)
     old = bpy.app.version < (4, 0, 0)
@@ -259,12 +264,8 @@ def test_bad_glass():
     rnode.distribution = "GGX"
     rnode.inputs["Roughness"].default_value = 0.4
     rnode.inputs["IOR"].default_value = 1.0
-    kit.plane("floor", 20.0, kit.diffuse("grey"))
-    kit.box("box", 1.5, (0.5, 0.3, 0.75), material=glass)
+    box_stage(glass)
     kit.box("box2", 1.0, (-2.0, -1.0, 1.0), material=refraction)
-    kit.point_light("lamp", (0, 0, 4), 300.0, radius=0.3)
-    kit.world((0.2, 0.2, 0.2))
-    camera()
     result, px, log = render("glass")
     warned = warnings_in(log)
     w = warned[0] if warned else ""
@@ -283,11 +284,7 @@ def test_principled_ior_zero():
     bsdf = next(n for n in mat.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
     bsdf.inputs["IOR"].default_value = 0.0
     kit.input_of(bsdf, "Transmission Weight", "Transmission").default_value = 0.5   # 4.0+ / 3.x
-    kit.plane("floor", 20.0, kit.diffuse("grey"))
-    kit.box("box", 1.5, (0.5, 0.3, 0.75), material=mat)
-    kit.point_light("lamp", (0, 0, 4), 300.0, radius=0.3)
-    kit.world((0.2, 0.2, 0.2))
-    camera()
+    box_stage(mat)
     result, px, log = render("principled_ior_zero")
     warned = warnings_in(log)
     w = warned[0] if warned else ""

@@ -380,6 +380,23 @@ def test_rays_too_many_for_memory_are_a_memory_error():
     assert s.intersect(np.float32([[0.2, 0.2, 1]]), np.float32([[0, 0, -1]]))["t"][0] == 1.0
 
 
+def test_a_pass_index_table_too_large_for_memory_is_a_memory_error():
+    # float64 needs a float32 copy: 400 GB. Refused naming the table; the scene still renders.
+    s = committed()
+    huge = np.broadcast_to(np.float64(1), (10**11,))
+    refused(lambda: s.render(camera(), samples=1, object_index=huge), MemoryError, "pass-index table: no memory")
+    refused(lambda: s.render(camera(), samples=1, object_index="abc"), TypeError, "array of numbers")
+    assert np.isfinite(s.render(camera(), samples=1)).all()
+
+
+def test_an_environment_matrix_of_no_numbers_is_a_type_error():
+    s = toyrt.Scene()
+    tid = s.add_texture(np.full((2, 4, 3), 0.5, np.float32), srgb=False)
+    words = [["a", "b", "c"]] * 3
+    refused(lambda: s.set_environment(tid, matrix=words), TypeError, "matrix must be an array of numbers")
+    s.set_environment(tid, matrix=np.eye(3))
+
+
 def test_texture_with_nan_texels_is_refused():
     px = np.zeros((2, 2, 4), np.float32)
     px[1, 1, 2] = np.nan
