@@ -97,15 +97,16 @@ template <bool AnyHit, class LeafFn>
       const vfloat tnx = (load(n.bounds[ray.near[0]]) - ox) * ix, tfx = (load(n.bounds[ray.far[0]]) - ox) * ix;
       const vfloat tny = (load(n.bounds[ray.near[1]]) - oy) * iy, tfy = (load(n.bounds[ray.far[1]]) - oy) * iy;
       const vfloat tnz = (load(n.bounds[ray.near[2]]) - oz) * iz, tfz = (load(n.bounds[ray.far[2]]) - oz) * iz;
+      // tfar joins the exits before the widening: a box entered just beyond tfar (within the
+      // widening) is visited for nothing, rarely, and one broadcast and one min a visit are saved.
       vfloat tmin = max_keep(max_keep(max_keep(start, tnx), tny), tnz);
-      vfloat tmax = min_keep(min_keep(min_keep(splat(kInfinity), tfx), tfy), tfz);
+      vfloat tmax = min_keep(min_keep(min_keep(splat(tfar), tfx), tfy), tfz);
       if (negative_start) {  // rare (rays reaching back before their origin): the general form
         tmin = tmin < 0.0f ? tmin * widen : tmin;
         tmax = tmax * (tmax < 0.0f ? shrink : widen);
       } else {  // tmin >= 0, so a negative exit is a miss however it is scaled: Ize's form
         tmax = tmax * widen;
       }
-      tmax = min_keep(tmax, splat(tfar));
       uint32_t mask = mask_of(tmin <= tmax);
       if (mask != 0 && AnyHit) {
         // Any hit ends the walk: no distance sort, the children hit in slot order, which
