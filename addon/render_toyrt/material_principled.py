@@ -113,16 +113,22 @@ def _clearcoat(name, node, notes) -> dict:
 def _transmission(name, node, notes) -> dict:
     """Transmission (3.x) / Transmission Weight (4.0+) as the 'principled' kind's transmission
     arguments ({} for none): the weight and the IOR socket's value (3.x's Specular sets the layer's
-    IOR, not the glass's). 3.x's Transmission Roughness, which roughens the refraction alone, is
-    the Roughness (noted)."""
+    IOR, not the glass's). 3.x's Transmission Roughness roughens the refraction alone, as Cycles
+    3.x combines it with the Roughness: 1 - (1 - Roughness)(1 - Transmission Roughness) with the
+    GGX distribution; Multiscatter GGX's glass is one closure of the Roughness, so it is unused."""
     trans = input_socket(node, "Transmission Weight", "Transmission")
     weight = _constant(name, trans, "Transmission", 0.0, notes, 0.0, 1.0)
     if weight <= 0.0:
         return {}
+    glass = dict(transmission=weight, transmission_ior=ior_value(name, node, notes))
     extra = input_socket(node, "Transmission Roughness")   # 3.x only
-    if extra is not None and (extra.is_linked or extra.default_value > 0.0):
-        notes.append(f"material '{name}': Principled Transmission Roughness (the Roughness)")
-    return dict(transmission=weight, transmission_ior=ior_value(name, node, notes))
+    if extra is not None and getattr(node, "distribution", "GGX") == "GGX":
+        amount = _constant(name, extra, "Transmission Roughness", 0.0, notes, 0.0, 1.0)
+        if amount > 0.0:
+            # The Roughness's own notes (linked, NaN, clamped) are the layer's (_specular_layer).
+            rough = _constant(name, input_socket(node, "Roughness"), "roughness", 0.5, [], 0.0, 1.0)
+            glass["refraction_roughness"] = 1.0 - (1.0 - rough) * (1.0 - amount)
+    return glass
 
 
 # The luminance Cycles 3.x's Principled specular divides the base colour by for its Specular Tint:

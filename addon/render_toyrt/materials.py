@@ -60,6 +60,7 @@ class MaterialSpec:
     burley: bool = False                                     # 'principled': 3.x's Burley diffuse base
     transmission: float = 0.0                                # 'principled': the glass's weight
     transmission_ior: float = 1.45                           # 'principled': the glass's IOR
+    refraction_roughness: float = -1.0                       # 'principled', 3.x: its refraction's (< 0: roughness)
     metallic: float = 0.0                                    # 'principled': Metallic (1: a metal of the base colour)
     coat_weight: float = 0.0                                 # 'principled', 4.0+: the coat (0: none)
     coat_roughness: float = 0.03
@@ -120,6 +121,8 @@ class MaterialSpec:
             args.update(specular_ior_level=self.specular_ior_level, specular_tint=self.specular_tint,
                         layered=self.layered, metallic=self.metallic, burley=self.burley,
                         transmission=self.transmission, transmission_ior=self.transmission_ior)
+            if self.refraction_roughness >= 0.0:
+                args.update(refraction_roughness=self.refraction_roughness)
             if self.coat_weight > 0.0:
                 args.update(coat_weight=self.coat_weight, coat_roughness=self.coat_roughness, coat_ior=self.coat_ior,
                             coat_tint=self.coat_tint)

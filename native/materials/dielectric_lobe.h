@@ -21,7 +21,9 @@
 //   Refraction  0 and 1 (Blender's Refraction BSDF: transmission only, no Fresnel term)
 //   Glass       F(wo.h) and 1 - F(wo.h), the Fresnel term on the microfacet (Cycles 4.0+)
 //   Glass3x     F(cos_o) and 1 - F(cos_o), the Fresnel term of the shading normal weighting two
-//               lobes without one (Cycles 3.x's Glass BSDF closures)
+//               lobes without one (Cycles 3.x's Glass BSDF closures). As two closures, each side
+//               may have its own roughness (3.x Principled's Transmission Roughness): the
+//               transmission's alpha is `alpha_transmit` when that is set.
 // A microfacet normal that cannot refract (total internal reflection) gives no transmission: for
 // Glass its F is 1 and the sampler reflects; Refraction and Glass3x lose that energy, as Cycles.
 #pragma once
@@ -49,6 +51,9 @@ struct DielectricLobe {
   Vec3 tint{1.0f};           // reflection
   Vec3 transmit_tint{1.0f};  // transmission
   float alpha = 0.1f;
+  // Glass3x only: the transmission's own alpha (0: alpha). The other kinds choose the side by the
+  // Fresnel term of the sampled microfacet, so both sides must share one distribution.
+  float alpha_transmit = 0.0f;
   MicrofacetDistribution distribution = MicrofacetDistribution::Ggx;
   float eta = 1.45f;  // n_far / n_near, != 1
   GgxShadowing shadowing = GgxShadowing::Separable;
@@ -58,6 +63,10 @@ struct DielectricLobe {
 
 namespace dielectric_detail {
 
+inline float transmission_alpha(const DielectricLobe& lobe) {
+  return lobe.alpha_transmit > 0.0f ? lobe.alpha_transmit : lobe.alpha;
+}
+
 // The reflection weight W_r for microfacet normal h (W_t = 1 - W_r).
 inline float reflect_weight(const DielectricLobe& lobe, float cos_oh) {
   if (lobe.kind == DielectricKind::Refraction) return 0.0f;
@@ -65,21 +74,22 @@ inline float reflect_weight(const DielectricLobe& lobe, float cos_oh) {
   return fresnel_dielectric(cos_oh, lobe.eta);
 }
 
-inline float normal_density(const DielectricLobe& lobe, const Vec3& m) {
-  return lobe.distribution == MicrofacetDistribution::Ggx ? ggx_d(lobe.alpha, m) : beckmann_d(lobe.alpha, m);
+// The helpers below take the side's alpha: lobe.alpha, or transmission_alpha(lobe).
+inline float normal_density(const DielectricLobe& lobe, float alpha, const Vec3& m) {
+  return lobe.distribution == MicrofacetDistribution::Ggx ? ggx_d(alpha, m) : beckmann_d(alpha, m);
 }
 
 // G2 / (cos_o |cos_i|), wi_up: wi turned to wo's side. GGX through the roots of ggx.h (finite
 // down to the horizon).
-inline float g2_over_cos(const DielectricLobe& lobe, const Vec3& wi_up) {
+inline float g2_over_cos(const DielectricLobe& lobe, float alpha, const Vec3& wi_up) {
   const Vec3& wo = lobe.wo;
   if (lobe.distribution == MicrofacetDistribution::Beckmann) {
-    const float lo = beckmann_lambda(lobe.alpha, wo), li = beckmann_lambda(lobe.alpha, wi_up);
+    const float lo = beckmann_lambda(alpha, wo), li = beckmann_lambda(alpha, wi_up);
     const float g2 =
         lobe.shadowing == GgxShadowing::Separable ? 1.0f / ((1.0f + lo) * (1.0f + li)) : 1.0f / (1.0f + lo + li);
     return g2 / (wo.z * wi_up.z);
   }
-  const float ro = ggx_root(lobe.alpha, wo), ri = ggx_root(lobe.alpha, wi_up);
+  const float ro = ggx_root(alpha, wo), ri = ggx_root(alpha, wi_up);
   return lobe.shadowing == GgxShadowing::Separable ? 4.0f / ((wo.z + ro) * (wi_up.z + ri))
                                                    : 2.0f / (wi_up.z * ro + wo.z * ri);
 }
@@ -87,24 +97,25 @@ inline float g2_over_cos(const DielectricLobe& lobe, const Vec3& wi_up) {
 // The density of the sampled microfacet normal h: GGX's visible normals, G1(wo) (wo.h) D(h) /
 // cos_o = 2 (wo.h) D / (cos_o + root_o); Beckmann's D(h) h.z (its visible normals have no closed
 // form; normals facing away from wo are drawn and give no sample).
-inline float normal_pdf(const DielectricLobe& lobe, const Vec3& h, float cos_oh) {
-  if (lobe.distribution == MicrofacetDistribution::Beckmann) return beckmann_d(lobe.alpha, h) * h.z;
-  return 2.0f * cos_oh * ggx_d(lobe.alpha, h) / (lobe.wo.z + ggx_root(lobe.alpha, lobe.wo));
+inline float normal_pdf(const DielectricLobe& lobe, float alpha, const Vec3& h, float cos_oh) {
+  if (lobe.distribution == MicrofacetDistribution::Beckmann) return beckmann_d(alpha, h) * h.z;
+  return 2.0f * cos_oh * ggx_d(alpha, h) / (lobe.wo.z + ggx_root(alpha, lobe.wo));
 }
 
 // The sampler's weight f |cos_i| / pdf = D G2 (wo.m) / (cos_o pdf_m): for GGX G2 / G1(wo), in
 // [0, 1] (as ggx_reflection_sample's); for Beckmann G2 (wo.m) / (cos_o m.z).
-inline float sample_weight(const DielectricLobe& lobe, const Vec3& m, float cos_om, const Vec3& wi_up) {
+inline float sample_weight(const DielectricLobe& lobe, float alpha, const Vec3& m, float cos_om, const Vec3& wi_up) {
   const Vec3& wo = lobe.wo;
-  if (lobe.distribution == MicrofacetDistribution::Beckmann) return g2_over_cos(lobe, wi_up) * wi_up.z * cos_om / m.z;
-  const float ro = ggx_root(lobe.alpha, wo), ri = ggx_root(lobe.alpha, wi_up);
+  if (lobe.distribution == MicrofacetDistribution::Beckmann)
+    return g2_over_cos(lobe, alpha, wi_up) * wi_up.z * cos_om / m.z;
+  const float ro = ggx_root(alpha, wo), ri = ggx_root(alpha, wi_up);
   return lobe.shadowing == GgxShadowing::Separable ? 2.0f * wi_up.z / (wi_up.z + ri)
                                                    : wi_up.z * (wo.z + ro) / (wi_up.z * ro + wo.z * ri);
 }
 
-inline Vec3 sample_normal(const DielectricLobe& lobe, const Vec2& u) {
-  return lobe.distribution == MicrofacetDistribution::Ggx ? ggx_sample_visible_normal(lobe.alpha, lobe.wo, u)
-                                                          : beckmann_sample_normal(lobe.alpha, u);
+inline Vec3 sample_normal(const DielectricLobe& lobe, float alpha, const Vec2& u) {
+  return lobe.distribution == MicrofacetDistribution::Ggx ? ggx_sample_visible_normal(alpha, lobe.wo, u)
+                                                          : beckmann_sample_normal(alpha, u);
 }
 
 }  // namespace dielectric_detail
@@ -119,8 +130,8 @@ inline BsdfEval dielectric_eval_local(const DielectricLobe& lobe, const Vec3& wi
     const float cos_oh = glm::dot(wo, h);
     const float w = reflect_weight(lobe, cos_oh);
     if (!(w > 0.0f)) return {};
-    const float f = 0.25f * normal_density(lobe, h) * g2_over_cos(lobe, wi);
-    const float pdf = normal_pdf(lobe, h, cos_oh) / (4.0f * cos_oh);
+    const float f = 0.25f * normal_density(lobe, lobe.alpha, h) * g2_over_cos(lobe, lobe.alpha, wi);
+    const float pdf = normal_pdf(lobe, lobe.alpha, h, cos_oh) / (4.0f * cos_oh);
     if (!std::isfinite(f) || !std::isfinite(pdf)) return {};
     return {lobe.tint * (w * f), w * pdf};
   }
@@ -135,10 +146,11 @@ inline BsdfEval dielectric_eval_local(const DielectricLobe& lobe, const Vec3& wi
   if (!(w > 0.0f)) return {};
   const float denom = cos_oh + lobe.eta * cos_ih;
   const float jacobian = lobe.eta * lobe.eta * -cos_ih / (denom * denom);  // d omega_h / d omega_i
-  const float d = normal_density(lobe, h);
+  const float alpha = transmission_alpha(lobe);
+  const float d = normal_density(lobe, alpha, h);
   const Vec3 wi_up(wi.x, wi.y, -wi.z);
-  const float f = d * g2_over_cos(lobe, wi_up) * cos_oh * jacobian;
-  const float pdf = normal_pdf(lobe, h, cos_oh) * jacobian;
+  const float f = d * g2_over_cos(lobe, alpha, wi_up) * cos_oh * jacobian;
+  const float pdf = normal_pdf(lobe, alpha, h, cos_oh) * jacobian;
   if (!std::isfinite(f) || !std::isfinite(pdf)) return {};
   return {lobe.transmit_tint * (w * f), w * pdf};
 }
@@ -155,16 +167,20 @@ inline BsdfSample dielectric_sample_local(const DielectricLobe& lobe, const Vec2
   const Vec3& wo = lobe.wo;
   BsdfSample s;
   if (!(wo.z >= kGgxMinCos)) return s;
-  const Vec3 m = sample_normal(lobe, u);
+  // Glass3x's side does not depend on the microfacet (the shading normal's Fresnel term), so it is
+  // known before the normal is drawn, from that side's distribution. The other kinds share one.
+  const bool transmit_side = lobe.kind == DielectricKind::Glass3x && !(u_side < lobe.fresnel_macro);
+  const float alpha = transmit_side ? transmission_alpha(lobe) : lobe.alpha;
+  const Vec3 m = sample_normal(lobe, alpha, u);
   const float cos_om = glm::dot(wo, m);
   if (!(cos_om > 0.0f)) return s;
   const float pr = reflect_weight(lobe, cos_om);
-  const float hpdf = normal_pdf(lobe, m, cos_om);
+  const float hpdf = normal_pdf(lobe, alpha, m, cos_om);
   if (u_side < pr) {
     s.wi = 2.0f * cos_om * m - wo;
     if (!(s.wi.z >= kGgxMinCos)) return s;
     s.pdf = pr * hpdf / (4.0f * cos_om);
-    s.weight = lobe.tint * sample_weight(lobe, m, cos_om, s.wi);
+    s.weight = lobe.tint * sample_weight(lobe, alpha, m, cos_om, s.wi);
   } else {
     // Snell at the microfacet: refract() takes n_near / n_far.
     const float eta_i = 1.0f / lobe.eta;
@@ -176,7 +192,7 @@ inline BsdfSample dielectric_sample_local(const DielectricLobe& lobe, const Vec2
     const float cos_im = glm::dot(s.wi, m);
     const float denom = cos_om + lobe.eta * cos_im;
     s.pdf = (1.0f - pr) * hpdf * lobe.eta * lobe.eta * -cos_im / (denom * denom);
-    s.weight = lobe.transmit_tint * sample_weight(lobe, m, cos_om, Vec3(s.wi.x, s.wi.y, -s.wi.z));
+    s.weight = lobe.transmit_tint * sample_weight(lobe, alpha, m, cos_om, Vec3(s.wi.x, s.wi.y, -s.wi.z));
   }
   if (!(s.pdf > 0.0f) || !std::isfinite(s.pdf) || !is_finite(s.weight)) s = BsdfSample{s.wi, Vec3(0.0f), 0.0f};
   return s;

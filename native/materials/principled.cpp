@@ -36,6 +36,14 @@ Principled Principled::from_params(const Params& params) {
     const DielectricRoughness rough{m.roughness, m.shadowing, MicrofacetDistribution::Ggx};
     m.glass = FresnelDielectric::make(glass_ior, rough, !m.layered, m.multiscatter && m.layered);
   }
+  if (params.has("refraction_roughness")) {
+    // 3.x's refraction closure has a roughness of its own (Transmission Roughness); 4.0+'s glass
+    // is one closure with one roughness.
+    if (m.layered) throw std::invalid_argument("principled: refraction_roughness needs layered False (Blender 3.x)");
+    const double r = params.number("refraction_roughness", 0.0);
+    if (!std::isfinite(r)) throw std::invalid_argument("principled: refraction_roughness must be finite");
+    m.glass.transmit_roughness = float(std::clamp(r, 0.0, 1.0));
+  }
   const float level = float(params.non_negative("specular_ior_level", 0.5));
   const Vec3 tint = params.color("specular_tint", Vec3(1.0f));
   // Specular IOR Level scales F0 (0.5: as the IOR gives it); the IOR with that F0 then shapes the

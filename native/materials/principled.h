@@ -25,7 +25,9 @@
 // specular_tint ((1, 1, 1), >= 0), multiscatter (True), layered (True; False: 3.x), shadowing
 // ('correlated', 4.0+; 'separable', 3.x), metallic (0, clamped to [0, 1]), burley (False; True:
 // 3.x's Burley diffuse base instead of Lambert), transmission (0, clamped to [0, 1]) and
-// transmission_ior (the ior): the share of a glass beside the opaque parts, below.
+// transmission_ior (the ior): the share of a glass beside the opaque parts, below; with layered
+// False, refraction_roughness (the roughness): its refraction's own roughness (3.x's Transmission
+// Roughness, combined with the Roughness by the add-on as Cycles 3.x combines them).
 //
 // Transmission (Cycles' order: the metal takes Metallic, the glass (1 - Metallic) Transmission,
 // the dielectric layer and base what is left): the glass is the Glass BSDF's rough dielectric of
@@ -66,8 +68,9 @@ struct Principled {
       "color, texture (the base colour), roughness (0.5), ior (1.45), specular_ior_level (0.5),\n"
       "specular_tint ((1, 1, 1)), multiscatter (True), layered (True; False: Blender 3.x's sum),\n"
       "shadowing ('correlated'; 'separable': 3.x), metallic (0), burley (False; True: 3.x's diffuse),\n"
-      "transmission (0), transmission_ior (the ior), coat_weight (0), coat_roughness (0.03), coat_ior (1.5),\n"
-      "coat_tint ((1, 1, 1); with layered False: 3.x's Clearcoat and its roughness): the Principled BSDF";
+      "transmission (0), transmission_ior (the ior), refraction_roughness (the roughness; 3.x), coat_weight (0),\n"
+      "coat_roughness (0.03), coat_ior (1.5), coat_tint ((1, 1, 1); with layered False: 3.x's Clearcoat and\n"
+      "its roughness): the Principled BSDF";
   Lambert base;
   float roughness = 0.5f;  // in [0, 1]
   bool multiscatter = true;

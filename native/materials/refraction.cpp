@@ -78,7 +78,7 @@ PerfectRefraction PerfectRefraction::make(float ior, DielectricRoughness rough, 
   return {checked_ior(ior), checked_roughness(rough), color};
 }
 FresnelDielectric FresnelDielectric::make(float ior, DielectricRoughness rough, bool macro_fresnel, bool multiscatter) {
-  FresnelDielectric m{checked_ior(ior), checked_roughness(rough), macro_fresnel, -1, Vec3(1.0f), Vec3(1.0f)};
+  FresnelDielectric m{checked_ior(ior), checked_roughness(rough), macro_fresnel, -1.0f, -1, Vec3(1.0f), Vec3(1.0f)};
   if (!multiscatter) return m;
   if (macro_fresnel || rough.distribution != MicrofacetDistribution::Ggx)
     throw std::invalid_argument("glass: multiscatter needs distribution 'ggx' and fresnel 'microfacet'");
@@ -101,15 +101,18 @@ FresnelDielectric FresnelDielectric::from_params(const Params& params) {
 }
 
 bool rough_dielectric(const ShadingPoint& s, float ior, const DielectricRoughness& rough, DielectricKind kind,
-                      DielectricLobe* lobe) {
+                      DielectricLobe* lobe, float transmit_roughness) {
   const float alpha = ggx_alpha(rough.roughness);
-  if (alpha < kDielectricMinAlpha || std::abs(ior - 1.0f) < 1e-4f) return false;
+  const bool own_transmission = transmit_roughness >= 0.0f;
+  const float alpha_transmit = own_transmission ? ggx_alpha(transmit_roughness) : alpha;
+  if (std::max(alpha, alpha_transmit) < kDielectricMinAlpha || std::abs(ior - 1.0f) < 1e-4f) return false;
   // The frame as a glossy lobe's (on wo's side, the geometric normal where wo is below the
   // shading normal's tangent plane); which side wo is on decides eta.
   const GlossyLobe g = oriented_lobe(s, rough.roughness, rough.shadowing);
   lobe->frame = g.frame;
   lobe->wo = g.wo;
-  lobe->alpha = alpha;
+  lobe->alpha = std::max(alpha, kDielectricMinAlpha);
+  lobe->alpha_transmit = own_transmission ? std::max(alpha_transmit, kDielectricMinAlpha) : 0.0f;
   lobe->distribution = rough.distribution;
   lobe->shadowing = rough.shadowing;
   lobe->eta = glm::dot(s.wo, s.ng) > 0.0f ? ior : 1.0f / ior;
@@ -163,7 +166,8 @@ Scatter scatter(const PerfectRefraction& m, const ShadingPoint& s, const Materia
 
 Scatter scatter(const FresnelDielectric& m, const ShadingPoint& s, const MaterialContext& ctx) {
   DielectricLobe lobe;
-  if (rough_dielectric(s, m.ior, m.rough, m.macro_fresnel ? DielectricKind::Glass3x : DielectricKind::Glass, &lobe)) {
+  if (rough_dielectric(s, m.ior, m.rough, m.macro_fresnel ? DielectricKind::Glass3x : DielectricKind::Glass, &lobe,
+                       m.macro_fresnel ? m.transmit_roughness : -1.0f)) {
     const float scale = m.albedo >= 0 ? multiscatter_glass_scale(dielectric_albedo_table(m.albedo),
                                                                  glm::dot(s.wo, s.ng) > 0.0f, lobe.wo.z)
                                       : 1.0f;

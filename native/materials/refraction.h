@@ -70,6 +70,10 @@ struct FresnelDielectric {
   float ior = 1.45f;
   DielectricRoughness rough;
   bool macro_fresnel = false;
+  // With macro_fresnel (3.x's two closures), the refraction's own roughness: 3.x Principled's
+  // Transmission Roughness combined with its Roughness as Cycles 3.x combines them (the add-on);
+  // < 0: the roughness. Not a parameter of the Glass BSDF, whose two closures share one.
+  float transmit_roughness = -1.0f;
   // Multiscatter GGX (materials/dielectric_albedo.h): the id of the lobe's albedo table over
   // cos_o, made by make() (shared_dielectric_albedo); -1: single scattering (or a sharp material).
   int32_t albedo = -1;
@@ -85,8 +89,11 @@ struct FresnelDielectric {
 
 // The rough lobe at a hit (frame and sides as refraction's: wo's side of the geometric normal
 // decides eta), or false when the material is specular there (kDielectricMinAlpha, ior ~ 1).
+// transmit_roughness (Glass3x only, >= 0): the transmission's own roughness. Then the material is
+// specular only where both are; a sharp reflection beside a rough refraction is the lobe of the
+// smallest rough alpha, kDielectricMinAlpha, which is within 0.06 degrees of the mirror.
 bool rough_dielectric(const ShadingPoint& s, float ior, const DielectricRoughness& rough, DielectricKind kind,
-                      DielectricLobe* lobe);
+                      DielectricLobe* lobe, float transmit_roughness = -1.0f);
 
 // Mirror of wo about n: 2 (wo . n) n - wo.
 inline Vec3 reflect(const Vec3& wo, const Vec3& n) { return 2.0f * glm::dot(wo, n) * n - wo; }

@@ -478,6 +478,29 @@ def scene_principled_glass(p):
 SCENES_SPEC.append(("principled_glass", scene_principled_glass, dict(roughness=0.3, base=(0.95, 0.8, 0.6),
                                                                      sample_factor=16), 8))
 
+# 3.x's Transmission Roughness (issue 14): Cycles 3.x's Principled glass is a reflection closure of
+# the Roughness and a refraction closure of 1 - (1 - Roughness)(1 - Transmission Roughness) (GGX;
+# Multiscatter GGX ignores it). A sharp reflection over a rough refraction (Roughness 0,
+# Transmission Roughness 0.5) and a rough pair (0.2, 0.6), Transmission 1, in principled_glass's
+# set. 3.x only: 4.0 removed the socket.
+def scene_principled_transmission_roughness(p):
+    kit.plane("floor", 6.0, checker("checker", 8, 0.15, 0.85), uv_repeat=4.0)
+    for i, (rough, extra, x) in enumerate(((0.0, 0.5, -0.8), (0.2, 0.6, 0.8))):
+        mat = kit.principled_dielectric(f"transmission_rough{i}", p["base"], rough)
+        bsdf = mat.node_tree.nodes["Principled BSDF"]
+        bsdf.inputs["Transmission"].default_value = 1.0
+        bsdf.inputs["Transmission Roughness"].default_value = extra
+        bsdf.inputs["IOR"].default_value = 1.45
+        kit.uv_sphere(f"ball{i}", 0.6, (x, 0.0, 0.65), mat)
+    kit.area_light("panel", (1.0, -1.0, 3.0), 200.0, 4.0, 3.0, target=(0, 0, 0))
+    camera((0.0, -5.0, 2.5), (0, 0, 0.4))
+    kit.world((0.05, 0.05, 0.05))
+
+
+SCENES_SPEC.append(("principled_transmission_roughness", scene_principled_transmission_roughness,
+                    dict(base=(0.95, 0.8, 0.6), before_version=(4, 0, 0), sample_factor=8), 8))
+
+
 # 4.0+'s Coat (issue 14): balls of a red Principled base under a sharp coat, a rough one and a
 # tinted one, and a coated gold metal, on the checker floor under an area lamp. Coat exists from
 # 4.0 (3.x's Clearcoat is another model, noted): not run on 3.4.

@@ -599,6 +599,35 @@ def test_principled_transmission():
     check(m.spec.metallic == 1.0 and m.spec.transmission == 0.0, f"Metallic 1 is the metal (no glass): {m}")
 
 
+def test_principled_transmission_roughness_3x():
+    """3.x's Transmission Roughness: with GGX the glass's refraction takes 1 - (1 - Roughness)(1 -
+    Transmission Roughness), as Cycles 3.x combines them (sent as refraction_roughness, nothing
+    noted); with Multiscatter GGX, whose glass is one closure of the Roughness, nothing is sent;
+    0 sends nothing. The socket is gone in 4.0+."""
+    if bpy.app.version >= (4, 0, 0):
+        return
+    _, _ = addon()
+    from render_toyrt import materials
+
+    mat = kit.principled_dielectric("rough_refraction", (0.9, 0.8, 0.7), 0.2)
+    node = mat.node_tree.nodes["Principled BSDF"]
+    node.inputs["Transmission"].default_value = 1.0
+    node.inputs["Transmission Roughness"].default_value = 0.6
+    c = materials.material_spec(mat)
+    combined = 1.0 - 0.8 * 0.4
+    check(abs(c.spec.refraction_roughness - combined) < 1e-6 and abs(c.spec.roughness - 0.2) < 1e-6
+          and abs(c.spec.arguments()["refraction_roughness"] - combined) < 1e-6 and not c.notes,
+          f"GGX: the refraction's roughness 1 - (1 - 0.2)(1 - 0.6) = {combined}: {c}")
+    node.distribution = "MULTI_GGX"
+    m = materials.material_spec(mat)
+    check(m.spec.refraction_roughness < 0.0 and "refraction_roughness" not in m.spec.arguments(),
+          f"Multiscatter GGX: one closure of the Roughness: {m}")
+    node.distribution = "GGX"
+    node.inputs["Transmission Roughness"].default_value = 0.0
+    z = materials.material_spec(mat)
+    check("refraction_roughness" not in z.spec.arguments(), f"Transmission Roughness 0 sends nothing: {z}")
+
+
 def test_glass_color():
     """The Glass and Refraction BSDFs' Color reaches the core's glass (every ray through or mirrored
     by it takes the colour, as in Cycles); a linked Color is noted and white; NaN channels are 0,
@@ -797,6 +826,6 @@ def test_command_line_range():
 PARTS = [test_counts_and_transforms, test_instancing_memory, test_missing_texture, test_emission_image,
          test_unsupported_node,
          test_mix_shader, test_mix_of_diffuse_and_glossy_keeps_the_glossy_model, test_principled_specular_layer,
-         test_principled_transmission, test_glass_color,
+         test_principled_transmission, test_principled_transmission_roughness_3x, test_glass_color,
          test_rough_glass_and_refraction, test_cancel, test_animation, test_command_line_range]
 run_script(PARTS, "export", TMP)

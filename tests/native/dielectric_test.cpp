@@ -133,41 +133,86 @@ TEST(Dielectric, PdfIntegratesToTheSamplersMassAndItsHistogramMatches) {
   for (MicrofacetDistribution dist : kDistributions) {
     for (DielectricKind kind : kKinds) {
       for (float alpha : {0.2f, 0.6f}) {
-        for (float eta : {1.5f, 1.0f / 1.5f}) {
-          const DielectricLobe lobe = lobe_at(kind, alpha, eta, 0.8, GgxShadowing::Separable, dist);
-          // Bins: theta in [0, pi] (both hemispheres), phi; the last bin: no sample.
-          std::vector<double> expected(2 * kTheta * kPhi + 1, 0.0);
-          const double dt = M_PI / (2 * kTheta * kSub), dp = 2.0 * M_PI / (kPhi * kSub);
-          double mass = 0.0;
-          for (int i = 0; i < 2 * kTheta * kSub; ++i) {
-            const double theta = (i + 0.5) * dt;
-            for (int j = 0; j < kPhi * kSub; ++j) {
-              const double p =
-                  dielectric_eval_local(lobe, direction(theta, (j + 0.5) * dp)).pdf * std::sin(theta) * dt * dp;
-              expected[size_t((i / kSub) * kPhi + j / kSub)] += p * kSamples;
-              mass += p;
+        for (float alpha_transmit : {0.0f, 0.75f}) {  // Glass3x: the refraction's own roughness
+          if (alpha_transmit > 0.0f && kind != DielectricKind::Glass3x) continue;
+          for (float eta : {1.5f, 1.0f / 1.5f}) {
+            DielectricLobe lobe = lobe_at(kind, alpha, eta, 0.8, GgxShadowing::Separable, dist);
+            lobe.alpha_transmit = alpha_transmit;
+            // Bins: theta in [0, pi] (both hemispheres), phi; the last bin: no sample.
+            std::vector<double> expected(2 * kTheta * kPhi + 1, 0.0);
+            const double dt = M_PI / (2 * kTheta * kSub), dp = 2.0 * M_PI / (kPhi * kSub);
+            double mass = 0.0;
+            for (int i = 0; i < 2 * kTheta * kSub; ++i) {
+              const double theta = (i + 0.5) * dt;
+              for (int j = 0; j < kPhi * kSub; ++j) {
+                const double p =
+                    dielectric_eval_local(lobe, direction(theta, (j + 0.5) * dp)).pdf * std::sin(theta) * dt * dp;
+                expected[size_t((i / kSub) * kPhi + j / kSub)] += p * kSamples;
+                mass += p;
+              }
             }
-          }
-          std::vector<double> counts(expected.size(), 0.0);
-          for (int k = 0; k < kSamples; ++k) {
-            const BsdfSample s = dielectric_sample_local(lobe, Vec2(uniform(rng), uniform(rng)), uniform(rng));
-            if (!(s.pdf > 0.0f)) {
-              counts.back() += 1.0;
-              continue;
+            std::vector<double> counts(expected.size(), 0.0);
+            for (int k = 0; k < kSamples; ++k) {
+              const BsdfSample s = dielectric_sample_local(lobe, Vec2(uniform(rng), uniform(rng)), uniform(rng));
+              if (!(s.pdf > 0.0f)) {
+                counts.back() += 1.0;
+                continue;
+              }
+              const double theta = std::acos(std::clamp(double(s.wi.z), -1.0, 1.0));
+              double phi = std::atan2(double(s.wi.y), double(s.wi.x));
+              if (phi < 0.0) phi += 2.0 * M_PI;
+              const int i = std::min(2 * kTheta - 1, int(theta / M_PI * 2 * kTheta));
+              const int j = std::min(kPhi - 1, int(phi / (2.0 * M_PI) * kPhi));
+              counts[size_t(i * kPhi + j)] += 1.0;
             }
-            const double theta = std::acos(std::clamp(double(s.wi.z), -1.0, 1.0));
-            double phi = std::atan2(double(s.wi.y), double(s.wi.x));
-            if (phi < 0.0) phi += 2.0 * M_PI;
-            const int i = std::min(2 * kTheta - 1, int(theta / M_PI * 2 * kTheta));
-            const int j = std::min(kPhi - 1, int(phi / (2.0 * M_PI) * kPhi));
-            counts[size_t(i * kPhi + j)] += 1.0;
+            const double sampled_mass = 1.0 - counts.back() / kSamples;
+            EXPECT_NEAR(mass, sampled_mass, 5e-3) << "kind " << int(kind) << " alpha " << alpha << " eta " << eta;
+            expected.back() = std::max(0.0, 1.0 - mass) * kSamples;
+            const PooledChiSquare t = pooled_chi_square(counts, expected);
+            EXPECT_LT(t.chi2, chi_square_quantile(t.bins - 1, 1e-4))
+                << "distribution " << int(dist) << " kind " << int(kind) << " alpha " << alpha << " alpha_transmit "
+                << alpha_transmit << " eta " << eta;
           }
-          const double sampled_mass = 1.0 - counts.back() / kSamples;
-          EXPECT_NEAR(mass, sampled_mass, 5e-3) << "kind " << int(kind) << " alpha " << alpha << " eta " << eta;
-          expected.back() = std::max(0.0, 1.0 - mass) * kSamples;
-          const PooledChiSquare t = pooled_chi_square(counts, expected);
-          EXPECT_LT(t.chi2, chi_square_quantile(t.bins - 1, 1e-4))
-              << "distribution " << int(dist) << " kind " << int(kind) << " alpha " << alpha << " eta " << eta;
+        }
+      }
+    }
+  }
+}
+
+TEST(Dielectric, Glass3xTransmissionRoughnessRoughensTheRefractionAlone) {
+  // Cycles 3.x's Principled glass is two closures: a reflection of the Roughness and a refraction
+  // of its own (Transmission Roughness). Above the surface the lobe is the reflection lobe of
+  // alpha, below it the lobe of alpha_transmit, value and pdf; and its sampler still returns what
+  // a quadrature of the value gives.
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (MicrofacetDistribution dist : kDistributions) {
+    for (float alpha : {0.001f, 0.09f}) {
+      for (float alpha_transmit : {0.16f, 0.81f}) {
+        for (float eta : {1.45f, 1.0f / 1.45f}) {
+          for (double theta_o : {0.3, 1.1}) {
+            DielectricLobe both = lobe_at(DielectricKind::Glass3x, alpha, eta, theta_o, GgxShadowing::Separable, dist);
+            both.alpha_transmit = alpha_transmit;
+            const DielectricLobe reflection =
+                lobe_at(DielectricKind::Glass3x, alpha, eta, theta_o, GgxShadowing::Separable, dist);
+            const DielectricLobe refraction =
+                lobe_at(DielectricKind::Glass3x, alpha_transmit, eta, theta_o, GgxShadowing::Separable, dist);
+            for (int k = 0; k < 500; ++k) {
+              const Vec3 wi = direction(M_PI * u(rng), 2.0 * M_PI * u(rng));
+              const BsdfEval e = dielectric_eval_local(both, wi);
+              const BsdfEval side = dielectric_eval_local(wi.z > 0.0f ? reflection : refraction, wi);
+              EXPECT_EQ(e.f.x, side.f.x);
+              EXPECT_EQ(e.pdf, side.pdf);
+            }
+            if (alpha < 0.01f) continue;  // a near-mirror reflection: beyond the quadrature's grid
+            const double quad = sphere_integral(
+                [&](const Vec3& wi) { return double(dielectric_eval_local(both, wi).f.x) * std::abs(wi.z); }, 1536,
+                384);
+            const SamplerMean m = sampler_mean(both, 200000, 13);
+            EXPECT_NEAR(quad, m.weight, 4.0 * m.stderr_weight + 3e-3)
+                << "distribution " << int(dist) << " alpha " << alpha << " alpha_transmit " << alpha_transmit << " eta "
+                << eta << " theta_o " << theta_o;
+          }
         }
       }
     }

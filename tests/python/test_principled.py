@@ -135,6 +135,22 @@ def test_principled_transmission_one_renders_the_glass_bsdf(version):
     np.testing.assert_array_equal(principled, glass)
 
 
+def test_3x_refraction_roughness_roughens_the_refraction_alone():
+    # 3.x's glass is a reflection closure of the Roughness and a refraction closure of its own
+    # (Transmission Roughness, combined by the add-on). Equal to the roughness: the same image, bit
+    # for bit; rougher: another image; with 4.0+'s one glass closure (layered True): refused.
+    args = dict(color=(1.0, 1.0, 1.0), ior=1.8, transmission=1.0, transmission_ior=1.45, roughness=0.3,
+                layered=False, burley=True, multiscatter=False, shadowing="separable")
+    plain = sphere_scene("principled", **args)
+    same = sphere_scene("principled", refraction_roughness=0.3, **args)
+    rougher = sphere_scene("principled", refraction_roughness=0.8, **args)
+    np.testing.assert_array_equal(same, plain)
+    assert np.abs(rougher - plain).max() > 0.05
+    assert np.isfinite(sphere_scene("principled", **{**args, "roughness": 0.0}, refraction_roughness=0.5)).all()
+    with pytest.raises(ValueError, match="refraction_roughness needs layered False"):
+        toyrt.Scene().add_material("principled", refraction_roughness=0.5)
+
+
 # ---- 4.0+'s coat ------------------------------------------------------------------------------
 
 def test_coat_head_on_is_its_lobe_plus_the_base_it_leaves():
