@@ -193,7 +193,20 @@ Scatter opaque_scatter(const Principled& m, const ShadingPoint& s, const Materia
     // the base weighted 1 - Metallic.
     if (m.eta == 1.0f && m.metallic == 0.0f) return burley_base(m, s, Scatter::diffuse(scale * lambert_f(albedo)));
     const Vec3 f0 = glm::mix(m.f0, glm::clamp(albedo, Vec3(0.0f), Vec3(1.0f)), m.metallic);
-    return burley_base(m, s, lobe_over(dielectric_layer(m, s, f0).lobe, scale * dielectric * lambert_f(albedo)));
+    Scatter sc = burley_base(m, s, lobe_over(dielectric_layer(m, s, f0).lobe, scale * dielectric * lambert_f(albedo)));
+    // The plain two-closure case (u < 0: neither glass nor clearcoat drew first): Cycles 3.x's
+    // sample weights (render/closure_pick.h), the specular closure's average Fresnel colour at
+    // the view, F0's colour blended to white by the IOR's normalised curve (as Cycles 3.x's
+    // interpolate_fresnel_color), against the diffuse closure's average colour, (1 - Metallic) x
+    // the base colour.
+    const float diffuse_weight = dielectric * (albedo.x + albedo.y + albedo.z) / 3.0f;
+    if (u < 0.0f && diffuse_weight > 0.0f) {
+      const float curve = (fresnel_dielectric(sc.glossy.wo.z, m.eta) - m.eta_f0) / (1.0f - m.eta_f0);
+      const Vec3 reflect = glm::mix(f0, Vec3(1.0f), std::clamp(curve, 0.0f, 1.0f));
+      const float layer_weight = (reflect.x + reflect.y + reflect.z) / 3.0f;
+      if (layer_weight > 0.0f) sc.glossy_pick = layer_weight / (layer_weight + diffuse_weight);
+    }
+    return sc;
   }
   // 4.0+: Metallic mixes a metal with the dielectric layer over its base. The base is always
   // there; of the two lobes one is drawn with probability its weight (its value then counts

@@ -449,8 +449,10 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             radiance += throughput * g.radiance;
             if (!(g.pdf > 0.0f)) return false;
             if (sc.glossy_pick > 0.0f) {
+              // 3.x's base is Burley's diffuse: its value along the lobe's direction.
+              const Vec3 f_diffuse = sc.burley ? sc.f * burley_factor(sc.retro, g.wi) : sc.f;
               picked_throughput =
-                  throughput * closure_pick_weight(g.weight, g.pdf, sc.f, glm::dot(ns, g.wi), sc.glossy_pick);
+                  throughput * closure_pick_weight(g.weight, g.pdf, f_diffuse, glm::dot(ns, g.wi), sc.glossy_pick);
               picked = true;
             }
             throughput *= g.weight;

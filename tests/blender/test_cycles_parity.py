@@ -595,8 +595,7 @@ def scene_principled_closure_pick(p):
     kit.world((0.05, 0.05, 0.05))
 
 
-SCENES_SPEC.append(("principled_closure_pick", scene_principled_closure_pick,
-                    dict(from_version=(4, 0, 0), sample_factor=2), 8))
+SCENES_SPEC.append(("principled_closure_pick", scene_principled_closure_pick, dict(sample_factor=2), 8))
 
 # General Mix and Add Shaders (issue 14: the core's 'mix' kind, one input drawn per hit by its
 # weight): left, a Mix of a Principled BSDF (a warm base, roughness 0.3) and a smooth Glass BSDF

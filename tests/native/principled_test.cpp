@@ -204,10 +204,26 @@ TEST(Principled, GlossyPickIsTheLayersShareOfCyclesSampleWeights) {
     const Scatter sc = scatter(m, hit, kContext);
     EXPECT_NEAR(sc.glossy_pick, layer / (layer + base), 1e-4f) << theta;
   }
-  // Only there: 3.x's sum, a coat, a metal or glass beside the layer leave the lobe its own weight.
+  // 3.x (Cycles 3.x's weights): the layer's F0 blended to white by the IOR's normalised Fresnel
+  // curve at the view, against the base's average colour, whole (3.x adds the layer to it).
+  const Principled m3 = principled(args({{"color", color},
+                                         {"roughness", 0.5},
+                                         {"ior", 1.5},
+                                         {"layered", false},
+                                         {"burley", true},
+                                         {"multiscatter", false},
+                                         {"shadowing", std::string("separable")}}));
+  for (const double theta : {0.2, 0.9, 1.4}) {
+    const float curve = (fresnel_dielectric(float(std::cos(theta)), 1.5f) - 0.04f) / 0.96f;
+    const float layer = 0.04f + 0.96f * curve;
+    const float base = (color.x + color.y + color.z) / 3.0f;
+    EXPECT_NEAR(scatter(m3, hit_from(direction(theta, 0.3)), kContext).glossy_pick, layer / (layer + base), 1e-4f)
+        << theta;
+  }
+  // Only there: a coat, a metal (4.0+) or glass beside the layer leave the lobe its own weight.
   const ShadingPoint hit = hit_from(direction(0.9, 0.3));
   for (const Params& p : std::vector<Params>{
-           args({{"color", color}, {"layered", false}, {"multiscatter", false}}),
+           args({{"color", color}, {"layered", false}, {"multiscatter", false}, {"coat_weight", 0.5}}),
            args({{"color", color}, {"coat_weight", 0.5}}),
            args({{"color", color}, {"metallic", 0.5}}),
            args({{"color", color}, {"transmission", 0.5}}),
