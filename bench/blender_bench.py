@@ -147,13 +147,21 @@ def write_ply(path, positions, normals, uvs):
 
 def material_description(mat, out_dir):
     """The subset of node materials the bench scenes use: Diffuse BSDF (colour or image), Glass,
-    Emission (colour x strength)."""
+    Emission (colour x strength), Glossy BSDF (colour, roughness and distribution, all constant)."""
     if mat is None or not mat.use_nodes:
         return dict(type="diffuse", color=[0.8, 0.8, 0.8])
     out = next(n for n in mat.node_tree.nodes if n.type == "OUTPUT_MATERIAL")
     bsdf = out.inputs["Surface"].links[0].from_node
     if bsdf.type == "BSDF_GLASS":
         return dict(type="glass", ior=bsdf.inputs["IOR"].default_value)
+    if bsdf.type in ("BSDF_GLOSSY", "BSDF_ANISOTROPIC"):  # 4.0+: the Glossy BSDF is the anisotropic node
+        linked = [s.name for s in bsdf.inputs if s.is_linked and s.name in ("Color", "Roughness", "Anisotropy")]
+        anisotropy = bsdf.inputs["Anisotropy"].default_value if "Anisotropy" in bsdf.inputs else 0.0
+        if linked or anisotropy != 0.0:
+            raise ValueError(f"material {mat.name}: a Glossy BSDF with linked {linked} or anisotropy {anisotropy} "
+                             "is not converted for Mitsuba")
+        return dict(type="glossy", color=list(bsdf.inputs["Color"].default_value)[:3],
+                    roughness=bsdf.inputs["Roughness"].default_value, distribution=bsdf.distribution)
     if bsdf.type == "EMISSION":
         return dict(type="emission", color=list(bsdf.inputs["Color"].default_value)[:3],
                     strength=bsdf.inputs["Strength"].default_value)
@@ -196,9 +204,10 @@ def world_description(scene, out_dir):
                 strength=background.inputs["Strength"].default_value)
 
 
-def dump_for_mitsuba(mesh, out_dir):
+def dump_for_mitsuba(mesh, out_dir, specular_depth=0):
     """Meshes (one PLY per mesh and material, in object space), their instances' world matrices,
-    lights in Blender's units, the camera and the world colour: bench/mitsuba_bench.py converts."""
+    lights in Blender's units, the camera, the world colour and the reference's specular depth (the
+    glossy bounces Cycles followed): bench/mitsuba_bench.py converts."""
     out_dir.mkdir(parents=True, exist_ok=True)
     depsgraph = bpy.context.evaluated_depsgraph_get()
     shapes, lights = {}, []
@@ -255,7 +264,7 @@ def dump_for_mitsuba(mesh, out_dir):
                 camera=dict(matrix=[list(row) for row in cam.matrix_world], lens=cam.data.lens,
                             sensor_width=cam.data.sensor_width, sensor_fit=cam.data.sensor_fit,
                             clip_start=cam.data.clip_start, clip_end=cam.data.clip_end),
-                width=r.resolution_x, height=r.resolution_y)
+                width=r.resolution_x, height=r.resolution_y, specular_depth=specular_depth)
     (out_dir / "scene.json").write_text(json.dumps(desc))
 
 
@@ -339,7 +348,7 @@ def main():
     result["approximated"] = stats.get("approximated", [])
     result["runs"] = runs
     if job.get("mitsuba_dir"):
-        dump_for_mitsuba(mesh, Path(job["mitsuba_dir"]))
+        dump_for_mitsuba(mesh, Path(job["mitsuba_dir"]), depth)
     out.write_text(json.dumps(result, indent=1))
 
 

@@ -1,7 +1,9 @@
 # Mitsuba 3 as the renderer a user might pick instead: the scene that bench/blender_bench.py wrote
 # (PLY meshes, lights in Blender's units, camera) given to Mitsuba through its Python API, rendered
 # by its `direct` integrator on the CPU at a sweep of sample counts and compared with the same
-# Cycles reference as TOYRT. Runs in .venv (requirements-bench.txt):
+# Cycles reference as TOYRT; a scene whose reference follows glossy bounces (its specular depth) and
+# has no diffuse surface by its `path` integrator to the same depth (`integrator`). Runs in .venv
+# (requirements-bench.txt):
 #     .venv/bin/python bench/mitsuba_bench.py SCENE_DIR REF.npy OUT.json --spp 1 4 16
 #
 # Units. Cycles' (measured in shared/BLENDER_UNITS.md, as TOYRT uses them): a point light of power
@@ -13,11 +15,13 @@
 # Also converted: a sun (Mitsuba's `directional`, irradiance = strength), a spot (`spot`, intensity
 # P / (4 pi)), Emission materials (an `area` emitter of radiance colour x strength on the mesh, on
 # both sides as Cycles' mesh lights: blender_bench.py writes a turned-over copy just behind the
-# surface; no BSDF), and an
-# Environment Texture world (`envmap`, its frame turned to Blender's equirectangular convention and
-# the Mapping node's rotation). What Mitsuba cannot express is rendered its nearest way and listed in
-# the output's "approximations": a sun's disc (Mitsuba's directional light is a delta), a spot's
-# smoothstep edge and radius (Mitsuba's spot is a point with a falloff linear in angle).
+# surface; no BSDF), an Environment Texture world (`envmap`, its frame turned to Blender's
+# equirectangular convention and the Mapping node's rotation) and the Glossy BSDF (`roughconductor`
+# of Fresnel 1 and the colour as its reflectance: glossy_bsdf). What Mitsuba cannot express is
+# rendered its nearest way and listed in the output's "approximations": a sun's disc (Mitsuba's
+# directional light is a delta), a spot's smoothstep edge and radius (Mitsuba's spot is a point with
+# a falloff linear in angle), an area lamp under a world (Mitsuba's rectangle is opaque, rays go on
+# through Cycles' lamps: under a constant world the rectangle adds the world's radiance it hides).
 #
 # Time: wall-clock seconds from the scene description to an image, as for the others: mi.load_dict
 # (which builds Mitsuba's BVH) plus mi.render.
@@ -74,6 +78,8 @@ def build_dict(mi, scene_dir, desc, approximations=None):
         bsdfs[key] = name
         if mat["type"] == "glass":
             d[name] = {"type": "dielectric", "int_ior": float(mat["ior"]), "ext_ior": 1.0}
+        elif mat["type"] == "glossy":
+            d[name] = glossy_bsdf(mat, approximations)
         elif "texture" in mat:
             rgb = np.load(scene_dir / mat["texture"])
             bitmap = mi.Bitmap(rgb)
@@ -122,9 +128,25 @@ def build_dict(mi, scene_dir, desc, approximations=None):
             area = sx * scale[0] * sy * scale[1]
             # Mitsuba's rectangle spans [-1, 1]^2 with normal +Z: scale to half sizes, turn over.
             local = np.diag([sx / 2, -sy / 2, -1.0, 1.0])
+            radiance = color / (4 * area)
+            # Cycles' lamp is no surface: a ray that meets it takes its light and goes on, to the world
+            # behind it, and shadow rays pass it. Mitsuba's rectangle is opaque: it hides the part of
+            # the world behind it. Seen from the front, a lamp of radiance L + the world's constant
+            # colour gives back what it hides (exactly); from behind it stays a black patch.
+            world = desc["world"]
+            if isinstance(world, list) and any(c > 0 for c in world):
+                radiance = radiance + np.array(world, np.float64)
+                approximations.append("area lamp under a constant world: Mitsuba's rectangle is opaque, so its "
+                                      "radiance is the lamp's plus the world's it hides (exact from the front; "
+                                      "from behind it hides the world, which Cycles' lamp does not)")
+            elif isinstance(world, dict):
+                approximations.append("area lamp: Mitsuba's rectangle is opaque and hides the map behind it "
+                                      "(Cycles' lamp does not)")
+            # Black: a shape without a BSDF gets Mitsuba's grey diffuse one, which would reflect the
+            # scene's light off the lamp (Cycles' lamps reflect nothing).
             d[f"light{k}"] = {"type": "rectangle", "to_world": to_transform(mi, m @ local),
-                              "emitter": {"type": "area", "radiance": {"type": "rgb",
-                                                                       "value": (color / (4 * area)).tolist()}}}
+                              "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}},
+                              "emitter": {"type": "area", "radiance": {"type": "rgb", "value": radiance.tolist()}}}
         elif light["type"] == "SUN":
             direction = -m[:3, 2] / np.linalg.norm(m[:3, 2])  # Blender's sun shines along its local -Z
             d[f"light{k}"] = {"type": "directional", "direction": direction.tolist(),
@@ -174,8 +196,46 @@ def build_dict(mi, scene_dir, desc, approximations=None):
         raise ValueError("some area lights are hidden from the camera and some not: Mitsuba cannot show that")
     if any(hidden) and desc["world"] is not None:
         raise ValueError("a hidden area light and a world colour: Mitsuba cannot hide one and show the other")
-    d["integrator"] = {"type": "direct", "hide_emitters": any(hidden)}
+    d["integrator"] = integrator(desc)
+    d["integrator"]["hide_emitters"] = any(hidden)
     return d
+
+
+def integrator(desc):
+    """Mitsuba's integrator for the transport of the Cycles reference: `direct` for direct light
+    alone (specular depth 0); for a specular depth N (Cycles' glossy and transmission bounces,
+    TOYRT's max_specular_depth) `path` with max_depth N + 2, which counts path segments: 2 is
+    direct light, and N bounces after the first hit add N segments (Cycles' last bounce is a ray
+    that only collects light, Mitsuba's last segment too). Only for scenes without diffuse
+    surfaces: TOYRT and the restricted Cycles end a path at a diffuse hit after its direct light,
+    which no Mitsuba integrator does."""
+    depth = int(desc.get("specular_depth", 0))
+    if depth == 0:
+        return {"type": "direct"}
+    diffuse = sorted({part["ply"] for shape in desc["shapes"] for part in shape["parts"]
+                      if part["material"]["type"] == "diffuse"})
+    if diffuse:
+        raise ValueError(f"specular depth {depth} with diffuse surfaces ({', '.join(diffuse)}): Mitsuba's path "
+                         "integrator would go on past them")
+    return {"type": "path", "max_depth": depth + 2}
+
+
+def glossy_bsdf(mat, approximations):
+    """Blender's Glossy BSDF: a microfacet reflection whose colour is a constant Fresnel, which is
+    Mitsuba's rough conductor of no material (Fresnel 1) scaled by specular_reflectance; alpha =
+    roughness^2 (Cycles' convention, roughness clamped to [0, 1]). Both use separable Smith masking
+    (Cycles 3.x G1(o) G1(i), Mitsuba's microfacet G) and sample visible normals."""
+    color = {"type": "rgb", "value": [float(c) for c in mat["color"]]}
+    dist = mat.get("distribution", "GGX")
+    if dist == "SHARP":
+        return {"type": "conductor", "material": "none", "specular_reflectance": color}
+    if dist not in ("GGX", "BECKMANN", "MULTI_GGX"):
+        raise ValueError(f"Glossy BSDF distribution {dist} is not converted for Mitsuba")
+    if dist == "MULTI_GGX":
+        approximations.append("Multiscatter GGX Glossy BSDF: single-scatter GGX (Mitsuba has no multiscatter)")
+    alpha = min(max(float(mat["roughness"]), 0.0), 1.0) ** 2
+    return {"type": "roughconductor", "material": "none", "specular_reflectance": color,
+            "distribution": "beckmann" if dist == "BECKMANN" else "ggx", "alpha": alpha}
 
 
 def main():
@@ -196,7 +256,10 @@ def main():
     # The pixels blender_bench.py counted (lights seen directly and their edges left out).
     mask = np.load(str(args.reference).replace(".ref.npy", ".mask.npy"))
     runs, approximations = [], []
-    build_dict(mi, args.scene_dir, desc, approximations)  # once, for the list of what it approximates
+    # Once, for the list of what it approximates and the integrator it picks.
+    used = build_dict(mi, args.scene_dir, desc, approximations)["integrator"]
+    method = f"Mitsuba 3 {used['type']}"
+    approximations = list(dict.fromkeys(approximations))
     for spp in args.spp:
         best = None
         for _ in range(args.repeats):
@@ -207,12 +270,11 @@ def main():
             best = (img, seconds) if best is None or seconds < best[1] else best
         d, r = (best[0] - ref)[mask], ref[mask]
         rmse, relmse = float(np.sqrt(np.mean(d * d))), float(np.mean(d * d / (r * r + 1e-2)))
-        runs.append(dict(renderer="mitsuba", method="Mitsuba 3 direct", spp=spp, seconds=best[1], rmse=rmse,
-                         relmse=relmse))
+        runs.append(dict(renderer="mitsuba", method=method, spp=spp, seconds=best[1], rmse=rmse, relmse=relmse))
         print(f"bench: mitsuba {args.scene_dir.name} {spp} spp {best[1]:.3f} s rmse {rmse:.4g}", flush=True)
     np.save(args.out.with_suffix(".mitsuba.npy"), best[0].astype(np.float32))
     args.out.write_text(json.dumps(dict(variant=variant, variant_note=note, version=mi.__version__, runs=runs,
-                                        approximations=approximations), indent=1))
+                                        integrator=used, approximations=approximations), indent=1))
 
 
 if __name__ == "__main__":

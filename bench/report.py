@@ -21,7 +21,14 @@ REPO = Path(__file__).resolve().parents[1]
 DOC = REPO / "docs" / "results.md"
 FIG = REPO / "docs" / "results"
 COLORS = {"TOYRT solid_angle/all": "#1f77b4", "TOYRT solid_angle/one": "#6baed6", "TOYRT area/all": "#d62728",
-          "TOYRT area/one": "#ff9896", "Cycles": "#2ca02c", "Mitsuba 3 direct": "#9467bd"}
+          "TOYRT area/one": "#ff9896", "Cycles": "#2ca02c", "Mitsuba 3 direct": "#9467bd",
+          "Mitsuba 3 path": "#8c564b"}
+
+
+def mitsuba_method(runs):
+    """The Mitsuba method of a scene's runs: its `direct` integrator, or `path` where the reference
+    follows glossy bounces through a scene with nothing diffuse (bench/mitsuba_bench.py: integrator)."""
+    return next((r["method"] for r in runs if r["renderer"] == "mitsuba"), "Mitsuba 3 direct")
 
 
 def sh(*cmd):
@@ -120,7 +127,7 @@ def fixed_costs(data):
     """The t0 of each renderer's time fit: what it pays before the first sample."""
     lights = data.get("scene_stats", {}).get("lights", 0)
     out = []
-    for m in ("Cycles", f"TOYRT solid_angle/{'one' if lights > 4 else 'all'}", "Mitsuba 3 direct"):
+    for m in ("Cycles", f"TOYRT solid_angle/{'one' if lights > 4 else 'all'}", mitsuba_method(data["runs"])):
         f = Fit(data["runs"], m, "relmse")
         out.append(fmt(f.t0) if f.ok else "-")
     return " / ".join(out)
@@ -280,8 +287,9 @@ def main():
           "(a light's edge is pixel-jitter noise of its full radiance, the same for every method): RMSE, and "
           "relative MSE = mean((x - ref)^2 / (ref^2 + 0.01)). TOYRT's methods: `area_light_sampling` "
           "solid_angle or area, `light_sampling` all (a shadow ray to every light) or one (one light per hit, "
-          "picked by expected contribution). Mitsuba renders the scenes without glass only: its `direct` "
-          "integrator does not follow specular chains.\n")
+          "picked by expected contribution). Mitsuba renders the scenes without glass by its `direct` "
+          "integrator, which does not follow specular chains, and a scene with nothing diffuse (glossy_metal) by "
+          "its `path` integrator to the same depth (max_depth 10 for glossy bounces 8).\n")
         w("![the benchmark scenes: Cycles references](results/scenes.png)\n")
         scene_montage(work, scenes)
         w("The reference has noise of its own: Cycles' RMSE fit (section 1's Fit) extrapolated to the reference's "
@@ -327,7 +335,7 @@ def main():
             methods = [m for m in dict.fromkeys(r["method"] for r in runs) if m.startswith("TOYRT")]
             for m in methods:
                 cells = []
-                for peer in ("Cycles", "Mitsuba 3 direct"):
+                for peer in ("Cycles", mitsuba_method(runs)):
                     for metric in ("rmse", "relmse"):
                         s, n = speedup(runs, m, peer, metric)
                         summary[(name, m, peer, metric)] = s
@@ -360,7 +368,7 @@ def main():
         lights = data.get("scene_stats", {}).get("lights", 0)
         m = f"TOYRT solid_angle/{'one' if lights > 4 else 'all'}"
         cells = []
-        for peer in ("Cycles", "Mitsuba 3 direct"):
+        for peer in ("Cycles", mitsuba_method(data["runs"])):
             for metric in ("rmse", "relmse"):
                 r = summary.get((name, m, peer, metric))
                 cells.append(f"{'>= ' if r[1] else ''}{fmt(r[0])}" if r else "n/a")
@@ -664,7 +672,7 @@ def main():
               + (" Embree's trees traced faster than TOYRT's SAH trees for every ray type at every size, so "
                  "final-render totals would gain most from faster traversal, not from another builder policy."
                  if embree_faster else ""))
-        sl = [(n, slopes.get((n, "TOYRT solid_angle/all")), slopes.get((n, "Mitsuba 3 direct")),
+        sl = [(n, slopes.get((n, "TOYRT solid_angle/all")), slopes.get((n, mitsuba_method(scenes[n]["runs"]))),
                slopes.get((n, "Cycles"))) for n in scenes]
         w("- **Sample pattern**: TOYRT's RMSE slopes against spp (Sobol-Owen) are "
           + ", ".join(f"{n} {fmt(a)}" for n, a, b, c in sl)

@@ -17,6 +17,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 
 # name, scene script, build options, max specular depth (0: direct light only), Mitsuba can render it
+# (its `direct` integrator at depth 0; above, its `path` integrator, for scenes with no diffuse surface)
 SCENES = [
     ("cornell", "cornell", {}, 8, False),  # the seed's final scene: glass needs specular chains
     ("cornell_diffuse", "cornell", {"glass": False}, 0, True),
@@ -32,6 +33,9 @@ SCENES = [
     ("glossy", "glossy", {}, 8, False),
     # The map and an emissive panel seen in the glossy balls: sampled at each glossy vertex.
     ("glossy_hdri", "glossy_hdri", {}, 8, False),
+    # Glossy BSDF balls on a Glossy floor, nothing diffuse: TOYRT's transport is then path tracing to
+    # depth 8, which Mitsuba's `path` integrator renders too (max_depth 10; bench/mitsuba_bench.py).
+    ("glossy_metal", "glossy_metal", {}, 8, True),
 ]
 METHODS = [["solid_angle", "all"], ["solid_angle", "one"], ["area", "all"], ["area", "one"]]
 # Features switched on one at a time on the seed's Cornell box (scenes/bench/cornell.py).
