@@ -10,6 +10,7 @@
 #   make demo         renders the seed's Cornell box with TOYRT -> out/demo_0001.png
 #   make bench-trace  ray-tracing benchmark against Embree -> docs/bench-trace.md
 #   make bench-lbvh   builders (LBVH, SAH, Embree) from 10K to 4M triangles -> docs/lbvh-bench.md, lbvh.png
+#   make parity-refs  render the Cycles references of the parity scenes (3.4 and bpy) -> tests/blender/parity_refs/
 #   make bench-blender TOYRT against Cycles in Blender: time to Cycles' 64-spp error, peak memory -> docs/blender-bench.md
 #   make bench        speed against accuracy vs Cycles, Mitsuba 3, Embree, Open3D -> docs/results.md, denoising -> docs/denoise-bench.md (BENCH_QUICK=1: smoke run)
 #   make fuzz         libFuzzer over scene building and ray queries (FUZZ_SECONDS=60) -> docs/robustness.md
@@ -52,11 +53,11 @@ VERSION     := $(shell sed -n 's/^project(toyrt LANGUAGES CXX VERSION \([0-9.]*\
 
 BLENDER_TESTS := $(sort $(wildcard tests/blender/test_*.py))
 
-.PHONY: bench help setup apt venv configure native addon tables test test-native test-python test-blender test-bpy bench-blender \
+.PHONY: bench help setup apt venv configure native addon tables test test-native test-python test-blender test-bpy bench-blender parity-refs \
 	demo bench-trace bench-lbvh clean distclean fuzz sanitize test-levels lint format test-quick venv-package package test-package
 
 help:
-	@sed -n '2,17p' Makefile | sed 's/^# \{0,1\}//'
+	@sed -n '2,18p' Makefile | sed 's/^# \{0,1\}//'
 
 # ---- setup ------------------------------------------------------------------------------------------
 setup: apt venv venv-package native addon
@@ -177,6 +178,15 @@ test-blender:
 # test_viewport.py, test_ui_layout.py and test_material_preview.py drive Debian's Blender with a window
 # under Xvfb (the bpy module has no UI, and renders no previews).
 BPY_TESTS := $(filter-out tests/blender/test_viewport.py tests/blender/test_ui_layout.py tests/blender/test_material_preview.py,$(BLENDER_TESTS))
+# The Cycles references of tests/blender/test_cycles_parity.py, committed so that a fresh clone's
+# `make test` renders none (about 12 minutes of Cycles). After a change to how its scenes are built,
+# stale references are rendered by the test itself (slower, never wrong); this writes them back.
+parity-refs: addon venv
+	TOYRT_PARITY_SAVE_REFS=1 TOYRT_BUILD_DIR=$(abspath $(BUILD)) $(BLENDER) -b --python-exit-code 1 \
+		--python tests/blender/test_cycles_parity.py
+	TOYRT_PARITY_SAVE_REFS=1 $(VENV)/bin/python tests/blender/run_with_bpy.py tests/blender/test_cycles_parity.py \
+		--build $(BUILD)
+
 test-bpy:
 	@passed=0; for t in $(BPY_TESTS); do \
 		echo "bpy: $$t"; start=$$(date +%s); \

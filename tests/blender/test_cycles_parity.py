@@ -11,12 +11,16 @@
 #
 # Metrics per scene (Blender's own render tests use the second): mean |TOYRT - Cycles| over the
 # mean of Cycles (<= 0.5 %), and the fraction of pixels where a channel differs by more than 0.016
-# after clamping both to [0, 1] (<= 1 %). The converged Cycles references are cached under
-# build/parity-cache/, keyed by a hash of the scene parameters, this file (scene building and
-# Cycles settings) and the Blender version, so only the first run pays for them (about 10 s).
+# after clamping both to [0, 1] (<= 1 %). The converged Cycles references are keyed by a hash of
+# the scene parameters, what builds scenes here (the text above the Cycles section, and
+# render_cycles), the scene kit, the Cycles settings and the Blender version. They are committed
+# in tests/blender/parity_refs/<version>/ (`make parity-refs` writes them after a change: a fresh
+# clone's `make test` then renders no reference, about 12 minutes of Cycles saved), and a
+# reference that is missing there or stale is rendered and cached under build/parity-cache/.
 # Results go to docs/parity.md; images of the last run to build/parity-cache/last-run/.
 import hashlib
 import importlib.util
+import inspect
 import json
 import os
 import sys
@@ -33,6 +37,9 @@ import kit  # noqa: E402
 
 # The build folder of this run (`make test-blender BUILD=...` and run_with_bpy.py set it).
 CACHE = Path(os.environ.get("TOYRT_BUILD_DIR", REPO / "build")) / "parity-cache"
+# The committed references of this Blender version, and whether this run writes them (make parity-refs).
+REFS = REPO / "tests" / "blender" / "parity_refs" / ".".join(map(str, bpy.app.version))
+SAVE_REFS = os.environ.get("TOYRT_PARITY_SAVE_REFS", "") == "1"
 # Debian's Blender 3.4 writes docs/parity.md; a current Blender through the bpy module
 # (tests/blender/run_with_bpy.py) writes its own report beside it.
 DOC = REPO / "docs" / ("parity.md" if bpy.app.version < (4, 0, 0) else
@@ -873,22 +880,50 @@ def applies(params):
     return tuple(params.get("from_version", (0, 0, 0))) <= version < tuple(params.get("before_version", (99, 0, 0)))
 
 
+def scene_source():
+    """What a Cycles reference depends on in this file: everything that builds scenes (the text
+    above the Cycles section) and render_cycles. The comparison and the report below do not."""
+    text = Path(__file__).read_text()
+    return text[:text.index("# ---- Cycles ---")] + inspect.getsource(render_cycles)
+
+
 def cache_key(name, params, transmission, samples):
-    # The text of this file, the kit and the Cycles settings is part of the key: any change to how
-    # scenes are built or how Cycles is set up renders the references again.
-    sources = (Path(__file__), REPO / "scenes" / "kit.py", REPO / "scenes" / "cycles_like_toyrt.py")
-    source = hashlib.sha256(b"".join(f.read_bytes() for f in sources)).hexdigest()
+    # What builds the scenes, the kit and the Cycles settings are part of the key: any change to
+    # how scenes are built or how Cycles is set up renders the references again.
+    kit_files = (REPO / "scenes" / "kit.py", REPO / "scenes" / "cycles_like_toyrt.py")
+    source = hashlib.sha256(scene_source().encode() + b"".join(f.read_bytes() for f in kit_files)).hexdigest()
     blob = json.dumps(dict(name=name, params=params, transmission=transmission, samples=samples,
                            size=(WIDTH, HEIGHT), blender=bpy.app.version_string, source=source), sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
+def committed_reference(name, key):
+    """The committed reference of this scene, or None where there is none or it is stale."""
+    path = REFS / f"{name}.npz"
+    if not path.exists():
+        return None
+    with np.load(path) as ref:
+        return (ref["image"], float(ref["seconds"])) if str(ref["key"]) == key else None
+
+
+def save_reference(name, key, img, seconds):
+    """Writes the committed reference (make parity-refs), where it is missing or stale."""
+    if committed_reference(name, key) is None:
+        REFS.mkdir(parents=True, exist_ok=True)
+        np.savez_compressed(REFS / f"{name}.npz", image=img.astype(np.float32), key=np.array(key),
+                            seconds=np.array(seconds))
+
+
 def cycles_reference(name, params, transmission, samples):
+    """(image, Cycles seconds, where it came from: 'committed', 'cached' or 'rendered')."""
     CACHE.mkdir(parents=True, exist_ok=True)
     key = cache_key(name, params, transmission, samples)
+    committed = committed_reference(name, key)
+    if committed is not None:
+        return committed[0], committed[1], "committed"
     npy, meta = CACHE / f"{name}-{key}.npy", CACHE / f"{name}-{key}.json"
     if npy.exists() and meta.exists():
-        return np.load(npy), json.loads(meta.read_text())["seconds"], True
+        return np.load(npy), json.loads(meta.read_text())["seconds"], "cached"
     kit.cycles(bpy.context.scene, samples, transmission)
     img, seconds = render_cycles(bpy.context.scene, CACHE / f"{name}-{key}.exr")
     for stale in list(CACHE.glob(f"{name}-*.npy")) + list(CACHE.glob(f"{name}-*.json")):
@@ -896,7 +931,7 @@ def cycles_reference(name, params, transmission, samples):
     np.save(npy, img)
     meta.write_text(json.dumps(dict(seconds=seconds, samples=samples, blender=bpy.app.version_string)))
     (CACHE / f"{name}-{key}.exr").unlink(missing_ok=True)
-    return img, seconds, False
+    return img, seconds, "rendered"
 
 
 # ---- comparison ----------------------------------------------------------------------------------
@@ -931,7 +966,7 @@ def main():
     toyrt = render_toyrt.native()
     sync = load_sync()
     wanted = {s for s in SCENES.split(",") if s}
-    results, failures = [], []
+    results, failures, sources = [], [], {}
     out_dir = CACHE / "last-run"
     out_dir.mkdir(parents=True, exist_ok=True)
     for name, build, params, transmission in SCENES_SPEC:
@@ -947,7 +982,10 @@ def main():
         # deviation of about L / (2 sqrt(spp))).
         factor = params.get("sample_factor", 1)
         cycles_spp, toyrt_spp = CYCLES_SAMPLES * factor, TOYRT_SAMPLES * factor
-        ref, cycles_s, cached = cycles_reference(name, params, transmission, cycles_spp)
+        ref, cycles_s, source = cycles_reference(name, params, transmission, cycles_spp)
+        sources[source] = sources.get(source, 0) + 1
+        if SAVE_REFS:
+            save_reference(name, cache_key(name, params, transmission, cycles_spp), ref, cycles_s)
 
         warnings = []
         depsgraph = bpy.context.evaluated_depsgraph_get()
@@ -970,7 +1008,7 @@ def main():
         print(f"  mean |diff| / mean = {mean_rel * 100:.3f} % (signed {bias * 100:+.3f} %), "
               f"pixels > {PIXEL_FAIL}: {frac * 100:.3f} %  -> {verdict}", flush=True)
         print(f"  TOYRT {toyrt_spp} spp: {toyrt_s:.2f} s render (+{t1 - t0:.3f} s export+commit); "
-              f"Cycles {cycles_spp} spp: {cycles_s:.2f} s{' (cached)' if cached else ''}; "
+              f"Cycles {cycles_spp} spp: {cycles_s:.2f} s{'' if source == 'rendered' else f' ({source})'}; "
               f"export: {stats['meshes']} meshes, {stats['instances']} instances, {stats['lights']} lights, "
               f"approximated: {stats['approximated'] or 'nothing'}", flush=True)
         if warnings:
@@ -980,6 +1018,14 @@ def main():
                             toyrt_spp=toyrt_spp, cycles_spp=cycles_spp, asserted=asserted))
         if not ok and asserted:
             failures.append(name)
+    print(f"parity: Cycles references {sources}" + (
+        "" if not sources.get("rendered") or SAVE_REFS else
+        " (`make parity-refs` commits the rendered ones: tests/blender/parity_refs/)"), flush=True)
+    if SAVE_REFS and not wanted:  # a whole run: references of scenes no longer here go
+        names = {n for n, _, p, _ in SCENES_SPEC if applies(p)}
+        for old in REFS.glob("*.npz"):
+            if old.stem not in names:
+                old.unlink()
     write_doc(results)
     return results, failures
 
@@ -1017,7 +1063,8 @@ def write_doc(results):
     lines += [
         "",
         "Times are wall-clock seconds of the render call alone (Cycles: `bpy.ops.render.render`, including its "
-        "scene sync; a cached reference keeps the time of the run that made it).",
+        "scene sync; a cached or committed reference (tests/blender/parity_refs/, `make parity-refs`) keeps the "
+        "time of the run that made it).",
         "",
         "Notes:",
         ("- Point and spot lights of radius R: Cycles 3.4 renders them as a disk facing the shading point "
