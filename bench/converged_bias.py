@@ -22,7 +22,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "bench"))
 import blender_bench as bb  # noqa: E402
 import kit  # noqa: E402
-from interleaved_sweep import mitsuba_module  # noqa: E402
+from interleaved_sweep import job_scene, mitsuba_module  # noqa: E402
 
 
 def rms(x, mask):
@@ -41,19 +41,13 @@ def main():
     ap.add_argument("--spp", type=int, default=4096)
     ap.add_argument("--save", type=Path, default=None, help="folder for the images (npy)")
     args = ap.parse_args(sys.argv[sys.argv.index("--") + 1:])
-    job = json.loads((args.work / f"job-{args.scene}.json").read_text())
-    ref0 = np.load(args.work / f"render-{args.scene}.ref.npy").astype(np.float64)
-    mask = np.load(args.work / f"render-{args.scene}.mask.npy")
+    job, ref0, mask = job_scene(args.work, args.scene)
 
     import render_toyrt
     from render_toyrt import sync
 
     toyrt = render_toyrt.native()
-    module, _ = bb.load_scene_module(job["module"])
-    module.build(**job.get("options", {}))
     scene = bpy.context.scene
-    kit.output(scene, job["width"], job["height"])
-    bpy.context.view_layer.update()
     depth = job["specular_depth"]
     images, seconds = {}, {}
 

@@ -32,6 +32,19 @@ def mitsuba_module(variant):
     return mi
 
 
+def job_scene(work, name):
+    """The job bench/run.py wrote into `work` for scene `name`, its scene rebuilt in this Blender:
+    (job, the Cycles reference as float64, the pixel mask)."""
+    job = json.loads((work / f"job-{name}.json").read_text())
+    ref = np.load(work / f"render-{name}.ref.npy").astype(np.float64)
+    mask = np.load(work / f"render-{name}.mask.npy")
+    module, _ = bb.load_scene_module(job["module"])
+    module.build(**job.get("options", {}))
+    kit.output(bpy.context.scene, job["width"], job["height"])
+    bpy.context.view_layer.update()
+    return job, ref, mask
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("work", type=Path)
@@ -41,9 +54,7 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--methods", nargs="+", default=["solid_angle/all", "area/all"])
     args = ap.parse_args(sys.argv[sys.argv.index("--") + 1:])
-    job = json.loads((args.work / f"job-{args.scene}.json").read_text())
-    ref = np.load(args.work / f"render-{args.scene}.ref.npy").astype(np.float64)
-    mask = np.load(args.work / f"render-{args.scene}.mask.npy")
+    job, ref, mask = job_scene(args.work, args.scene)
     args.out.mkdir(parents=True, exist_ok=True)
     np.save(args.out / f"render-{args.scene}.ref.npy", ref.astype(np.float32))
     np.save(args.out / f"render-{args.scene}.mask.npy", mask)
@@ -52,11 +63,7 @@ def main():
     from render_toyrt import mesh, sync  # noqa: F401  (the add-on's exporter)
 
     toyrt = render_toyrt.native()
-    module, _ = bb.load_scene_module(job["module"])
-    module.build(**job.get("options", {}))
     scene = bpy.context.scene
-    kit.output(scene, job["width"], job["height"])
-    bpy.context.view_layer.update()
     depth = job["specular_depth"]
     tmp = args.out / f"{args.scene}.cycles.exr"
 
