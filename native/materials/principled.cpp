@@ -196,13 +196,13 @@ Scatter opaque_scatter(const Principled& m, const ShadingPoint& s, const Materia
     Scatter sc = burley_base(m, s, lobe_over(dielectric_layer(m, s, f0).lobe, scale * dielectric * lambert_f(albedo)));
     // The plain two-closure case (u < 0: neither glass nor clearcoat drew first): Cycles 3.x's
     // sample weights (render/closure_pick.h), the specular closure's average Fresnel colour at
-    // the view, F0's colour blended to white by the IOR's normalised curve (as Cycles 3.x's
-    // interpolate_fresnel_color), against the diffuse closure's average colour, (1 - Metallic) x
-    // the base colour.
+    // the view (Cycles 3.x's interpolate_fresnel_color about the shading normal: the lobe's own
+    // Fresnel for the microfacet normal z, whose mirror of wo is wo turned about z), against the
+    // diffuse closure's average colour, (1 - Metallic) x the base colour.
     const float diffuse_weight = dielectric * (albedo.x + albedo.y + albedo.z) / 3.0f;
     if (u < 0.0f && diffuse_weight > 0.0f) {
-      const float curve = (fresnel_dielectric(sc.glossy.wo.z, m.eta) - m.eta_f0) / (1.0f - m.eta_f0);
-      const Vec3 reflect = glm::mix(f0, Vec3(1.0f), std::clamp(curve, 0.0f, 1.0f));
+      const Vec3& wo = sc.glossy.wo;
+      const Vec3 reflect = lobe_fresnel(sc.glossy, Vec3(-wo.x, -wo.y, wo.z));
       const float layer_weight = (reflect.x + reflect.y + reflect.z) / 3.0f;
       if (layer_weight > 0.0f) sc.glossy_pick = layer_weight / (layer_weight + diffuse_weight);
     }
