@@ -245,19 +245,39 @@ Scatter opaque_scatter(const Principled& m, const ShadingPoint& s, const Materia
 // draw carries no clearcoat, so the opaque draws carry it over their share of the draws.
 Scatter clearcoated(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx, const Vec3& albedo,
                     float scale, float u) {
-  const float v = u < 0.0f ? ctx.lobe_uniform() : u;
-  const float p = 0.5f * m.coat;
-  Scatter sc = opaque_scatter(m, s, ctx, albedo, scale, std::min(std::max(v - p, 0.0f) / (1.0f - p), 0x1.fffffep-1f));
-  if (!(v < p)) {
-    if (sc.kind == Scatter::Kind::Glossy) sc.glossy.tint /= 1.0f - p;
-    return sc;
-  }
   GlossyLobe coat = oriented_lobe(s, m.coat_roughness, GgxShadowing::Separable);
   coat.clearcoat = true;
   coat.fresnel = LobeFresnel::Dielectric;
   coat.f0 = Vec3(kClearcoatF0);
   coat.ior = kClearcoatIor;
   coat.ior_f0 = kClearcoatF0;
+  if (u < 0.0f) {
+    // No glass drew first: Cycles 3.x's three closures side by side (materials/closure_mixture.h),
+    // each picked by its sample weight: the diffuse's (1 - Metallic) x the base's average colour,
+    // the specular's and the clearcoat's their closure weights' average Fresnel colour at the view
+    // (interpolate_fresnel_color about the shading normal: the lobe's Fresnel for the microfacet
+    // normal z, whose mirror of wo is wo turned about z), the clearcoat's times 0.25 x Clearcoat.
+    Scatter sc = opaque_scatter(m, s, ctx, albedo, scale, 1.0f);
+    coat.tint = Vec3(0.25f * m.coat);
+    const Vec3 mirror(-coat.wo.x, -coat.wo.y, coat.wo.z);
+    const auto average = [](const Vec3& c) { return (c.x + c.y + c.z) / 3.0f; };
+    Vec3 weights(0.0f, 0.0f, average(coat.tint * lobe_fresnel(coat, mirror)));
+    if (sc.kind == Scatter::Kind::Glossy) weights.y = average(lobe_fresnel(sc.glossy, mirror));
+    if (sc.f != Vec3(0.0f)) weights.x = (1.0f - m.metallic) * average(albedo);
+    const float total = weights.x + weights.y + weights.z;
+    if (!(total > 0.0f)) return sc;
+    sc.kind = Scatter::Kind::Mixture;
+    sc.second_glossy = coat;
+    sc.closure_pick = weights / total;
+    return sc;
+  }
+  const float v = u;
+  const float p = 0.5f * m.coat;
+  Scatter sc = opaque_scatter(m, s, ctx, albedo, scale, std::min(std::max(v - p, 0.0f) / (1.0f - p), 0x1.fffffep-1f));
+  if (!(v < p)) {
+    if (sc.kind == Scatter::Kind::Glossy) sc.glossy.tint /= 1.0f - p;
+    return sc;
+  }
   const float glass = (1.0f - m.metallic) * m.transmission;
   coat.tint = Vec3(0.25f * m.coat / (p * (1.0f - glass)));
   Scatter out =

@@ -65,6 +65,9 @@ struct Scatter {
                  // a diffuse part f, if not 0, gets its direct light as a Diffuse answer does
     Dielectric,  // a rough dielectric: lights sampled on both sides with MIS against `dielectric`,
                  // then the path continues along its sample (reflected or transmitted)
+    Mixture,     // Cycles' closures side by side, combined as Cycles combines them: the diffuse part f,
+                 // `glossy` and `second_glossy`, each picked with probability closure_pick's
+                 // (materials/closure_mixture.h)
   };
   Kind kind = Kind::Diffuse;
   Vec3 f{0.0f};  // Diffuse, and Glossy's diffuse part (0: none): for directions on wo's side
@@ -76,6 +79,10 @@ struct Scatter {
   // (its sample weight over both), which decides what the continuation's next vertex scatters:
   // the whole BSDF over the closures' mixed pdf (render/closure_pick.h). 0: the lobe's own value.
   float glossy_pick = 0.0f;
+  // Mixture: a second glossy closure (3.x's Clearcoat) and each closure's pick probability, x the
+  // diffuse part's, y `glossy`'s, z `second_glossy`'s (Cycles' sample weights over their sum).
+  GlossyLobe second_glossy;
+  Vec3 closure_pick{0.0f};
   int count = 0;
   SpecularSample branches[2];
   GlossyLobe glossy;

@@ -15,15 +15,8 @@ DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& 
                                  uint8_t receiver_set) {
   DielectricStep step;
   const Vec3 above = offset_ray_origin(p, ng), below = offset_ray_origin(p, -ng);
-  const World& world = scene.world();
   const LobeVertex lv{nullptr, &lobe, p, ng, above, below};
-  step.radiance = lobe_lamp_lighting(scene, lv, pixel, sample, light_dim, emitter_dim - 1, settings, receiver_set);
-  if (scene.any_emission())
-    step.radiance += lobe_emitter_lighting(scene, lv, sobol_owen_2d(pixel, sample, emitter_dim, settings.seed),
-                                           settings, receiver_set);
-  if (samples_environment_at_lobes(world))
-    step.radiance +=
-        lobe_environment_lighting(scene, lv, sobol_owen_2d(pixel, sample, emitter_dim + 1, settings.seed), settings);
+  step.radiance = lobe_vertex_lighting(scene, lv, pixel, sample, light_dim, emitter_dim, settings, receiver_set);
   const BsdfSample g = dielectric_sample(lobe, sobol_owen_2d(pixel, sample, lobe_dim, settings.seed),
                                          sobol_owen_1d(pixel, sample, side_dim, settings.seed));
   if (!(g.pdf > 0.0f)) return step;

@@ -1,6 +1,7 @@
 #include "render/glossy_lighting.h"
 
 #include "lights/light_selector.h"
+#include "materials/closure_mixture.h"
 #include "render/transparent_walk.h"
 #include "sampling/sobol_owen.h"
 
@@ -10,6 +11,18 @@ namespace toyrt {
 
 LobeAnswer lobe_towards(const LobeVertex& v, const Vec3& wi) {
   LobeAnswer a;
+  if (v.mixture) {
+    a.cos = glm::dot(v.mixture->second_glossy.frame.n, wi);
+    if (a.cos <= 0.0f || glm::dot(v.ng, wi) <= 0.0f) return a;
+    a.e = mixture_eval(*v.mixture, wi);
+    a.origin = v.above;
+    // As Cycles' light samples at such a vertex count a lamp for all its closures, by the kind
+    // of ray the picked closure would send: glossy, whose visibility decides here (a lamp seen
+    // by glossy rays but hidden from diffuse ones still lights the diffuse part: noted in
+    // docs/render.md).
+    a.seen_by = kVisibleGlossy;
+    return a;
+  }
   if (v.glossy) {
     a.cos = glm::dot(v.glossy->frame.n, wi);
     if (a.cos <= 0.0f || glm::dot(v.ng, wi) <= 0.0f) return a;
@@ -117,23 +130,46 @@ float lobe_environment_hit_weight(const Scene& scene, float bsdf_pdf, const Vec3
   return power_heuristic(bsdf_pdf, environment_pdf(scene.world().environment, wi));
 }
 
+Vec3 lobe_vertex_lighting(const Scene& scene, const LobeVertex& v, uint32_t pixel, uint32_t sample, uint32_t light_dim,
+                          uint32_t emitter_dim, const IntegratorSettings& settings, uint8_t receiver_set) {
+  Vec3 sum = lobe_lamp_lighting(scene, v, pixel, sample, light_dim, emitter_dim - 1, settings, receiver_set);
+  if (scene.any_emission())
+    sum += lobe_emitter_lighting(scene, v, sobol_owen_2d(pixel, sample, emitter_dim, settings.seed), settings,
+                                 receiver_set);
+  if (samples_environment_at_lobes(scene.world()))
+    sum += lobe_environment_lighting(scene, v, sobol_owen_2d(pixel, sample, emitter_dim + 1, settings.seed), settings);
+  return sum;
+}
+
 GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng, const GlossyLobe& lobe,
                          uint32_t pixel, uint32_t sample, uint32_t light_dim, uint32_t lobe_dim, uint32_t emitter_dim,
                          const IntegratorSettings& settings, uint8_t receiver_set) {
   GlossyStep step;
   const LobeVertex v{&lobe, nullptr, p, ng, origin, origin};
-  step.radiance = lobe_lamp_lighting(scene, v, pixel, sample, light_dim, emitter_dim - 1, settings, receiver_set);
-  if (scene.any_emission())
-    step.radiance += lobe_emitter_lighting(scene, v, sobol_owen_2d(pixel, sample, emitter_dim, settings.seed), settings,
-                                           receiver_set);
-  if (samples_environment_at_lobes(scene.world()))
-    step.radiance +=
-        lobe_environment_lighting(scene, v, sobol_owen_2d(pixel, sample, emitter_dim + 1, settings.seed), settings);
+  step.radiance = lobe_vertex_lighting(scene, v, pixel, sample, light_dim, emitter_dim, settings, receiver_set);
   const BsdfSample g = sample_lobe(lobe, sobol_owen_2d(pixel, sample, lobe_dim, settings.seed));
   if (!(g.pdf > 0.0f) || glm::dot(g.wi, ng) <= 0.0f) return step;
   step.wi = g.wi;
   step.weight = g.weight;
   step.pdf = g.pdf;
+  return step;
+}
+
+GlossyStep mixture_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng, const Scatter& mixture,
+                          uint32_t pixel, uint32_t sample, uint32_t light_dim, uint32_t lobe_dim, uint32_t pick_dim,
+                          uint32_t emitter_dim, const IntegratorSettings& settings, uint8_t receiver_set) {
+  GlossyStep step;
+  LobeVertex v{nullptr, nullptr, p, ng, origin, origin};
+  v.mixture = &mixture;
+  step.radiance = lobe_vertex_lighting(scene, v, pixel, sample, light_dim, emitter_dim, settings, receiver_set);
+  bool diffuse = false;
+  const BsdfSample g = mixture_sample(mixture, sobol_owen_1d(pixel, sample, pick_dim, settings.seed),
+                                      sobol_owen_2d(pixel, sample, lobe_dim, settings.seed), diffuse);
+  if (!(g.pdf > 0.0f) || glm::dot(g.wi, ng) <= 0.0f) return step;
+  step.wi = g.wi;
+  step.weight = g.weight;
+  step.pdf = g.pdf;
+  step.diffuse = diffuse;
   return step;
 }
 

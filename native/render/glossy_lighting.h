@@ -13,6 +13,7 @@
 
 #include "materials/dielectric_lobe.h"
 #include "materials/glossy_lobe.h"
+#include "materials/scatter.h"
 #include "render/render_settings.h"
 #include "scene/scene.h"
 
@@ -35,15 +36,18 @@ inline bool picks_one_lamp(const World& world, const IntegratorSettings& setting
 
 // A vertex with a lobe, as the emitter and map samples see it: a glossy lobe (one side, above
 // the true surface) or a rough dielectric's (both sides; a direction below leaves by refraction).
+// Or Cycles' closures side by side (a Scatter::Kind::Mixture, materials/closure_mixture.h): one
+// side, evaluated whole with its mixed pdf.
 struct LobeVertex {
-  const GlossyLobe* glossy = nullptr;          // exactly one of the two
+  const GlossyLobe* glossy = nullptr;          // exactly one of the three
   const DielectricLobe* dielectric = nullptr;  // (materials/dielectric_lobe.h)
   Vec3 p{0.0f};                                // the hit point
   Vec3 ng{0.0f};                               // the geometric normal on wo's side
   Vec3 above{0.0f}, below{0.0f};               // the shadow rays' origins on each side
-  // The normal the light tree weighs emitters by: the glossy lobe's; 0 (none) for a dielectric,
-  // which takes light from both sides.
-  Vec3 tree_normal() const { return glossy ? glossy->frame.n : Vec3(0.0f); }
+  const Scatter* mixture = nullptr;
+  // The normal the light tree weighs emitters by: the glossy lobe's (the mixture's shading
+  // normal); 0 (none) for a dielectric, which takes light from both sides.
+  Vec3 tree_normal() const { return glossy ? glossy->frame.n : mixture ? mixture->second_glossy.frame.n : Vec3(0.0f); }
 };
 // What the lobe makes of a light sample along unit wi: f and the lobe's pdf (f = 0: nothing, the
 // direction is on no side the lobe scatters to), |cos| at the shading normal, the shadow ray's
@@ -76,6 +80,12 @@ inline bool samples_environment_at_lobes(const World& world) {
 Vec3 lobe_environment_lighting(const Scene& scene, const LobeVertex& v, const Vec2& u,
                                const IntegratorSettings& settings);
 
+// All three at the vertex: the lamps (lamp j from dimension light_dim + j, or the one lamp picked on
+// emitter_dim - 1), an emitter sample (dimension emitter_dim) and a map sample (emitter_dim + 1)
+// where the scene has them.
+Vec3 lobe_vertex_lighting(const Scene& scene, const LobeVertex& v, uint32_t pixel, uint32_t sample, uint32_t light_dim,
+                          uint32_t emitter_dim, const IntegratorSettings& settings, uint8_t receiver_set);
+
 // Where a lobe vertex sampled emitters and the map from: its point and tree_normal(), for the
 // weight of the light its continuation ray finds.
 struct LobeOrigin {
@@ -102,10 +112,19 @@ struct GlossyStep {
   Vec3 wi{0.0f};
   Vec3 weight{0.0f};
   float pdf = 0.0f;
+  bool diffuse = false;  // mixture_vertex: the diffuse closure drew wi (the ray only looks for light)
 };
 [[gnu::noinline]] GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng,
                                            const GlossyLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t light_dim,
                                            uint32_t lobe_dim, uint32_t emitter_dim, const IntegratorSettings& settings,
                                            uint8_t receiver_set = 0);
+
+// The same for Cycles' closures side by side (Scatter::Kind::Mixture, materials/closure_mixture.h):
+// the light samples evaluate the whole mixture, and the continuation's closure is picked on
+// dimension pick_dim (1D) before its direction is drawn from lobe_dim.
+[[gnu::noinline]] GlossyStep mixture_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng,
+                                            const Scatter& mixture, uint32_t pixel, uint32_t sample, uint32_t light_dim,
+                                            uint32_t lobe_dim, uint32_t pick_dim, uint32_t emitter_dim,
+                                            const IntegratorSettings& settings, uint8_t receiver_set = 0);
 
 }  // namespace toyrt

@@ -278,7 +278,10 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
 
 // The instances a path ray of this kind sees (Instance::visibility).
 uint8_t seen_by(RayKind kind) {
-  return kind == RayKind::Camera ? kVisibleCamera : kind == RayKind::Glossy ? kVisibleGlossy : kVisibleTransmission;
+  return kind == RayKind::Camera         ? kVisibleCamera
+         : kind == RayKind::Glossy       ? kVisibleGlossy
+         : kind == RayKind::Transmission ? kVisibleTransmission
+                                         : kVisibleDiffuse;
 }
 
 // The kind of ray that leaves a surface along wi, on the side of ng the path came from: a
@@ -460,6 +463,29 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             lobe_from = LobeOrigin{s.p, sc.glossy.frame.n, true};  // LobeVertex::tree_normal()
             light_only = bounce >= settings.max_specular_depth;
             kind = RayKind::Glossy;
+            receiver = s.receiver_set;
+            ray = Ray{origin, 0.0f, g.wi, kInfinity};
+            return true;
+          }
+          if (sc.kind == Scatter::Kind::Mixture) {
+            // Cycles' closures side by side (materials/closure_mixture.h): one light sample for all,
+            // one closure picked to continue; a diffuse pick's ray only looks for light.
+            if (first) {
+              first->diffuse = sc.f * kPi;
+              first->glossy = glossy_pass_color(material, sc.glossy);
+            }
+            const Vec3 origin = offset_ray_origin(s.p, ng);
+            const GlossyStep g =
+                mixture_vertex(scene, s.p, origin, ng, sc, pixel, sample, vertex_dimension(depth, 1),
+                               vertex_dimension(depth, kDimsPerVertex - 5), vertex_dimension(depth, kDimsPerVertex - 6),
+                               vertex_dimension(depth, kDimsPerVertex - 10), settings, s.receiver_set);
+            radiance += throughput * g.radiance;
+            if (!(g.pdf > 0.0f)) return false;
+            throughput *= g.weight;
+            bsdf_pdf = g.pdf;
+            lobe_from = LobeOrigin{s.p, sc.second_glossy.frame.n, true};  // LobeVertex::tree_normal()
+            light_only = g.diffuse || bounce >= settings.max_specular_depth;
+            kind = g.diffuse ? RayKind::Diffuse : RayKind::Glossy;
             receiver = s.receiver_set;
             ray = Ray{origin, 0.0f, g.wi, kInfinity};
             return true;

@@ -30,7 +30,9 @@ inline void shadow_bumps(const Scene& scene, int32_t material, Scatter& sc, cons
   if (material < 0 || size_t(material) >= scene.normal_maps().size() || smooth == bent) return;
   const MaterialNormalMap& map = scene.normal_maps()[size_t(material)];
   if (!map.active() || map.shadowing == BumpShadowing::None) return;
-  if (sc.kind != Scatter::Kind::Diffuse && !(sc.kind == Scatter::Kind::Glossy && sc.f != Vec3(0.0f))) return;
+  if (sc.kind != Scatter::Kind::Diffuse &&
+      !((sc.kind == Scatter::Kind::Glossy || sc.kind == Scatter::Kind::Mixture) && sc.f != Vec3(0.0f)))
+    return;
   if (!sc.burley) {
     sc.burley = true;
     sc.retro = BurleyDiffuse{bent, wo, 0.0f, false};

@@ -32,9 +32,10 @@ struct LightVisibility {
 
   // Whether a path ray of kind `ray` (one RayVisibility bit of scene/instance.h) sees the light.
   bool seen_by(uint8_t ray) const {
-    return ray == kVisibleCamera   ? camera
-           : ray == kVisibleGlossy ? glossy
-                                   : ray == kVisibleTransmission && transmission;
+    return ray == kVisibleCamera    ? camera
+           : ray == kVisibleGlossy  ? glossy
+           : ray == kVisibleDiffuse ? diffuse
+                                    : ray == kVisibleTransmission && transmission;
   }
 };
 
@@ -57,7 +58,9 @@ struct World {
 };
 
 // The kind of a ray a path traces, for the world's visibility above.
-enum class RayKind : uint8_t { Camera, Glossy, Transmission };
+// Diffuse: a ray a diffuse closure drew where Cycles' closures are mixed (materials/closure_mixture.h),
+// which only looks for light.
+enum class RayKind : uint8_t { Camera, Glossy, Transmission, Diffuse };
 
 inline bool background_visible(const World& world, RayKind kind) {
   switch (kind) {
@@ -67,6 +70,8 @@ inline bool background_visible(const World& world, RayKind kind) {
       return world.background_visible_glossy;
     case RayKind::Transmission:
       return world.background_visible_transmission;
+    case RayKind::Diffuse:
+      return world.background_lights_surfaces;
   }
   return true;
 }

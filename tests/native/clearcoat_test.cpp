@@ -1,8 +1,7 @@
 // Blender 3.x's Principled Clearcoat (materials/clearcoat.h, materials/principled.cpp) against
 // closed forms and invariants: GTR1's normalisation, the sampler and the evaluation reporting the
-// same (Cycles') pdf and a weight of f cos / pdf, no NaN at roughness 0 or grazing, and the drawn
-// lobes averaging to the 3.x Principled without the clearcoat plus 0.25 x Clearcoat x F x the
-// clearcoat lobe: added beside the rest, nothing below attenuated.
+// same (Cycles') pdf and a weight of f cos / pdf, no NaN at roughness 0 or grazing. How the
+// Principled combines it with its other closures: tests/native/closure_mixture_test.cpp.
 #include "materials/clearcoat.h"
 #include "hemisphere.h"
 #include "material_fixtures.h"
@@ -73,36 +72,6 @@ TEST(Clearcoat, SamplerAndEvaluationReportCyclesPdfAndWeighFCosOverIt) {
         EXPECT_LE(s.weight, 1.0f);  // G1 of the fixed masking
       }
     }
-}
-
-TEST(Clearcoat, DrawnLobesAverageToThePrincipledPlusTheClearcoatNothingAttenuated) {
-  // The clearcoat is drawn with probability Clearcoat / 2; averaged over 64 stratified draws the
-  // value for a light's direction is the bare 3.x Principled's plus 0.25 x Clearcoat x F(IOR 1.5)
-  // x D G1 G1 / (4 cos cos) of GTR1 with alpha = Clearcoat Roughness^2.
-  // Clearcoat 0.5: the probability 1 / 4 splits 64 stratified draws exactly, so this holds to rounding.
-  const float coat = 0.5f, coat_rough = 0.3f, alpha = coat_rough * coat_rough;
-  const Vec3 wo = direction(1.0, 0.3);
-  const ShadingPoint hit = hit_from(wo);
-  const Scatter bare = scatter(principled_3x(0.0f, coat_rough), hit, kContext);
-  const Principled m = principled_3x(coat, coat_rough);
-  for (const Vec3& wi : {direction(0.3, 2.0), direction(1.0, 3.4), direction(0.6, 0.1)}) {
-    const Vec3 h = glm::normalize(wo + wi);
-    const float clearcoat = 0.25f * coat * fresnel_dielectric(glm::dot(wo, h), 1.5f) * clearcoat_eval(alpha, wo, wi).f;
-    const Vec3 want = evaluate_lobe(bare.glossy, wi).f + bare.f + Vec3(clearcoat);
-    Vec3 mean(0.0f);
-    constexpr int kDraws = 64;
-    for (int k = 0; k < kDraws; ++k) {
-      MaterialContext ctx = kContext;
-      ctx.sample = uint32_t(k);
-      ctx.lobe_dimension = 7;
-      const Scatter sc = scatter(m, hit, ctx);
-      EXPECT_EQ(sc.f, bare.f);  // the base, on either draw
-      EXPECT_TRUE(sc.burley);   // still 3.x's Burley base
-      mean += (evaluate_lobe(sc.glossy, wi).f + sc.f) / float(kDraws);
-    }
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean[c], want[c], 2e-4f * want[c]) << c;
-    EXPECT_GT(clearcoat, 1e-3f * want.x);  // the clearcoat counts in the sum
-  }
 }
 
 TEST(Clearcoat, WithoutClearcoatThe3xPrincipledIsUnchangedAndAMirrorCoatStaysFinite) {
