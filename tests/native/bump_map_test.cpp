@@ -46,18 +46,24 @@ MaterialNormalMap bump_of(float distance, float strength = 1.0f) {
 constexpr double kKinkX = 1.0 / 64.0, kKinkSlope = 32.0 / 63.0;
 double kink_height(double x) { return std::max(0.0, kKinkSlope * (x - kKinkX)); }
 
-Scene kinked_floor(MaterialNormalMap map) {
+// The kinked surface as material 0 of `scene`, placed by `to_world`, seen by the rays `visibility` names.
+void add_kinked_surface(Scene& scene, MaterialNormalMap map, const Mat4& to_world = Mat4(1.0f),
+                        uint8_t visibility = kVisibleAll) {
   std::vector<float> texels(64 * 3);
   for (int i = 0; i < 64; ++i)
     texels[size_t(3 * i)] = texels[size_t(3 * i + 1)] = texels[size_t(3 * i + 2)] = std::max(0, i - 32) / 63.0f;
-  Scene scene;
   map.texture = int32_t(scene.add_texture(Texture::from_floats(64, 1, 3, texels, ColorEncoding::Linear)));
   scene.add_material(Lambert{Vec3(0.5f), -1}, {}, {}, map);
   MeshShading sh;
   sh.material_ids = {0, 0};
   sh.corner_uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}};
   scene.add_instance(scene.add_mesh({{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, {{0, 1, 2}, {0, 2, 3}}, sh),
-                     Mat4(1.0f));
+                     to_world, true, 0, 0, visibility);
+}
+
+Scene kinked_floor(const MaterialNormalMap& map) {
+  Scene scene;
+  add_kinked_surface(scene, map);
   return scene;
 }
 
@@ -185,6 +191,47 @@ TEST(BumpMap, AnOrthographicPixelsFootprintIsItsWidth) {
   point.commit();
   const double flat = render(point, pixel_above(w), few_samples(1024)).rgba[0];
   EXPECT_GT(flat - rendered, 0.01 * expected);
+}
+
+TEST(BumpMap, AReflectedRayKeepsTheFootprintItStartedWith) {
+  // Cycles 3.x starts a reflected ray with the hit's width. The orthographic 2 cm pixel sees a
+  // sharp mirror at z = 0 that shows the kinked surface as a ceiling at z = 1 (hidden from camera
+  // rays), lit by a point lamp at (0.5, 0, 0.5), off the mirror's direction. At the ceiling Ng on the ray's side is -z, whose axes
+  // are a = (-1, 1, 0) / sqrt 2, b = (1, 1, 0) / sqrt 2: before the kink h_x = 0 (a looks back,
+  // into the flat part) and h_y = dh = h(x + w / sqrt 2) - h(x), so N' = normalize(-z - Distance
+  // dh / w b). The ceiling's radiance, integrated over the pixel: albedo / pi x P / (4 pi) x
+  // max(0, N' . l) / r^2, l towards the lamp.
+  const float w = 0.02f, power = 100.0f, distance = 2.0f;
+  double sum = 0.0;
+  const int n = 400;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double x = w * ((i + 0.5) / n - 0.5), y = w * ((j + 0.5) / n - 0.5);
+      const double t = distance * (kink_height(x + w / std::sqrt(2.0)) - kink_height(x)) / (w * std::sqrt(2.0));
+      const double len = std::sqrt(2.0 * t * t + 1.0), r = std::sqrt((0.5 - x) * (0.5 - x) + y * y + 0.25);
+      // N' = (-t, -t, -1) / len, l = (0.5 - x, -y, -0.5) / r.
+      sum += std::max(0.0, (-t * (0.5 - x) + t * y + 0.5) / (len * r)) / (r * r);
+    }
+  const double expected = 0.5 / kPiD * power / (4.0 * kPiD) * sum / (n * n);
+  for (bool footprint : {true, false}) {
+    MaterialNormalMap map = bump_of(distance);
+    map.bump_footprint = footprint;
+    Scene ceiling;
+    add_kinked_surface(ceiling, map, glm::translate(Mat4(1.0f), Vec3(0.0f, 0.0f, 1.0f)),
+                       uint8_t(kVisibleAll & ~kVisibleCamera));
+    ceiling.add_material(Glossy::make(Vec3(1.0f), 0.0f, GgxShadowing::Separable));
+    MeshShading mirror;
+    mirror.material_ids = {1, 1};
+    ceiling.add_instance(
+        ceiling.add_mesh({{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, {{0, 1, 2}, {0, 2, 3}}, mirror), Mat4(1.0f));
+    ceiling.add_light(PointLight::make(Vec3(0.5f, 0.0f, 0.5f), power, Vec3(1.0f)));
+    ceiling.commit();
+    const double rendered = render(ceiling, pixel_above(w), few_samples(1024)).rgba[0];
+    if (footprint)
+      EXPECT_NEAR(rendered, expected, 1e-3 * expected);
+    else  // the slope at the point: the flat ceiling, clearly apart
+      EXPECT_GT(std::fabs(rendered - expected), 0.01 * expected);
+  }
 }
 
 TEST(BumpMap, ItsKeywordsAreReadAndMistakesRefused) {
