@@ -196,11 +196,10 @@ TEST(BumpMap, AnOrthographicPixelsFootprintIsItsWidth) {
 TEST(BumpMap, AReflectedRayKeepsTheFootprintItStartedWith) {
   // Cycles 3.x starts a reflected ray with the hit's width. The orthographic 2 cm pixel sees a
   // sharp mirror at z = 0 that shows the kinked surface as a ceiling at z = 1 (hidden from camera
-  // rays), lit by a point lamp at (0.5, 0, 0.5), off the mirror's direction. At the ceiling Ng on the ray's side is -z, whose axes
-  // are a = (-1, 1, 0) / sqrt 2, b = (1, 1, 0) / sqrt 2: before the kink h_x = 0 (a looks back,
-  // into the flat part) and h_y = dh = h(x + w / sqrt 2) - h(x), so N' = normalize(-z - Distance
-  // dh / w b). The ceiling's radiance, integrated over the pixel: albedo / pi x P / (4 pi) x
-  // max(0, N' . l) / r^2, l towards the lamp.
+  // rays), lit by a point lamp at (0.5, 0, 0.5), off the mirror's direction. At the ceiling Ng on the ray's side is -z,
+  // whose axes are a = (-1, 1, 0) / sqrt 2, b = (1, 1, 0) / sqrt 2: before the kink h_x = 0 (a looks back, into the
+  // flat part) and h_y = dh = h(x + w / sqrt 2) - h(x), so N' = normalize(-z - Distance dh / w b). The ceiling's
+  // radiance, integrated over the pixel: albedo / pi x P / (4 pi) x max(0, N' . l) / r^2, l towards the lamp.
   const float w = 0.02f, power = 100.0f, distance = 2.0f;
   double sum = 0.0;
   const int n = 400;
