@@ -5,8 +5,9 @@ object or world space, its Strength a constant, 5.x+'s convention (DirectX negat
 the node has it.
 
 A Bump node takes the same place: its Height an Image Texture's Color (Rec. 709 luminance) or
-Alpha, its Strength and Distance constants, Invert a negative distance (the core's bump_map;
-docs/render.md). A Bump's own Normal input (a chain of bumps or a normal map under it) is not
+Alpha, its Strength and Distance constants, Invert a negative distance, and before 4.4 (no Filter
+Width) the height differenced over the ray's footprint as Cycles 3.x does (the core's bump_map,
+bump_footprint; docs/render.md). A Bump's own Normal input (a chain of bumps or a normal map under it) is not
 followed, noted.
 
 One normal per material: the surface shader's own Normal input (Principled, Diffuse, Glossy,
@@ -47,12 +48,18 @@ class NormalMapSpec:
     # A Bump node (space 'BUMP'): its Distance (negative: Invert) and the height's channel.
     distance: float = 1.0
     channel: str = "gray"
+    # Where a Bump takes the height's slope: 'point' (Cycles 4.4+) or 'pixel', differences over
+    # the ray's footprint (Cycles before 4.4, which has no Filter Width).
+    footprint: str = "point"
 
     def arguments(self, texture_id: int) -> dict:
         """add_material's keywords for the core's MaterialNormalMap."""
         if self.space == "BUMP":
-            return dict(bump_map=texture_id, bump_strength=self.strength, bump_distance=self.distance,
+            bump = dict(bump_map=texture_id, bump_strength=self.strength, bump_distance=self.distance,
                         bump_channel=self.channel, normal_shadowing=self.shadowing, normal_lift=self.lift)
+            if self.footprint != "point":
+                bump["bump_footprint"] = self.footprint
+            return bump
         return dict(normal_map=texture_id, normal_strength=self.strength, normal_space=self.space,
                     normal_convention=self.convention, normal_strength_mode=self.strength_mode,
                     normal_shadowing=self.shadowing, normal_lift=self.lift)
@@ -155,16 +162,15 @@ def _bump(name, src, notes, correction):
     normal = input_socket(src, "Normal")
     if normal is not None and normal.is_linked:
         notes.append(f"material '{name}': a Bump's Normal input (the surface normal under the bump)")
-    if input_socket(src, "Filter Width") is None:
-        # Before 4.4 Cycles differences the height over a whole pixel's footprint.
-        notes.append(f"material '{name}': Bump slope at the point (Cycles before 4.4: over a pixel's footprint)")
+    # Before 4.4 (no Filter Width) Cycles differences the height over the ray's footprint.
+    footprint = "pixel" if input_socket(src, "Filter Width") is None else "point"
     channel = "alpha" if output == "Alpha" else "gray"
     strength = _constant(name, input_socket(src, "Strength"), "Bump Strength", 1.0, notes)
     distance = _constant(name, input_socket(src, "Distance"), "Bump Distance", 1.0, notes)
     if getattr(src, "invert", False):
         distance = -distance
     return NormalMapSpec(replace(key, alpha=True), strength, "BUMP", shadowing=_shadowing(correction),
-                         distance=distance, channel=channel), image
+                         distance=distance, channel=channel, footprint=footprint), image
 
 
 def _has_pixels(image) -> bool:

@@ -50,7 +50,8 @@ MaterialNormalMap MaterialNormalMap::from_params(const Params& params) {
                                         : BumpShadowing::None;
   n.lift = params.flag("normal_lift", n.lift);
   const int64_t bump = params.integer("bump_map", -1);
-  if (bump >= 0 || params.has("bump_strength") || params.has("bump_distance") || params.has("bump_channel")) {
+  if (bump >= 0 || params.has("bump_strength") || params.has("bump_distance") || params.has("bump_channel") ||
+      params.has("bump_footprint")) {
     if (n.texture >= 0) throw std::invalid_argument("a material takes a normal_map or a bump_map, not both");
     n.texture = int32_t(bump);
     n.bump = true;
@@ -60,6 +61,10 @@ MaterialNormalMap MaterialNormalMap::from_params(const Params& params) {
     if (channel != "gray" && channel != "alpha")
       throw std::invalid_argument("bump_channel must be 'gray' or 'alpha', got '" + channel + "'");
     n.bump_alpha = channel == "alpha";
+    const std::string footprint = params.text("bump_footprint", "point");
+    if (footprint != "point" && footprint != "pixel")
+      throw std::invalid_argument("bump_footprint must be 'point' or 'pixel', got '" + footprint + "'");
+    n.bump_footprint = footprint == "pixel";
   }
   return n;
 }
@@ -122,6 +127,13 @@ Vec3 bump_normal(const MaterialNormalMap& map, const Vec3& n, const Vec3& dx, co
   const Vec3 surface_gradient = hx * rx + hy * ry;
   const Vec3 bent = unit_or_zero(std::fabs(det) * n - map.distance * (det < 0.0f ? -1.0f : 1.0f) * surface_gradient);
   return bent == Vec3(0.0f) ? n : bent;
+}
+
+void footprint_axes(const Vec3& ng, Vec3& a, Vec3& b) {
+  a = ng.x != ng.y || ng.x != ng.z ? Vec3(ng.z - ng.y, ng.x - ng.z, ng.y - ng.x)
+                                   : Vec3(ng.z - ng.y, ng.x + ng.z, -ng.y - ng.x);
+  a = glm::normalize(a);
+  b = glm::cross(ng, a);
 }
 
 }  // namespace toyrt

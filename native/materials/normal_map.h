@@ -24,8 +24,11 @@
 // R_x = dy x N, R_y = N x dx, det = dx . R_x, and
 // N' = normalize(|det| N - distance sign(det) ((h_x) R_x + (h_y) R_y)), blended with N by the
 // strength as 3.x's normal maps are (distance < 0: Invert). To first order the result does not
-// depend on dx, dy: Cycles takes the pixel's footprint, TOYRT the triangle's edges, with the
-// height's change along them from its UV gradient (bump_normal(); render/normal_mapping.cpp).
+// depend on dx, dy: Cycles 4.4+ takes the slope at the point, as TOYRT does by default with the
+// triangle's edges and the height's change along them from its UV gradient (bump_normal();
+// render/normal_mapping.cpp). Cycles before 4.4 differences the height over the ray's footprint
+// instead (`bump_footprint`): dx, dy = w a, w b, with a, b = footprint_axes(Ng) and w the ray
+// cone's width at the hit (camera/ray_cone.h), h_x = h(P + dx) - h(P), h_y = h(P + dy) - h(P).
 #pragma once
 
 #include "core/math.h"
@@ -53,17 +56,19 @@ struct MaterialNormalMap {
   // Lift the bent normal so the view's mirror stays above the surface (valid_reflection_normal):
   // Cycles 3.x does for every closure, 4.x+ only for glossy ones (not a Diffuse BSDF's).
   bool lift = true;
-  bool bump = false;        // a Bump node's height field (above), not a Normal Map
-  float distance = 1.0f;    // the Bump node's Distance, negated by Invert
-  bool bump_alpha = false;  // the height is the image's alpha (else its luminance)
+  bool bump = false;            // a Bump node's height field (above), not a Normal Map
+  float distance = 1.0f;        // the Bump node's Distance, negated by Invert
+  bool bump_alpha = false;      // the height is the image's alpha (else its luminance)
+  bool bump_footprint = false;  // differences over the ray's footprint (Cycles before 4.4), not the slope
 
   // From add_material's keywords, which every material kind accepts: normal_map (a texture id,
   // -1: none), normal_strength (1), normal_space ('TANGENT', 'OBJECT', 'WORLD', 'BLENDER_OBJECT',
   // 'BLENDER_WORLD'), normal_convention ('OPENGL', 'DIRECTX'), normal_strength_mode ('tangent':
   // Blender 4.x+, 'blend': 3.x), normal_shadowing ('conty': 4.x+, 'chiang': 3.x, 'none'),
   // normal_lift (True). Or a Bump node: bump_map (a texture id), bump_strength (1),
-  // bump_distance (1; negative: inverted), bump_channel ('gray': luminance, 'alpha'), with
-  // normal_shadowing and normal_lift as above.
+  // bump_distance (1; negative: inverted), bump_channel ('gray': luminance, 'alpha'),
+  // bump_footprint ('point': the slope at the point, Blender 4.4+; 'pixel': differences over the
+  // ray's footprint, before 4.4), with normal_shadowing and normal_lift as above.
   // Throws std::invalid_argument for an unknown name, or for both a normal map and a bump map.
   static MaterialNormalMap from_params(const Params& params);
 
@@ -71,7 +76,7 @@ struct MaterialNormalMap {
   bool operator==(const MaterialNormalMap& o) const {
     return texture == o.texture && strength == o.strength && space == o.space && directx == o.directx &&
            strength_mode == o.strength_mode && shadowing == o.shadowing && lift == o.lift && bump == o.bump &&
-           distance == o.distance && bump_alpha == o.bump_alpha;
+           distance == o.distance && bump_alpha == o.bump_alpha && bump_footprint == o.bump_footprint;
   }
   // Throws std::invalid_argument for a non-finite strength or a texture id that is not -1 or
   // below `textures` (the scene's count).
@@ -101,6 +106,11 @@ Vec3 blend_normal_strength(const MaterialNormalMap& map, const Vec3& bent, const
 // The Bump node's normal (above) from the smooth unit normal n, two tangent vectors dx, dy and
 // the height's changes hx, hy along them; n for a degenerate result. Unit, before the strength.
 Vec3 bump_normal(const MaterialNormalMap& map, const Vec3& n, const Vec3& dx, const Vec3& dy, float hx, float hy);
+
+// Cycles' two unit tangents a, b of a footprint around the unit normal ng (its make_orthonormals:
+// a along (1, 1, 1) x ng, or (-1, 1, 1) x ng when ng's components are all equal; b = ng x a).
+// Which pair matters: forward differences along them shift the bumps by half a footprint.
+void footprint_axes(const Vec3& ng, Vec3& a, Vec3& b);
 
 // The height a bump map reads from a texel (linear RGBA).
 inline float bump_height(const MaterialNormalMap& map, const glm::vec4& t) {

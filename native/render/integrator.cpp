@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 namespace toyrt {
 namespace {
@@ -290,16 +291,23 @@ RayKind kind_towards(const Vec3& wi, const Vec3& ng) {
   return glm::dot(wi, ng) > 0.0f ? RayKind::Glossy : RayKind::Transmission;
 }
 
+// The ray's footprint (camera/ray_cone.h), carried only by the loop that reads bump maps: the
+// other instantiation takes an empty parameter, which is not passed at all.
+struct NoCone {};
+template <bool kNormalMaps>
+using ConeOf = std::conditional_t<kNormalMaps, RayCone, NoCone>;
+
 // The radiance arriving along `ray`, whose first vertex is path vertex `depth` (0: the camera
 // ray), after `first_crossed` transparent surfaces; `first_kind` is the ray's kind for the
-// world's visibility. Recursive only where a Fresnel surface is split, so at most split_depth
-// levels deep.
+// world's visibility; `cone` its footprint (kNormalMaps only). Recursive only where a Fresnel
+// surface is split, so at most split_depth levels deep.
 // kNormalMaps: some material has a normal map (Scene::any_normal_map); false compiles the loop
 // without them, so other scenes run the code they ran before normal maps existed.
 template <bool kCutOuts, bool kNormalMaps>
 Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, uint32_t sample,
                 const IntegratorSettings& path_settings, FirstHit* first = nullptr, int first_crossed = 0,
-                RayKind first_kind = RayKind::Camera, uint8_t first_receiver = 0) {
+                RayKind first_kind = RayKind::Camera, uint8_t first_receiver = 0,
+                [[maybe_unused]] ConeOf<kNormalMaps> cone = {}) {
   static const Material kDefault = Lambert{};
   const World& world = scene.world();
   const std::vector<Material>& materials = scene.materials();
@@ -352,7 +360,12 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     SurfaceHit s = surface_at(scene, hit);
     const Vec3 wo = -glm::normalize(ray.dir);
     [[maybe_unused]] const Vec3 smooth = s.ns;  // before a normal map bends it (render/normal_mapping.h)
-    if constexpr (kNormalMaps) s.ns = normal_mapped(scene, hit, s.material, wo, s.ng, s.ns, s.uv);
+    if constexpr (kNormalMaps) {
+      // The footprint here; every ray that leaves this hit starts from it, with the same spread
+      // (Cycles 3.x: a bounce copies the width and keeps the camera's spread).
+      cone.width = cone.at(hit.t * glm::length(ray.dir));
+      s.ns = normal_mapped(scene, hit, s.material, wo, s.ng, s.ns, s.uv, cone.width);
+    }
     // The geometric normal decides the side; the shading normal is turned to that side.
     const bool front = glm::dot(s.ng, wo) > 0.0f;
     const Vec3 ng = front ? s.ng : -s.ng;
@@ -514,9 +527,10 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             for (int b = 0; b < sc.count; ++b) {
               const SpecularSample& branch = sc.branches[b];
               const Ray next{offset_ray_origin(s.p, branch.offset_normal), 0.0f, branch.wi, kInfinity};
-              radiance += throughput * branch.weight * branch.probability *
-                          trace_from<kCutOuts, kNormalMaps>(scene, next, depth + 1, pixel, sample, settings, nullptr,
-                                                            cut.crossed(), kind_towards(branch.wi, ng), s.receiver_set);
+              radiance +=
+                  throughput * branch.weight * branch.probability *
+                  trace_from<kCutOuts, kNormalMaps>(scene, next, depth + 1, pixel, sample, settings, nullptr,
+                                                    cut.crossed(), kind_towards(branch.wi, ng), s.receiver_set, cone);
             }
             return false;
           }
@@ -538,10 +552,17 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
 Vec3 trace_path(const Scene& scene, const Ray& camera_ray, uint32_t pixel, uint32_t sample,
                 const IntegratorSettings& settings, FirstHit* first) {
   const bool cut_outs = scene.any_transparency();
+  // The camera ray's footprint, for bumps that difference over it (Scene::any_bump_footprint).
+  auto cone = [&] {
+    return scene.any_bump_footprint() && settings.camera_cone ? settings.camera_cone->of_ray(camera_ray.dir)
+                                                              : RayCone{};
+  };
   const Vec3 radiance =
       scene.any_normal_map()
-          ? (cut_outs ? trace_from<true, true>(scene, camera_ray, 0, pixel, sample, settings, first)
-                      : trace_from<false, true>(scene, camera_ray, 0, pixel, sample, settings, first))
+          ? (cut_outs ? trace_from<true, true>(scene, camera_ray, 0, pixel, sample, settings, first, 0, RayKind::Camera,
+                                               0, cone())
+                      : trace_from<false, true>(scene, camera_ray, 0, pixel, sample, settings, first, 0,
+                                                RayKind::Camera, 0, cone()))
           : (cut_outs ? trace_from<true, false>(scene, camera_ray, 0, pixel, sample, settings, first)
                       : trace_from<false, false>(scene, camera_ray, 0, pixel, sample, settings, first));
   // A numerical failure anywhere (it should not happen) must not poison the pixel.

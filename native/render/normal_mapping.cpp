@@ -15,10 +15,12 @@ Vec3 lifted(const MaterialNormalMap& map, const Vec3& bent, const Vec3& ng, cons
 
 // A Bump node's normal at the hit: the triangle's world edges as the tangent vectors, the
 // height's change along each from the image's UV gradient (forward differences of a hundredth of
-// a texel: the slope of the bilinear patch the point is in, as Cycles' differences over a pixel
-// footprint smaller than a texel give). ns for a mesh without UVs or with degenerate ones.
+// a texel: the slope of the bilinear patch the point is in, as Cycles 4.4+ takes it). With
+// bump_footprint and a footprint w > 0, Cycles 3.x's differences over the footprint instead
+// (materials/normal_map.h). ns for a mesh without UVs or with degenerate ones. ng: the unit geometric
+// normal on the ray's side, as Cycles' Ng.
 Vec3 bumped(const Scene& scene, const Instance& inst, const MeshShading& sh, const MaterialNormalMap& map,
-            const Hit& hit, const Vec3& ns, const Vec2& uv) {
+            const Hit& hit, const Vec3& ns, const Vec3& ng, const Vec2& uv, float footprint) {
   const size_t c = 3 * size_t(hit.prim);
   if (sh.corner_uvs.size() < c + 3) return ns;
   const Vec2 d1 = sh.corner_uvs[c + 1] - sh.corner_uvs[c], d2 = sh.corner_uvs[c + 2] - sh.corner_uvs[c];
@@ -29,6 +31,26 @@ Vec3 bumped(const Scene& scene, const Instance& inst, const MeshShading& sh, con
   const glm::mat3 to_world(inst.to_world);
   const Vec3 e1 = to_world * (mesh.vertices()[tri.y] - p0), e2 = to_world * (mesh.vertices()[tri.z] - p0);
   const Texture& image = scene.textures()[size_t(map.texture)];
+  if (map.bump_footprint && footprint > 0.0f) {
+    // Cycles 3.x: the footprint's tangents dx = w a, dy = w b, and the UV offsets that move the
+    // point by them on the triangle's plane (its differential_dudv: e1 s + e2 t = dx, solved by
+    // the plane's Gram matrix), the image read there and at the point.
+    Vec3 a, b;
+    footprint_axes(ng, a, b);
+    const Vec3 dx = footprint * a, dy = footprint * b;
+    const float g11 = glm::dot(e1, e1), g12 = glm::dot(e1, e2), g22 = glm::dot(e2, e2);
+    const float det = g11 * g22 - g12 * g12;
+    if (det > 0.0f) {
+      auto uv_step = [&](const Vec3& d) {
+        const float r1 = glm::dot(e1, d), r2 = glm::dot(e2, d);
+        return ((g22 * r1 - g12 * r2) * d1 + (g11 * r2 - g12 * r1) * d2) / det;
+      };
+      const float h = bump_height(map, image.lookup(uv));
+      const float hx = bump_height(map, image.lookup(uv + uv_step(dx))) - h;
+      const float hy = bump_height(map, image.lookup(uv + uv_step(dy))) - h;
+      return bump_normal(map, ns, dx, dy, hx, hy);
+    }
+  }
   const float du = 0.01f / float(image.width), dv = 0.01f / float(image.height);
   const float h = bump_height(map, image.lookup(uv));
   const float hu = (bump_height(map, image.lookup(uv + Vec2(du, 0.0f))) - h) / du;
@@ -39,7 +61,7 @@ Vec3 bumped(const Scene& scene, const Instance& inst, const MeshShading& sh, con
 }  // namespace
 
 Vec3 normal_mapped(const Scene& scene, const Hit& hit, int32_t material, const Vec3& wo, const Vec3& ng, const Vec3& ns,
-                   const Vec2& uv) {
+                   const Vec2& uv, float footprint) {
   if (material < 0 || size_t(material) >= scene.normal_maps().size()) return ns;
   const MaterialNormalMap& map = scene.normal_maps()[size_t(material)];
   if (!map.active()) return ns;
@@ -49,7 +71,7 @@ Vec3 normal_mapped(const Scene& scene, const Hit& hit, int32_t material, const V
     // Cycles bumps the normal turned to the ray's side (a back face's heights rise towards the
     // viewer); the result goes back to ns's side for the strength and the lift.
     const float side = glm::dot(ng, wo) >= 0.0f ? 1.0f : -1.0f;
-    return lifted(map, side * bumped(scene, inst, sh, map, hit, side * ns, uv), ng, wo, ns);
+    return lifted(map, side * bumped(scene, inst, sh, map, hit, side * ns, side * ng, uv, footprint), ng, wo, ns);
   }
   const Vec3 n = normal_map_vector(map, Vec3(scene.textures()[size_t(map.texture)].lookup(uv)));
   // Object-space vectors go to world space by the inverse transpose (to_object is the inverse).

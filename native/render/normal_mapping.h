@@ -19,8 +19,10 @@ namespace toyrt {
 // normal map). Returns the new unit shading normal, on
 // ng's side as ns is; ns itself for a material without a normal map and, in tangent space, for
 // a mesh sent without tangents (Cycles falls back to the unbent normal there too).
+// footprint: the ray cone's width at the hit in metres (camera/ray_cone.h), read only by bump maps
+// that difference over it (MaterialNormalMap::bump_footprint); 0 gives them the slope at the point.
 Vec3 normal_mapped(const Scene& scene, const Hit& hit, int32_t material, const Vec3& wo, const Vec3& ng, const Vec3& ns,
-                   const Vec2& uv);
+                   const Vec2& uv, float footprint = 0.0f);
 
 // Cycles' bump shadowing (materials/bump_shadowing.h) on the diffuse part of a normal-mapped
 // hit's answer `sc`, carried by the integrator's Burley path (Scatter::burley, BurleyDiffuse):

@@ -4,6 +4,7 @@
 // strings users pass.
 #pragma once
 
+#include "camera/ray_cone.h"
 #include "lights/area_light.h"
 #include "render/adaptive_sampling.h"
 
@@ -44,6 +45,10 @@ struct IntegratorSettings {
   // what remains of it along its path is blocked. >= 0. Within one path the integrator lowers it
   // by each crossing, so shadow rays read what remains.
   int transparent_max_bounces = 8;
+  // Not a user setting: render() points it at its camera's constants for Cycles 3.x's ray
+  // footprints (camera/ray_cone.h), read only by bump maps that difference over a footprint.
+  // Null: zero footprints (those bumps take the slope at the point).
+  const CameraCone* camera_cone = nullptr;
 };
 
 struct RenderSettings {

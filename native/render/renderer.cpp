@@ -283,6 +283,8 @@ RenderResult render(const Scene& scene, const Camera& camera, const RenderSettin
   RenderSettings settings = requested;
   settings.integrator.light_sampling =
       resolve_light_sampling(requested.integrator.light_sampling, scene.world().lights.size());
+  const CameraCone camera_cone = CameraCone::of(camera);
+  settings.integrator.camera_cone = &camera_cone;
   const auto start = std::chrono::steady_clock::now();
   const PixelWindow win = camera.window;
   const size_t needed = render_memory_estimate(camera, settings, passes), available = available_memory_bytes();

@@ -121,6 +121,7 @@ uint32_t Scene::add_material(const Material& material, const MaterialEmission& e
   mixes_.emplace_back();
   any_transparency_ = any_transparency_ || transparency.transparent();
   any_normal_map_ = any_normal_map_ || normal_map.active();
+  any_bump_footprint_ = any_bump_footprint_ || (normal_map.active() && normal_map.bump && normal_map.bump_footprint);
   if (emission.emits()) {
     any_emission_ = true;
     committed_ = false;
@@ -145,6 +146,9 @@ void Scene::set_material(int64_t material, const Material& replacement, const Ma
   }
   any_normal_map_ =
       std::any_of(normal_maps_.begin(), normal_maps_.end(), [](const MaterialNormalMap& n) { return n.active(); });
+  any_bump_footprint_ = std::any_of(normal_maps_.begin(), normal_maps_.end(), [](const MaterialNormalMap& n) {
+    return n.active() && n.bump && n.bump_footprint;
+  });
   any_transparency_ = std::any_of(transparency_.begin(), transparency_.end(),
                                   [](const MaterialTransparency& t) { return t.transparent(); });
   if (!(emission_[size_t(material)] == emission)) {

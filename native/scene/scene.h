@@ -205,6 +205,9 @@ class Scene {
   // Whether some material has a normal map: only then does a hit look one up
   // (render/normal_mapping.h), so other scenes run the code they ran before.
   bool any_normal_map() const { return any_normal_map_; }
+  // Some bump map differences over the ray's footprint (MaterialNormalMap::bump_footprint): only
+  // then does the integrator carry ray cones (camera/ray_cone.h).
+  bool any_bump_footprint() const { return any_bump_footprint_; }
   // Mix and Add Shaders of other materials (materials/material_mix.h): material `material`
   // becomes a mix of two materials added before it; set_material makes it a plain material
   // again. Throws std::invalid_argument for an unknown id or child.
@@ -272,6 +275,7 @@ class Scene {
   bool any_transparency_ = false;
   std::vector<MaterialNormalMap> normal_maps_;  // parallel to materials_
   bool any_normal_map_ = false;
+  bool any_bump_footprint_ = false;
   std::vector<MaterialMix> mixes_;  // parallel to materials_
   bool any_mix_ = false;
   MeshEmitters emitters_;

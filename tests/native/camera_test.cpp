@@ -1,7 +1,10 @@
 // Blender's camera against closed forms: the pinhole angles set by lens and sensor fit, shift,
 // pixel aspect, orthographic extent, clip planes, the render border, and a round trip through an
-// independently written pinhole projection.
+// independently written pinhole projection. The ray cones of Cycles 3.x's footprints: a
+// perspective ray's spread is the chord of the angle one pixel turns it by, an orthographic ray's
+// width one pixel.
 #include "camera/camera.h"
+#include "camera/ray_cone.h"
 
 #include <gtest/gtest.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -464,4 +467,41 @@ TEST(ThinLens, RejectsInvalidSettingsAndClampsZerosAsCycles) {
   EXPECT_FLOAT_EQ(cam.lens.focus_distance, 1e-5f);
   EXPECT_FLOAT_EQ(cam.lens.radius, 0.035f / 2e-5f);
   EXPECT_EQ(cam.lens.blades, 0);  // fewer than 3 blades: round
+}
+
+TEST(CameraCone, PerspectiveSpreadIsTheChordOfOnePixelsAngle) {
+  // 36 mm sensor, 50 mm lens, 100 x 100 pixels: one pixel is 0.0072 on the plane at unit depth.
+  CameraParams p;
+  p.resolution_x = p.resolution_y = 100;
+  p.matrix_world = some_camera_matrix();
+  const Camera cam = Camera::make(p);
+  const CameraCone cone = CameraCone::of(cam);
+  const double s = 36.0 / 50.0 / 100.0;
+  auto chord = [](double angle) { return 2.0 * std::sin(0.5 * angle); };
+  // Along the view axis both steps turn the ray by atan(s).
+  const RayCone centre = cone.of_ray(-cam.axis_z);
+  EXPECT_EQ(centre.width, 0.0f);
+  EXPECT_NEAR(centre.spread, chord(std::atan(s)), 1e-6);
+  // Through (0.3, 0) on the unit-depth plane: the x step turns it by atan(0.3 + s) - atan(0.3),
+  // the y step by the angle between (0.3, 0, -1) and (0.3, s, -1).
+  const Vec3 dir = glm::normalize(0.3f * cam.axis_x - cam.axis_z);
+  const double along_x = std::atan(0.3 + s) - std::atan(0.3);
+  const double along_y = std::acos((0.09 + 1.0) / (std::sqrt(1.09) * std::sqrt(1.09 + s * s)));
+  EXPECT_NEAR(cone.of_ray(dir).spread, 0.5 * (chord(along_x) + chord(along_y)), 2e-6);
+  EXPECT_NEAR(cone.of_ray(dir).at(4.0f), 4.0 * 0.5 * (chord(along_x) + chord(along_y)), 1e-5);
+}
+
+TEST(CameraCone, OrthographicWidthIsOnePixelAndDoesNotSpread) {
+  CameraParams p;
+  p.type = CameraType::Orthographic;
+  p.ortho_scale = 6.0f;
+  p.resolution_x = 200;
+  p.resolution_y = 100;
+  const Camera cam = Camera::make(p);
+  const RayCone cone = CameraCone::of(cam).of_ray(-cam.axis_z);
+  EXPECT_FLOAT_EQ(cone.width, 6.0f / 200.0f);
+  EXPECT_EQ(cone.spread, 0.0f);
+  EXPECT_FLOAT_EQ(cone.at(100.0f), 6.0f / 200.0f);
+  // A camera without constants (CameraCone{}): zero cones, the slope at the point.
+  EXPECT_EQ(CameraCone{}.of_ray(Vec3(0, 0, -1)).spread, 0.0f);
 }
