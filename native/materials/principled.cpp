@@ -240,9 +240,11 @@ Scatter opaque_scatter(const Principled& m, const ShadingPoint& s, const Materia
 // by the rest; the layers below are attenuated and tinted on both draws, the diffuse part kept.
 // 3.x's Clearcoat beside what opaque_scatter answers (materials/clearcoat.h), added as Cycles 3.x
 // adds its closure, nothing below attenuated: its lobe, 0.25 x Clearcoat times the Fresnel term of
-// IOR 1.5, drawn with probability coat / 2 (its weight divided by that), else the answer below with
-// its lobe divided by the rest; the diffuse part is kept on both draws. A Transmission's glass
-// draw carries no clearcoat, so the opaque draws carry it over their share of the draws.
+// IOR 1.5. Without a glass draw (u < 0) the closures are answered side by side, as Cycles mixes
+// them (materials/closure_mixture.h). After the opaque share of a Transmission's glass draw (u >= 0:
+// the rest of that number) the clearcoat is drawn with probability coat / 2 (its weight divided by
+// that), else the answer below with its lobe divided by the rest; the diffuse part is kept on both
+// draws. The glass draw carries no clearcoat, so the opaque draws carry it over their share.
 Scatter clearcoated(const Principled& m, const ShadingPoint& s, const MaterialContext& ctx, const Vec3& albedo,
                     float scale, float u) {
   GlossyLobe coat = oriented_lobe(s, m.coat_roughness, GgxShadowing::Separable);
@@ -271,10 +273,9 @@ Scatter clearcoated(const Principled& m, const ShadingPoint& s, const MaterialCo
     sc.closure_pick = weights / total;
     return sc;
   }
-  const float v = u;
   const float p = 0.5f * m.coat;
-  Scatter sc = opaque_scatter(m, s, ctx, albedo, scale, std::min(std::max(v - p, 0.0f) / (1.0f - p), 0x1.fffffep-1f));
-  if (!(v < p)) {
+  Scatter sc = opaque_scatter(m, s, ctx, albedo, scale, std::min(std::max(u - p, 0.0f) / (1.0f - p), 0x1.fffffep-1f));
+  if (!(u < p)) {
     if (sc.kind == Scatter::Kind::Glossy) sc.glossy.tint /= 1.0f - p;
     return sc;
   }

@@ -16,10 +16,9 @@ LobeAnswer lobe_towards(const LobeVertex& v, const Vec3& wi) {
     if (a.cos <= 0.0f || glm::dot(v.ng, wi) <= 0.0f) return a;
     a.e = mixture_eval(*v.mixture, wi);
     a.origin = v.above;
-    // As Cycles' light samples at such a vertex count a lamp for all its closures, by the kind
-    // of ray the picked closure would send: glossy, whose visibility decides here (a lamp seen
-    // by glossy rays but hidden from diffuse ones still lights the diffuse part: noted in
-    // docs/render.md).
+    // One visibility for the whole mixture, the glossy closures': a lamp hidden from glossy rays
+    // alone leaves the diffuse part unlit here too, and one hidden from diffuse rays alone still
+    // lights it (docs/render.md, 3.x's Clearcoat).
     a.seen_by = kVisibleGlossy;
     return a;
   }
