@@ -118,6 +118,9 @@ bool rough_dielectric(const ShadingPoint& s, float ior, const DielectricRoughnes
   lobe->eta = glm::dot(s.wo, s.ng) > 0.0f ? ior : 1.0f / ior;
   lobe->kind = kind;
   lobe->fresnel_macro = kind == DielectricKind::Glass3x ? fresnel_dielectric(g.wo.z, lobe->eta) : 0.0f;
+  // Cycles 3.4 and 4.0+ both evaluate transmission pairs no microfacet refracts
+  // (materials/dielectric_lobe.h): light through a rough interface is counted as they count it.
+  lobe->unchecked_refraction = true;
   lobe->tint = lobe->transmit_tint = Vec3(1.0f);
   return true;
 }
@@ -168,9 +171,10 @@ Scatter scatter(const FresnelDielectric& m, const ShadingPoint& s, const Materia
   DielectricLobe lobe;
   if (rough_dielectric(s, m.ior, m.rough, m.macro_fresnel ? DielectricKind::Glass3x : DielectricKind::Glass, &lobe,
                        m.macro_fresnel ? m.transmit_roughness : -1.0f)) {
-    const float scale = m.albedo >= 0 ? multiscatter_glass_scale(dielectric_albedo_table(m.albedo),
-                                                                 glm::dot(s.wo, s.ng) > 0.0f, lobe.wo.z)
-                                      : 1.0f;
+    const Vec3 scale = m.albedo >= 0
+                           ? multiscatter_glass_factor(dielectric_albedo_table(m.albedo), glm::dot(s.wo, s.ng) > 0.0f,
+                                                       lobe.wo.z, m.transmit_tint)
+                           : Vec3(1.0f);
     lobe.tint = m.reflect_tint * scale;
     lobe.transmit_tint = m.transmit_tint * scale;
     return Scatter::dielectric_lobe(lobe);

@@ -101,20 +101,12 @@ float view_cosine(const ShadingPoint& s) {
 
 // Multiscatter GGX glass (4.0+): Cycles keeps in the closure's weight the share E (1 + F_ms (1 -
 // E) / E) of its energy compensation, with Fss the glass's transmission colour (sqrt of the base
-// colour) and E, E_avg the glass lobe's albedo and its cosine-weighted mean on this side (TOYRT's
-// table of the lobe, materials/dielectric_albedo.h). 1 for a white glass.
+// colour) and E, E_avg the glass's albedo as Cycles' tables give it and its cosine-weighted mean on
+// this side (materials/dielectric_albedo.h). 1 for a white glass.
 Vec3 glass_energy_share(const FresnelDielectric& glass, bool entering, float cos_o, const Vec3& fss) {
   if (glass.albedo < 0 || fss == Vec3(1.0f)) return Vec3(1.0f);
   const DielectricAlbedo& table = dielectric_albedo_table(glass.albedo);
-  const auto& e = entering ? table.entering : table.leaving;
-  double e_avg = 0.0;  // 2 int E(mu) mu dmu, trapezoids over the table's points
-  for (int i = 0; i < DielectricAlbedo::kMu; ++i) {
-    const double mu0 = double(i) / DielectricAlbedo::kMu, mu1 = double(i + 1) / DielectricAlbedo::kMu;
-    e_avg += (double(e[size_t(i)]) * mu0 + double(e[size_t(i) + 1]) * mu1) / DielectricAlbedo::kMu;
-  }
-  const float e_o = 1.0f / multiscatter_glass_scale(table, entering, cos_o), avg = float(e_avg);
-  const Vec3 f_ms = fss * avg / (Vec3(1.0f) - fss * (1.0f - avg));
-  return e_o * (Vec3(1.0f) + f_ms * (1.0f - e_o) / e_o);
+  return multiscatter_glass_factor(table, entering, cos_o, fss) / multiscatter_glass_scale(table, entering, cos_o);
 }
 
 // 4.0+: Cycles' Principled closures from the top (kernel/svm/closure.h), each adding its weight

@@ -41,7 +41,9 @@ TEST(PrincipledTransmission, TransmissionOneIsTheGlassBsdf) {
   const ShadingPoint inside = hit_from(-glm::normalize(Vec3(0.4f, 0.1f, 1.0f)));
   // 4.0+ (Multiscatter GGX, height-correlated masking) and 3.x (GGX, separable, macro Fresnel).
   for (const bool new_model : {true, false}) {
+    // A white base: the glass's transmission colour is then white, as the Glass BSDF's default.
     const Principled m = principled({{"transmission", 1.0},
+                                     {"color", Vec3(1.0f)},
                                      {"roughness", 0.3},
                                      {"ior", new_model ? 1.5 : 1.8},
                                      {"transmission_ior", 1.5},

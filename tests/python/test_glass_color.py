@@ -12,7 +12,12 @@ linear in the tints, pixel by pixel and sample by sample:
     Principled, base b, Specular Tint k = k * R + t(b) * T,   R + T = the white Principled glass
 
 with R the reflected light (the image of a black base, whose transmission is black) and t(b) =
-sqrt(b) (4.0+) or b (3.x, where k is not used: R white)."""
+sqrt(b) (4.0+) or b (3.x, where k is not used: R white).
+
+Multiscatter GGX glass (4.0+) is the exception, as in Cycles: its energy compensation keeps, per
+channel c of the transmission colour, the share E + F_ms (1 - E) of 1 / E, F_ms = c E_avg / (1 - c
+(1 - E_avg)) (materials/dielectric_albedo.h), which is not linear in c: a white channel is the
+white glass's, a darker one lies between c E and c times the white glass."""
 import numpy as np
 import pytest
 import toyrt
@@ -43,7 +48,7 @@ def close(a, b):
 GLASSES = [
     ("glass", dict(ior=1.5)),                                                    # sharp, split
     ("glass", dict(ior=1.5, roughness=0.3, fresnel="macro")),                    # 3.x's rough pair
-    ("glass", dict(ior=1.5, roughness=0.4, shadowing="correlated", multiscatter=True)),  # 4.0+
+    ("glass", dict(ior=1.5, roughness=0.4, shadowing="correlated")),             # 4.0+ (GGX)
     ("refraction", dict(ior=1.33)),
     ("refraction", dict(ior=1.33, roughness=0.25, distribution="beckmann")),
 ]
@@ -63,7 +68,7 @@ def test_glass_color_scales_every_path_through_it(kind, params):
 def test_principled_glass_takes_cycles_tints(version, roughness):
     new = version == "4.0+"
     common = dict(ior=1.45, transmission=1.0, transmission_ior=1.45, roughness=roughness, layered=new,
-                  burley=not new, multiscatter=new, shadowing="correlated" if new else "separable")
+                  burley=not new, multiscatter=False, shadowing="correlated" if new else "separable")
 
     def render(base, tint=(1.0, 1.0, 1.0)):
         return plane_scene("principled", color=base, specular_tint=tint, **common)
@@ -83,3 +88,24 @@ def test_bad_glass_colors_are_refused_by_name():
     for bad in [(float("nan"), 0.0, 0.0), (-0.1, 0.5, 0.5)]:
         with pytest.raises(ValueError, match="color"):
             toyrt.Scene().add_material("glass", color=bad)
+
+
+@pytest.mark.parametrize("kind", ["glass", "principled"])
+def test_multiscatter_glass_darkens_a_tinted_channel_as_cycles(kind):
+    params = dict(ior=1.5, roughness=0.4, shadowing="correlated", multiscatter=True)
+    c = np.array([1.0, 0.5, 0.2])
+    if kind == "principled":
+        # Its transmission colour is the square root of the base colour; a Specular Tint of the
+        # same colour makes the whole glass that colour, as the Glass BSDF's.
+        params.update(transmission=1.0, transmission_ior=1.5, layered=True)
+        white = plane_scene(kind, color=(1.0, 1.0, 1.0), **params)
+        tinted = plane_scene(kind, color=tuple(c ** 2), specular_tint=tuple(c), **params)
+    else:
+        white = plane_scene(kind, color=(1.0, 1.0, 1.0), **params)
+        tinted = plane_scene(kind, color=tuple(c), **params)
+    close(tinted[..., 0], white[..., 0])  # a white channel keeps 1 / E exactly
+    for ch in (1, 2):
+        linear = c[ch] * white[..., ch]
+        assert np.all(tinted[..., ch] <= linear * (1.0 + 1e-5) + 1e-7)
+        assert np.all(tinted[..., ch] >= 0.9 * linear)  # E > 0.9 at roughness 0.4 away from grazing
+        assert tinted[..., ch].mean() < linear.mean() * (1.0 - 1e-4)  # and darker than linear
