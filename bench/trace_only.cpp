@@ -11,7 +11,11 @@
 //   trace_only lbvh-all [rings] [repeats]     the whole LBVH commit on every core against Embree's
 //                                             Morton build (LOW quality, dynamic scene), interleaved,
 //                                             wall-clock medians, with the LBVH's stage times
+//   trace_only wide [rings]   the 8-wide layout of the SAH and LBVH trees, collapsed greedily and
+//                             by the SAH dynamic programme: children a node, SAH cost, collapse ms
+#include "accel/binned_sah_builder.h"
 #include "accel/lbvh_builder.h"
+#include "accel/wide_bvh.h"
 #include "embree_oracle.h"
 #include "geometry/triangle_block.h"
 #include "scene/scene.h"
@@ -68,6 +72,36 @@ int main(int argc, char** argv) {
     }
     std::sort(collapse_ms.begin(), collapse_ms.end());
     std::printf("  host collapse %.1f ms (median of 3)\n", collapse_ms[1]);
+    return 0;
+  }
+  if (kind == "wide") {
+    auto wall_ms = [] {
+      timespec ts;
+      clock_gettime(CLOCK_MONOTONIC, &ts);
+      return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+    };
+    const PrimitiveBounds prims = triangle_bounds(mesh);
+    BinnedSahConfig sah;
+    sah.leaf_without_search = kBlockWidth;  // as Mesh::build
+    const Bvh trees[2] = {build_binned_sah(prims.boxes.data(), prims.centers.data(), prims.boxes.size(), sah),
+                          build_lbvh(prims.boxes.data(), prims.centers.data(), prims.boxes.size())};
+    for (int t = 0; t < 2; ++t)
+      for (CollapseMethod method : {CollapseMethod::Greedy, CollapseMethod::Sah}) {
+        std::vector<double> ms;
+        WideBvh wide;
+        for (int k = 0; k < 3; ++k) {
+          const double start = wall_ms();
+          wide = collapse(trees[t], kBlockWidth, method);
+          ms.push_back(wall_ms() - start);
+        }
+        std::sort(ms.begin(), ms.end());
+        const WideStats st = wide_stats(wide, kBlockWidth);
+        std::printf(
+            "wide: %zu triangles, %s tree, %s collapse: %zu nodes, %.2f children a node, SAH cost %.2f, "
+            "collapse %.1f ms (median of 3)\n",
+            mesh.triangles.size(), t ? "LBVH" : "SAH", method == CollapseMethod::Sah ? "DP" : "greedy", st.nodes,
+            st.children_per_node, st.sah_cost, ms[1]);
+      }
     return 0;
   }
   if (kind == "commit" || kind == "commit-all") {
