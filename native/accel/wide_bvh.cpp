@@ -1,6 +1,7 @@
 #include "accel/wide_bvh.h"
 
 #include <algorithm>
+#include <array>
 #include <memory>
 #include <utility>
 
@@ -39,16 +40,18 @@ Ranges subtree_ranges(const Bvh& bvh) {
 // the thread count, so the layout (and every traversal result) is the same on any machine.
 constexpr uint32_t kParallelPrimitives = 32768;
 
-// The dynamic programme's answer for one binary interior node. Budget b = 1..kWidth is index
-// b - 1: the least cost of the subtree in at most b slots of a wide node, and how it is reached
-// (left[b - 1] and right[b - 1] slots to the two children; 0 and 0: the node takes one slot
-// itself, as the wide node that holds its children). `open_left`: the left child's share of the
-// kWidth slots of the node's own wide node (the right child's is kWidth minus it).
+// The dynamic programme's decisions for one binary interior node. Budget b = 1..kWidth is index
+// b - 1: how the least cost of the subtree in at most b slots of a wide node is reached, as the
+// slots given to the left child (low 4 bits) and to the right (high 4); 0: the node takes one
+// slot itself, as the wide node that holds its children. `open_left`: the left child's share of
+// the kWidth slots of the node's own wide node (the right child's is kWidth minus it). Only the
+// decisions are kept (9 bytes a node): the costs pass from children to parent on the stack, as
+// the LBVH's 2M binary nodes at 1M triangles made a kept cost table 80 MB of fresh pages.
 struct Plan {
-  float cost[kWidth];
-  uint8_t left[kWidth], right[kWidth];
+  uint8_t split[kWidth];
   uint8_t open_left;
 };
+using Costs = std::array<float, kWidth>;  // by budget - 1
 
 struct Planner {
   const Bvh& bvh;
@@ -57,28 +60,23 @@ struct Planner {
   Plan* plan;  // by binary node; written for interior nodes that are not collapsed leaves
 
   bool is_leaf(uint32_t i) const { return bvh.nodes[i].is_leaf() || range[i].count <= leaf_size; }
-  // The cost of binary node i held in at most `budget` slots.
-  float cost(uint32_t i, int budget) const {
-    if (!is_leaf(i)) return plan[i].cost[budget - 1];
-    const uint32_t blocks = (range[i].count + leaf_size - 1) / leaf_size;
-    return float(kBlockCost) * bvh.nodes[i].bbox().half_area() * float(blocks);
-  }
 
-  // Bottom up. Each node's plan depends on its subtree alone, so the parallel split (by a fixed
-  // primitive count) gives the same plans as the serial walk.
-  void solve(uint32_t i) const {
-    if (is_leaf(i)) return;
-    const uint32_t l = bvh.nodes[i].first, r = l + 1;
-    if (range[i].count > kParallelPrimitives) {
-      tbb::parallel_invoke([&] { solve(l); }, [&] { solve(r); });
-    } else {
-      solve(l);
-      solve(r);
+  // Bottom up: the costs of binary node i in at most 1..kWidth slots. Each node's plan depends on
+  // its subtree alone, so the parallel split (by a fixed primitive count) gives the serial plans.
+  Costs solve(uint32_t i) const {
+    Costs out;
+    if (is_leaf(i)) {  // the same in any budget: one collapsed leaf
+      const uint32_t blocks = (range[i].count + leaf_size - 1) / leaf_size;
+      out.fill(float(kBlockCost) * bvh.nodes[i].bbox().half_area() * float(blocks));
+      return out;
     }
-    float left_cost[kWidth], right_cost[kWidth];
-    for (int b = 1; b < kWidth; ++b) {
-      left_cost[b] = cost(l, b);
-      right_cost[b] = cost(r, b);
+    const uint32_t l = bvh.nodes[i].first, r = l + 1;
+    Costs left_cost, right_cost;
+    if (range[i].count > kParallelPrimitives) {
+      tbb::parallel_invoke([&] { left_cost = solve(l); }, [&] { right_cost = solve(r); });
+    } else {
+      left_cost = solve(l);
+      right_cost = solve(r);
     }
     Plan& p = plan[i];
     // Distributing b slots between the children, k to the left: the best k for every b.
@@ -88,7 +86,7 @@ struct Planner {
       spread[b] = kInfinity;
       spread_left[b] = 1;
       for (int k = 1; k < b; ++k) {
-        const float c = left_cost[k] + right_cost[b - k];
+        const float c = left_cost[size_t(k - 1)] + right_cost[size_t(b - k - 1)];
         if (c < spread[b]) {
           spread[b] = c;
           spread_left[b] = uint8_t(k);
@@ -97,21 +95,20 @@ struct Planner {
     }
     // One slot: the node as a wide node of its own, its children spread over kWidth slots.
     p.open_left = spread_left[kWidth];
-    p.cost[0] = float(kWideNodeCost) * bvh.nodes[i].bbox().half_area() + spread[kWidth];
-    p.left[0] = p.right[0] = 0;
+    out[0] = float(kWideNodeCost) * bvh.nodes[i].bbox().half_area() + spread[kWidth];
+    p.split[0] = 0;
     // More slots: the node opened into its parent (its children take the slots), or the
     // answer for one slot fewer, whichever is cheaper.
     for (int b = 2; b <= kWidth; ++b) {
-      if (spread[b] < p.cost[b - 2]) {
-        p.cost[b - 1] = spread[b];
-        p.left[b - 1] = spread_left[b];
-        p.right[b - 1] = uint8_t(b - spread_left[b]);
+      if (spread[b] < out[size_t(b - 2)]) {
+        out[size_t(b - 1)] = spread[b];
+        p.split[b - 1] = uint8_t(spread_left[b] | (b - spread_left[b]) << 4);
       } else {
-        p.cost[b - 1] = p.cost[b - 2];
-        p.left[b - 1] = p.left[b - 2];
-        p.right[b - 1] = p.right[b - 2];
+        out[size_t(b - 1)] = out[size_t(b - 2)];
+        p.split[b - 1] = p.split[b - 2];
       }
     }
+    return out;
   }
 };
 
@@ -126,12 +123,12 @@ struct Collapser {
 
   // The slots binary node i takes with `budget` of them, by its plan.
   void read_out(uint32_t i, int budget, uint32_t kids[kWidth], int& n) const {
-    if (is_leaf(i) || plan[i].left[budget - 1] == 0) {
+    if (is_leaf(i) || plan[i].split[budget - 1] == 0) {
       kids[n++] = i;
       return;
     }
-    read_out(bvh.nodes[i].first, plan[i].left[budget - 1], kids, n);
-    read_out(bvh.nodes[i].first + 1, plan[i].right[budget - 1], kids, n);
+    read_out(bvh.nodes[i].first, plan[i].split[budget - 1] & 15, kids, n);
+    read_out(bvh.nodes[i].first + 1, plan[i].split[budget - 1] >> 4, kids, n);
   }
 
   // The wide node for binary interior node `binary`: the slots of its plan, or (greedy) the
