@@ -46,8 +46,10 @@ enum class CollapseMethod {
   Sah,
 };
 
-// The SAH weights of a wide node visit and of one triangle block test (an 8-wide box test
-// against an 8-wide triangle test: the block test is the dearer, about 1.5 visits' instructions).
+// The SAH weights of a wide node visit and of one triangle block test (8 box tests against 8
+// triangle tests; the block's weight is an estimate). While every leaf is a collapsed subtree of
+// at most leaf_size primitives the leaves cost the same in every layout, and 1.0, 1.5 and 2.5
+// gave the same trees (docs/trace-speed.md, eighteenth session).
 inline constexpr double kWideNodeCost = 1.0, kBlockCost = 1.5;
 
 // Collapses a binary Bvh into wide nodes. A subtree of at most `leaf_size` primitives becomes
