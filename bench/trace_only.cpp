@@ -3,7 +3,8 @@
 // does not blur (bench_trace gives the speed against Embree). Prints rays, hits and a checksum of
 // the distances, so an A/B of two builds also shows that both found the same hits.
 //
-//   trace_only [primary|diffuse|shadow] [rings] [repeats] [embree]   (rings 708: the 1M-triangle sphere)
+//   trace_only [primary|diffuse|shadow] [rings] [repeats] [embree|room]   (rings 708: the 1M-triangle sphere;
+//                                         room: traced inside a closed room, see below)
 //   trace_only commit [rings] [repeats]   the whole single-thread SAH commit of a fresh scene, in
 //                                         CPU milliseconds (the process's CPU clock: one thread,
 //                                         so other work on the machine does not inflate it)
@@ -11,7 +12,11 @@
 //   trace_only lbvh-all [rings] [repeats]     the whole LBVH commit on every core against Embree's
 //                                             Morton build (LOW quality, dynamic scene), interleaved,
 //                                             wall-clock medians, with the LBVH's stage times
+//   trace_only wide [rings]   the 8-wide layout of the SAH and LBVH trees, collapsed greedily and
+//                             by the SAH dynamic programme: children a node, SAH cost, collapse ms
+#include "accel/binned_sah_builder.h"
 #include "accel/lbvh_builder.h"
+#include "accel/wide_bvh.h"
 #include "embree_oracle.h"
 #include "geometry/triangle_block.h"
 #include "scene/scene.h"
@@ -31,6 +36,7 @@ int main(int argc, char** argv) {
   const std::string kind = argc > 1 ? argv[1] : "diffuse";
   const int rings = argc > 2 ? std::atoi(argv[2]) : 224;
   const int repeats = argc > 3 ? std::atoi(argv[3]) : 1;
+  const bool room = argc > 4 && std::string(argv[4]) == "room";
   const MeshData mesh = uv_sphere(rings, rings, 1.0f, 0.15f);
   if (kind == "lbvh-all") {
     auto wall_ms = [] {
@@ -68,6 +74,36 @@ int main(int argc, char** argv) {
     }
     std::sort(collapse_ms.begin(), collapse_ms.end());
     std::printf("  host collapse %.1f ms (median of 3)\n", collapse_ms[1]);
+    return 0;
+  }
+  if (kind == "wide") {
+    auto wall_ms = [] {
+      timespec ts;
+      clock_gettime(CLOCK_MONOTONIC, &ts);
+      return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+    };
+    const PrimitiveBounds prims = triangle_bounds(mesh);
+    BinnedSahConfig sah;
+    sah.leaf_without_search = kBlockWidth;  // as Mesh::build
+    const Bvh trees[2] = {build_binned_sah(prims.boxes.data(), prims.centers.data(), prims.boxes.size(), sah),
+                          build_lbvh(prims.boxes.data(), prims.centers.data(), prims.boxes.size())};
+    for (int t = 0; t < 2; ++t)
+      for (CollapseMethod method : {CollapseMethod::Greedy, CollapseMethod::Sah}) {
+        std::vector<double> ms;
+        WideBvh wide;
+        for (int k = 0; k < 3; ++k) {
+          const double start = wall_ms();
+          wide = collapse(trees[t], kBlockWidth, method);
+          ms.push_back(wall_ms() - start);
+        }
+        std::sort(ms.begin(), ms.end());
+        const WideStats st = wide_stats(wide, kBlockWidth);
+        std::printf(
+            "wide: %zu triangles, %s tree, %s collapse: %zu nodes, %.2f children a node, SAH cost %.2f, "
+            "collapse %.1f ms (median of 3)\n",
+            mesh.triangles.size(), t ? "LBVH" : "SAH", method == CollapseMethod::Sah ? "DP" : "greedy", st.nodes,
+            st.children_per_node, st.sah_cost, ms[1]);
+      }
     return 0;
   }
   if (kind == "commit" || kind == "commit-all") {
@@ -114,15 +150,24 @@ int main(int argc, char** argv) {
   // instruction counts side by side (under valgrind Embree runs its AVX2 kernels).
   const bool embree = argc > 4 && std::string(argv[4]) == "embree";
   const EmbreeScene peer(mesh.vertices, mesh.triangles, false, 1);
+  // "room" as the fourth argument: the same rays traced in the mesh inside a closed room of 12
+  // triangles (bench_trace's closed room: with the light outside, a wall blocks every shadow ray).
+  Scene in_room;
+  if (room) {
+    const MeshData walled = in_closed_room(mesh, 0.5f);
+    in_room.add_instance(in_room.add_mesh(walled.vertices, walled.triangles), Mat4(1.0f));
+    in_room.commit();
+  }
+  const Scene& target = room ? in_room : scene;
   const bool shadow = kind == "shadow";  // compared once: a string compare per ray would be counted too
   size_t found = 0;
   double checksum = 0.0;
   for (int k = 0; k < repeats; ++k)
     for (const Ray& r : rays) {
       if (shadow) {
-        found += embree ? peer.occluded(r) : scene.occluded(r);
+        found += embree ? peer.occluded(r) : target.occluded(r);
       } else {
-        const Hit h = embree ? peer.intersect(r) : scene.intersect(r);
+        const Hit h = embree ? peer.intersect(r) : target.intersect(r);
         if (h.found()) {
           ++found;
           checksum += h.t;

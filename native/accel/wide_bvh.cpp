@@ -1,9 +1,12 @@
 #include "accel/wide_bvh.h"
 
 #include <algorithm>
+#include <array>
+#include <memory>
 #include <utility>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 namespace toyrt {
 
@@ -37,22 +40,111 @@ Ranges subtree_ranges(const Bvh& bvh) {
 // the thread count, so the layout (and every traversal result) is the same on any machine.
 constexpr uint32_t kParallelPrimitives = 32768;
 
+// The dynamic programme's decisions for one binary interior node. Budget b = 1..kWidth is index
+// b - 1: how the least cost of the subtree in at most b slots of a wide node is reached, as the
+// slots given to the left child (low 4 bits) and to the right (high 4); 0: the node takes one
+// slot itself, as the wide node that holds its children. `open_left`: the left child's share of
+// the kWidth slots of the node's own wide node (the right child's is kWidth minus it). Only the
+// decisions are kept (9 bytes a node): the costs pass from children to parent on the stack, as
+// the LBVH's 2M binary nodes at 1M triangles made a kept cost table 80 MB of fresh pages.
+struct Plan {
+  uint8_t split[kWidth];
+  uint8_t open_left;
+};
+using Costs = std::array<float, kWidth>;  // by budget - 1
+
+struct Planner {
+  const Bvh& bvh;
+  const Ranges& range;
+  uint32_t leaf_size;
+  Plan* plan;  // by binary node; written for interior nodes that are not collapsed leaves
+
+  bool is_leaf(uint32_t i) const { return bvh.nodes[i].is_leaf() || range[i].count <= leaf_size; }
+
+  // Bottom up: the costs of binary node i in at most 1..kWidth slots. Each node's plan depends on
+  // its subtree alone, so the parallel split (by a fixed primitive count) gives the serial plans.
+  Costs solve(uint32_t i) const {
+    Costs out;
+    if (is_leaf(i)) {  // the same in any budget: one collapsed leaf
+      const uint32_t blocks = (range[i].count + leaf_size - 1) / leaf_size;
+      out.fill(float(kBlockCost) * bvh.nodes[i].bbox().half_area() * float(blocks));
+      return out;
+    }
+    const uint32_t l = bvh.nodes[i].first, r = l + 1;
+    Costs left_cost, right_cost;
+    if (range[i].count > kParallelPrimitives) {
+      tbb::parallel_invoke([&] { left_cost = solve(l); }, [&] { right_cost = solve(r); });
+    } else {
+      left_cost = solve(l);
+      right_cost = solve(r);
+    }
+    Plan& p = plan[i];
+    // Distributing b slots between the children, k to the left: the best k for every b.
+    float spread[kWidth + 1];
+    uint8_t spread_left[kWidth + 1];
+    for (int b = 2; b <= kWidth; ++b) {
+      spread[b] = kInfinity;
+      spread_left[b] = 1;
+      for (int k = 1; k < b; ++k) {
+        const float c = left_cost[size_t(k - 1)] + right_cost[size_t(b - k - 1)];
+        if (c < spread[b]) {
+          spread[b] = c;
+          spread_left[b] = uint8_t(k);
+        }
+      }
+    }
+    // One slot: the node as a wide node of its own, its children spread over kWidth slots.
+    p.open_left = spread_left[kWidth];
+    out[0] = float(kWideNodeCost) * bvh.nodes[i].bbox().half_area() + spread[kWidth];
+    p.split[0] = 0;
+    // More slots: the node opened into its parent (its children take the slots), or the
+    // answer for one slot fewer, whichever is cheaper.
+    for (int b = 2; b <= kWidth; ++b) {
+      if (spread[b] < out[size_t(b - 2)]) {
+        out[size_t(b - 1)] = spread[b];
+        p.split[b - 1] = uint8_t(spread_left[b] | (b - spread_left[b]) << 4);
+      } else {
+        out[size_t(b - 1)] = out[size_t(b - 2)];
+        p.split[b - 1] = p.split[b - 2];
+      }
+    }
+    return out;
+  }
+};
+
 struct Collapser {
   using Nodes = std::vector<WideNode, HugePageAllocator<WideNode>>;
   const Bvh& bvh;
   const Ranges& range;
   uint32_t leaf_size;
+  const Plan* plan;  // null: the greedy collapse
 
   bool is_leaf(uint32_t i) const { return bvh.nodes[i].is_leaf() || range[i].count <= leaf_size; }
 
-  // The wide node for binary interior node `binary`: its children are the binary node's two, then
-  // the largest (by surface area) interior one is opened until kWidth are held. Leaf slots are
+  // The slots binary node i takes with `budget` of them, by its plan.
+  void read_out(uint32_t i, int budget, uint32_t kids[kWidth], int& n) const {
+    if (is_leaf(i) || plan[i].split[budget - 1] == 0) {
+      kids[n++] = i;
+      return;
+    }
+    read_out(bvh.nodes[i].first, plan[i].split[budget - 1] & 15, kids, n);
+    read_out(bvh.nodes[i].first + 1, plan[i].split[budget - 1] >> 4, kids, n);
+  }
+
+  // The wide node for binary interior node `binary`: the slots of its plan, or (greedy) the
+  // binary node's two children, then the largest (by surface area) interior one opened until
+  // kWidth are held. Leaf slots are
   // final; an interior slot's child field holds its binary node until the caller places it.
   int gather(uint32_t binary, WideNode& node, uint32_t kids[kWidth]) const {
     kids[0] = bvh.nodes[binary].first;
     kids[1] = bvh.nodes[binary].first + 1;
     int n = 2;
-    while (n < kWidth) {
+    if (plan) {
+      n = 0;
+      read_out(bvh.nodes[binary].first, plan[binary].open_left, kids, n);
+      read_out(bvh.nodes[binary].first + 1, kWidth - plan[binary].open_left, kids, n);
+    }
+    while (!plan && n < kWidth) {
       int best = -1;
       float best_area = -1.0f;
       for (int i = 0; i < n; ++i) {
@@ -152,7 +244,7 @@ struct Collapser {
 };
 }  // namespace
 
-WideBvh collapse(const Bvh& bvh, uint32_t leaf_size) {
+WideBvh collapse(const Bvh& bvh, uint32_t leaf_size, CollapseMethod method) {
   WideBvh wide;
   if (bvh.nodes.empty()) return wide;
   // The builder's ranges where it wrote them (the LBVH's: its two million binary nodes at 1M
@@ -160,7 +252,14 @@ WideBvh collapse(const Bvh& bvh, uint32_t leaf_size) {
   const bool given = bvh.ranges.size() == bvh.nodes.size();
   const Ranges walked = given ? Ranges{} : subtree_ranges(bvh);
   const Ranges& range = given ? bvh.ranges : walked;
-  const Collapser c{bvh, range, leaf_size};
+  leaf_size = std::max(leaf_size, 1u);
+  // Not zeroed: only interior nodes' plans are written, and only they are read.
+  std::unique_ptr<Plan[]> plans;
+  if (method == CollapseMethod::Sah) {
+    plans.reset(new Plan[bvh.nodes.size()]);
+    Planner{bvh, range, leaf_size, plans.get()}.solve(0);
+  }
+  const Collapser c{bvh, range, leaf_size, plans.get()};
   if (c.is_leaf(0)) {
     wide.root_leaf_first = range[0].first;
     wide.root_leaf_count = range[0].count;
@@ -169,6 +268,40 @@ WideBvh collapse(const Bvh& bvh, uint32_t leaf_size) {
   wide.nodes.reserve(bvh.nodes.size() / (kWidth - 1) + 1);
   c.expand_alone(0, wide.nodes);
   return wide;
+}
+
+WideStats wide_stats(const WideBvh& wide, uint32_t block_width) {
+  WideStats s;
+  block_width = std::max(block_width, 1u);
+  auto blocks = [&](uint32_t count) { return double((count + block_width - 1) / block_width); };
+  if (wide.nodes.empty()) {
+    s.sah_cost = kBlockCost * blocks(wide.root_leaf_count);
+    return s;
+  }
+  auto slot_box = [](const WideNode& n, int i) {
+    BBox b;
+    b.lo = {n.bounds[0][i], n.bounds[1][i], n.bounds[2][i]};
+    b.hi = {n.bounds[3][i], n.bounds[4][i], n.bounds[5][i]};
+    return b;
+  };
+  auto used = [](const WideNode& n, int i) { return n.bounds[0][i] <= n.bounds[3][i]; };
+  BBox root;
+  for (int i = 0; i < kWidth; ++i)
+    if (used(wide.nodes[0], i)) root.extend(slot_box(wide.nodes[0], i));
+  const double root_area = root.half_area();
+  size_t children = 0;
+  double cost = kWideNodeCost;  // the root, visited by every ray
+  for (const WideNode& n : wide.nodes)
+    for (int i = 0; i < kWidth; ++i) {
+      if (!used(n, i)) continue;
+      ++children;
+      const double p = root_area > 0.0 ? slot_box(n, i).half_area() / root_area : 1.0;
+      cost += p * (n.count[i] ? kBlockCost * blocks(n.count[i]) : kWideNodeCost);
+    }
+  s.nodes = wide.nodes.size();
+  s.children_per_node = double(children) / double(s.nodes);
+  s.sah_cost = cost;
+  return s;
 }
 
 }  // namespace toyrt

@@ -33,11 +33,37 @@ struct WideBvh {
   bool empty() const { return nodes.empty() && root_leaf_count == 0; }
 };
 
-// Collapses a binary Bvh: each wide node takes the children of a binary node and keeps opening
-// the largest (by surface area) interior child among them until it holds kWidth children. A
-// subtree of at most `leaf_size` primitives becomes one leaf (a subtree's primitives are
-// contiguous in prim_ids, since builders partition top-down), so small leaves do not leave wide
-// nodes half empty.
-WideBvh collapse(const Bvh& bvh, uint32_t leaf_size = 1);
+// How collapse() chooses which binary nodes a wide node opens.
+enum class CollapseMethod {
+  // Opens the largest (by surface area) interior child until kWidth children are held.
+  Greedy,
+  // A bottom-up dynamic programme over the binary tree (after Ylitie, Karras and Laine 2017,
+  // "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", section 4): for
+  // every binary node and every budget of 1..kWidth slots, the least SAH cost of its subtree
+  // held in that many slots, then the decisions read out top-down. Greedy fills the top of each
+  // node and leaves narrow nodes near the bottom (a subtree of 12-24 triangles as a node of two
+  // or three leaves); the programme spends slots where they save the most node visits.
+  Sah,
+};
+
+// The SAH weights of a wide node visit and of one triangle block test (8 box tests against 8
+// triangle tests; the block's weight is an estimate). While every leaf is a collapsed subtree of
+// at most leaf_size primitives the leaves cost the same in every layout, and 1.0, 1.5 and 2.5
+// gave the same trees (docs/trace-speed.md, eighteenth session).
+inline constexpr double kWideNodeCost = 1.0, kBlockCost = 1.5;
+
+// Collapses a binary Bvh into wide nodes. A subtree of at most `leaf_size` primitives becomes
+// one leaf (a subtree's primitives are contiguous in prim_ids, since builders partition
+// top-down), so small leaves do not leave wide nodes half empty.
+WideBvh collapse(const Bvh& bvh, uint32_t leaf_size = 1, CollapseMethod method = CollapseMethod::Sah);
+
+struct WideStats {
+  size_t nodes = 0;
+  double children_per_node = 0.0;
+  // Expected cost of a random ray (probability of a box = its area over the root's): kWideNodeCost
+  // a wide node visit, kBlockCost a block of up to `block_width` primitives in a leaf.
+  double sah_cost = 0.0;
+};
+WideStats wide_stats(const WideBvh& wide, uint32_t block_width);
 
 }  // namespace toyrt

@@ -1,0 +1,145 @@
+// collapse(): the 8-wide layout derived from a binary tree, greedy and by the SAH dynamic
+// programme. Structural invariants with known answers (every primitive in exactly one leaf, no
+// node narrower than two children), the programme's optimality against the greedy collapse under
+// the same cost, and a layout that does not depend on the thread count.
+#include "accel/wide_bvh.h"
+#include "accel/binned_sah_builder.h"
+#include "accel/lbvh_builder.h"
+#include "core/parallel.h"
+#include "test_scenes.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+using namespace toyrt;
+using namespace toyrt::testing;
+
+namespace {
+
+constexpr uint32_t kLeaf = 8;  // a mesh's block width
+
+Bvh sah_tree(const MeshData& m) {
+  const PrimitiveBounds p = triangle_bounds(m);
+  BinnedSahConfig config;
+  config.leaf_without_search = kLeaf;
+  return build_binned_sah(p.boxes.data(), p.centers.data(), p.boxes.size(), config);
+}
+
+Bvh lbvh_tree(const MeshData& m) {
+  const PrimitiveBounds p = triangle_bounds(m);
+  return build_lbvh(p.boxes.data(), p.centers.data(), p.boxes.size());
+}
+
+std::vector<MeshData> varied_meshes() {
+  std::vector<MeshData> meshes;
+  for (uint64_t seed = 1; seed <= 6; ++seed) meshes.push_back(triangle_soup(200 * seed * seed, 0.05f, seed));
+  meshes.push_back(uv_sphere(40, 40, 1.0f, 0.15f));
+  meshes.push_back(in_closed_room(uv_sphere(30, 30), 0.5f));
+  meshes.push_back(slivers(3000, 7));
+  meshes.push_back(triangle_soup(5, 0.3f, 9));  // one leaf: no wide node at all
+  return meshes;
+}
+
+const CollapseMethod kMethods[] = {CollapseMethod::Greedy, CollapseMethod::Sah};
+
+// Walks the wide tree from the root: counts how often each primitive slot and each node is
+// reached, and checks node shapes as it goes.
+void check_structure(const WideBvh& wide, const Bvh& bvh, uint32_t leaf_size) {
+  std::vector<int> prim_seen(bvh.prim_ids.size(), 0), node_seen(wide.nodes.size(), 0);
+  if (wide.nodes.empty()) {
+    ASSERT_EQ(wide.root_leaf_count, bvh.prim_ids.size());
+    return;
+  }
+  std::vector<uint32_t> stack{0};
+  node_seen[0] = 1;
+  while (!stack.empty()) {
+    const WideNode& n = wide.nodes[stack.back()];
+    stack.pop_back();
+    int children = 0;
+    for (int i = 0; i < kWidth; ++i) {
+      if (n.bounds[0][i] > n.bounds[3][i]) continue;  // an empty slot
+      ++children;
+      if (n.count[i]) {
+        EXPECT_LE(n.count[i], leaf_size);
+        for (uint32_t k = 0; k < n.count[i]; ++k) ++prim_seen[n.child[i] + k];
+      } else {
+        ASSERT_LT(n.child[i], wide.nodes.size());
+        ++node_seen[n.child[i]];
+        stack.push_back(n.child[i]);
+      }
+    }
+    EXPECT_GE(children, 2);  // a wide node of one child is a visit for nothing
+  }
+  for (size_t k = 0; k < prim_seen.size(); ++k) ASSERT_EQ(prim_seen[k], 1) << "primitive slot " << k;
+  for (size_t k = 0; k < node_seen.size(); ++k) ASSERT_EQ(node_seen[k], 1) << "wide node " << k;
+}
+
+}  // namespace
+
+TEST(WideBvh, EveryPrimitiveInExactlyOneLeafAndEveryNodeReachedOnce) {
+  for (const MeshData& m : varied_meshes())
+    for (const Bvh& bvh : {sah_tree(m), lbvh_tree(m)})
+      for (CollapseMethod method : kMethods) {
+        SCOPED_TRACE(m.triangles.size());
+        check_structure(collapse(bvh, kLeaf, method), bvh, kLeaf);
+      }
+}
+
+// The greedy collapse is one of the layouts the programme chooses among (each of its nodes holds
+// at most 8 slots, each slot a collapsed leaf or a node of its own), so the programme's SAH cost
+// is never above it.
+TEST(WideBvh, SahCollapseCostsNoMoreThanTheGreedyOne) {
+  int cheaper = 0, cases = 0;
+  for (const MeshData& m : varied_meshes())
+    for (const Bvh& bvh : {sah_tree(m), lbvh_tree(m)}) {
+      const double greedy = wide_stats(collapse(bvh, kLeaf, CollapseMethod::Greedy), kLeaf).sah_cost;
+      const double dp = wide_stats(collapse(bvh, kLeaf, CollapseMethod::Sah), kLeaf).sah_cost;
+      EXPECT_LE(dp, greedy * (1.0 + 1e-5)) << m.triangles.size() << " triangles";  // float sums in the programme
+      cheaper += dp < greedy * (1.0 - 1e-3);
+      ++cases;
+    }
+  EXPECT_GT(cheaper, cases / 2);  // and on most trees strictly cheaper: the programme does something
+}
+
+// A complete binary tree of 64 equal, disjoint leaves of one primitive each (unit boxes along x,
+// built by hand): the least cost is the root of 8 nodes of 8 leaves (9 nodes, all full), which
+// both collapses find.
+TEST(WideBvh, BalancedTreeOf64LeavesCollapsesToNineFullNodes) {
+  Bvh bvh;
+  // Heap order: node k's children are 2k + 1 and 2k + 2, leaves at 63..126 hold primitive k - 63.
+  bvh.nodes.resize(127);
+  for (int k = 126; k >= 0; --k) {
+    Node& n = bvh.nodes[size_t(k)];
+    if (k >= 63) {
+      const float x = float(k - 63);
+      n.set_bbox({{x, 0.0f, 0.0f}, {x + 0.5f, 0.5f, 0.5f}});
+      n.first = uint32_t(k - 63);
+      n.count = 1;
+    } else {
+      BBox b = bvh.nodes[size_t(2 * k + 1)].bbox();
+      b.extend(bvh.nodes[size_t(2 * k + 2)].bbox());
+      n.set_bbox(b);
+      n.first = uint32_t(2 * k + 1);
+      n.count = 0;
+    }
+  }
+  for (uint32_t k = 0; k < 64; ++k) bvh.prim_ids.push_back(k);
+  for (CollapseMethod method : kMethods) {
+    const WideBvh wide = collapse(bvh, 1, method);
+    const WideStats s = wide_stats(wide, 1);
+    EXPECT_EQ(s.nodes, 9u);
+    EXPECT_DOUBLE_EQ(s.children_per_node, 8.0);
+    check_structure(wide, bvh, 1);
+  }
+}
+
+// The programme runs in parallel over large subtrees; the layout must be the serial one's.
+TEST(WideBvh, SahCollapseIsTheSameForAnyThreadCount) {
+  const Bvh bvh = sah_tree(uv_sphere(200, 200, 1.0f, 0.15f));  // 80K triangles: parallel subtrees
+  WideBvh one, many;
+  run_with_threads(1, [&] { one = collapse(bvh, kLeaf, CollapseMethod::Sah); });
+  run_with_threads(0, [&] { many = collapse(bvh, kLeaf, CollapseMethod::Sah); });
+  ASSERT_EQ(one.nodes.size(), many.nodes.size());
+  EXPECT_EQ(std::memcmp(one.nodes.data(), many.nodes.data(), one.nodes.size() * sizeof(WideNode)), 0);
+}
