@@ -53,13 +53,17 @@ struct Plan {
 };
 using Costs = std::array<float, kWidth>;  // by budget - 1
 
-struct Planner {
+// The binary tree as collapse() sees it: a subtree of at most leaf_size primitives is one leaf.
+struct CollapsedTree {
   const Bvh& bvh;
   const Ranges& range;
   uint32_t leaf_size;
-  Plan* plan;  // by binary node; written for interior nodes that are not collapsed leaves
 
   bool is_leaf(uint32_t i) const { return bvh.nodes[i].is_leaf() || range[i].count <= leaf_size; }
+};
+
+struct Planner : CollapsedTree {
+  Plan* plan;  // by binary node; written for interior nodes that are not collapsed leaves
 
   // Bottom up: the costs of binary node i in at most 1..kWidth slots. Each node's plan depends on
   // its subtree alone, so the parallel split (by a fixed primitive count) gives the serial plans.
@@ -112,14 +116,9 @@ struct Planner {
   }
 };
 
-struct Collapser {
+struct Collapser : CollapsedTree {
   using Nodes = std::vector<WideNode, HugePageAllocator<WideNode>>;
-  const Bvh& bvh;
-  const Ranges& range;
-  uint32_t leaf_size;
   const Plan* plan;  // null: the greedy collapse
-
-  bool is_leaf(uint32_t i) const { return bvh.nodes[i].is_leaf() || range[i].count <= leaf_size; }
 
   // The slots binary node i takes with `budget` of them, by its plan.
   void read_out(uint32_t i, int budget, uint32_t kids[kWidth], int& n) const {
@@ -133,31 +132,32 @@ struct Collapser {
 
   // The wide node for binary interior node `binary`: the slots of its plan, or (greedy) the
   // binary node's two children, then the largest (by surface area) interior one opened until
-  // kWidth are held. Leaf slots are
-  // final; an interior slot's child field holds its binary node until the caller places it.
+  // kWidth are held. Leaf slots are final; an interior slot's child field holds its binary node
+  // until the caller places it.
   int gather(uint32_t binary, WideNode& node, uint32_t kids[kWidth]) const {
-    kids[0] = bvh.nodes[binary].first;
-    kids[1] = bvh.nodes[binary].first + 1;
-    int n = 2;
+    const uint32_t left = bvh.nodes[binary].first, right = left + 1;
+    int n = 0;
     if (plan) {
-      n = 0;
-      read_out(bvh.nodes[binary].first, plan[binary].open_left, kids, n);
-      read_out(bvh.nodes[binary].first + 1, kWidth - plan[binary].open_left, kids, n);
-    }
-    while (!plan && n < kWidth) {
-      int best = -1;
-      float best_area = -1.0f;
-      for (int i = 0; i < n; ++i) {
-        const Node& c = bvh.nodes[kids[i]];
-        if (!is_leaf(kids[i]) && c.bbox().half_area() > best_area) {
-          best = i;
-          best_area = c.bbox().half_area();
+      read_out(left, plan[binary].open_left, kids, n);
+      read_out(right, kWidth - plan[binary].open_left, kids, n);
+    } else {
+      kids[n++] = left;
+      kids[n++] = right;
+      while (n < kWidth) {
+        int best = -1;
+        float best_area = -1.0f;
+        for (int i = 0; i < n; ++i) {
+          const Node& c = bvh.nodes[kids[i]];
+          if (!is_leaf(kids[i]) && c.bbox().half_area() > best_area) {
+            best = i;
+            best_area = c.bbox().half_area();
+          }
         }
+        if (best < 0) break;
+        const uint32_t opened = kids[best];
+        kids[best] = bvh.nodes[opened].first;
+        kids[n++] = bvh.nodes[opened].first + 1;
       }
-      if (best < 0) break;
-      const uint32_t opened = kids[best];
-      kids[best] = bvh.nodes[opened].first;
-      kids[n++] = bvh.nodes[opened].first + 1;
     }
     // Children by decreasing surface area: the order an any-hit walk visits them in. A large box
     // is the likelier to block a shadow ray (a wall beside a dense model: found at once instead
@@ -228,7 +228,7 @@ struct Collapser {
       const size_t base = out.size();
       auto moved = [&](WideNode w) {
         for (int i = 0; i < kWidth; ++i)
-          if (w.count[i] == 0 && w.bounds[0][i] <= w.bounds[3][i]) w.child[i] = uint32_t(base + w.child[i] - 1);
+          if (w.count[i] == 0 && w.used(i)) w.child[i] = uint32_t(base + w.child[i] - 1);
         return w;
       };
       out[first + size_t(j)] = moved(sub[0]);
@@ -257,9 +257,9 @@ WideBvh collapse(const Bvh& bvh, uint32_t leaf_size, CollapseMethod method) {
   std::unique_ptr<Plan[]> plans;
   if (method == CollapseMethod::Sah) {
     plans.reset(new Plan[bvh.nodes.size()]);
-    Planner{bvh, range, leaf_size, plans.get()}.solve(0);
+    Planner{{bvh, range, leaf_size}, plans.get()}.solve(0);
   }
-  const Collapser c{bvh, range, leaf_size, plans.get()};
+  const Collapser c{{bvh, range, leaf_size}, plans.get()};
   if (c.is_leaf(0)) {
     wide.root_leaf_first = range[0].first;
     wide.root_leaf_count = range[0].count;
@@ -284,16 +284,15 @@ WideStats wide_stats(const WideBvh& wide, uint32_t block_width) {
     b.hi = {n.bounds[3][i], n.bounds[4][i], n.bounds[5][i]};
     return b;
   };
-  auto used = [](const WideNode& n, int i) { return n.bounds[0][i] <= n.bounds[3][i]; };
   BBox root;
   for (int i = 0; i < kWidth; ++i)
-    if (used(wide.nodes[0], i)) root.extend(slot_box(wide.nodes[0], i));
+    if (wide.nodes[0].used(i)) root.extend(slot_box(wide.nodes[0], i));
   const double root_area = root.half_area();
   size_t children = 0;
   double cost = kWideNodeCost;  // the root, visited by every ray
   for (const WideNode& n : wide.nodes)
     for (int i = 0; i < kWidth; ++i) {
-      if (!used(n, i)) continue;
+      if (!n.used(i)) continue;
       ++children;
       const double p = root_area > 0.0 ? slot_box(n, i).half_area() / root_area : 1.0;
       cost += p * (n.count[i] ? kBlockCost * blocks(n.count[i]) : kWideNodeCost);

@@ -22,6 +22,9 @@ struct alignas(64) WideNode {
   // slot, as in Node.
   uint32_t child[kWidth];
   uint32_t count[kWidth];
+
+  // Whether slot i holds a child (an unused slot's box is empty).
+  bool used(int i) const { return bounds[0][i] <= bounds[3][i]; }
 };
 static_assert(sizeof(WideNode) == 256, "WideNode: 4 cache lines for 8 children");
 

@@ -36,13 +36,6 @@ float albedo_at(float alpha, float eta, GgxShadowing shadowing, float cos_o) {
   return float(sum / (kN * kN));
 }
 
-// Smith's Lambda of a direction at |cos| from the normal: a refraction that comes back to wo's
-// side is shadowed as if it were there.
-double lambda_at(double alpha2, double cos_abs) {
-  const double t2 = std::max(1.0 / (cos_abs * cos_abs) - 1.0, 0.0);
-  return 0.5 * (std::sqrt(1.0 + alpha2 * t2) - 1.0);
-}
-
 // E_avg of each side, trapezoids over the table's points.
 void set_averages(DielectricAlbedo& table) {
   for (int side = 0; side < 2; ++side) {
@@ -61,7 +54,7 @@ void set_averages(DielectricAlbedo& table) {
 double cycles_table_albedo(float alpha, float eta, float cos_o) {
   constexpr int kN = 128;
   const Vec3 wo(std::sqrt(std::max(0.0f, 1.0f - cos_o * cos_o)), 0.0f, cos_o);
-  const double a2 = double(alpha) * alpha, lo = lambda_at(a2, cos_o);
+  const double lo = ggx_lambda(alpha, wo);
   double sum = 0.0;
   for (int i = 0; i < kN; ++i) {
     for (int j = 0; j < kN; ++j) {
@@ -70,11 +63,12 @@ double cycles_table_albedo(float alpha, float eta, float cos_o) {
       if (!(c > 0.0f)) continue;
       const double f = fresnel_dielectric(c, eta);
       const Vec3 r = 2.0f * c * m - wo;
-      if (r.z > 0.0f) sum += f * (1.0 + lo) / (1.0 + lo + lambda_at(a2, r.z));
+      if (r.z > 0.0f) sum += f * (1.0 + lo) / (1.0 + lo + ggx_lambda(alpha, r));
       if (f < 1.0) {  // Snell at m (1 / eta: n_near / n_far); kept whichever side it lands on
         const double ei = 1.0 / eta, cos_t = std::sqrt(std::max(0.0, 1.0 - ei * ei * (1.0 - double(c) * c)));
         const Vec3 t = glm::normalize(-float(ei) * wo + float(ei * c - cos_t) * m);
-        if (t.z != 0.0f) sum += (1.0 - f) * (1.0 + lo) / (1.0 + lo + lambda_at(a2, std::abs(t.z)));
+        // A refraction that comes back to wo's side is shadowed as if it were there: Lambda at |t.z|.
+        if (t.z != 0.0f) sum += (1.0 - f) * (1.0 + lo) / (1.0 + lo + ggx_lambda(alpha, Vec3(t.x, t.y, std::abs(t.z))));
       }
     }
   }
