@@ -45,7 +45,8 @@ enum class CollapseMethod {
   // every binary node and every budget of 1..kWidth slots, the least SAH cost of its subtree
   // held in that many slots, then the decisions read out top-down. Greedy fills the top of each
   // node and leaves narrow nodes near the bottom (a subtree of 12-24 triangles as a node of two
-  // or three leaves); the programme spends slots where they save the most node visits.
+  // or three leaves); the programme spends slots where they save the most node visits. The
+  // root's own node is still opened greedily (largest first), for any-hit walks: see gather().
   Sah,
 };
 

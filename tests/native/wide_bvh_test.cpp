@@ -143,3 +143,36 @@ TEST(WideBvh, SahCollapseIsTheSameForAnyThreadCount) {
   ASSERT_EQ(one.nodes.size(), many.nodes.size());
   EXPECT_EQ(std::memcmp(one.nodes.data(), many.nodes.data(), one.nodes.size() * sizeof(WideNode)), 0);
 }
+
+// A dense model inside a closed room of 12 wall triangles (the last 12 of the mesh): the SAH
+// builder files walls along a chain of room-sized binary nodes, and an any-hit walk tests the
+// root's children largest first. Under either method the root's largest slot must be a leaf of
+// walls only, so a shadow ray blocked by one of them is decided by the first leaf it tests
+// instead of after a second node. The 1M-triangle sphere of bench_trace's closed room: with the
+// programme at the root too, its largest child was an interior node (smaller spheres, 20K to
+// 720K triangles, happened to pass either way).
+TEST(WideBvh, RootsLargestChildIsALeafOfWallsInAClosedRoom) {
+  const MeshData m = in_closed_room(uv_sphere(708, 708, 1.0f, 0.15f), 0.5f);
+  const uint32_t first_wall = uint32_t(m.triangles.size() - 12);
+  const Bvh bvh = sah_tree(m);
+  for (CollapseMethod method : kMethods) {
+    SCOPED_TRACE(::testing::Message() << m.triangles.size() << " triangles, method " << int(method));
+    const WideBvh wide = collapse(bvh, kLeaf, method);
+    ASSERT_FALSE(wide.nodes.empty());
+    const WideNode& root = wide.nodes[0];
+    int largest = -1;
+    float largest_area = -1.0f;
+    for (int i = 0; i < kWidth; ++i) {
+      if (!root.used(i)) continue;
+      const BBox b{{root.bounds[0][i], root.bounds[1][i], root.bounds[2][i]},
+                   {root.bounds[3][i], root.bounds[4][i], root.bounds[5][i]}};
+      if (b.half_area() > largest_area) {
+        largest = i;
+        largest_area = b.half_area();
+      }
+    }
+    EXPECT_EQ(largest, 0);  // slot order is decreasing area: the any-hit walk's first
+    ASSERT_GT(root.count[0], 0u) << "the root's largest child is an interior node";
+    for (uint32_t k = 0; k < root.count[0]; ++k) EXPECT_GE(bvh.prim_ids[root.child[0] + k], first_wall);
+  }
+}
