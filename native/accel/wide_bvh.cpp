@@ -65,9 +65,10 @@ struct CollapsedTree {
 struct Planner : CollapsedTree {
   Plan* plan;  // by binary node; written for interior nodes that are not collapsed leaves
 
-  // Bottom up: the costs of binary node i in at most 1..kWidth slots. Each node's plan depends on
-  // its subtree alone, so the parallel split (by a fixed primitive count) gives the serial plans.
-  Costs solve(uint32_t i) const {
+  // Bottom up: the costs of binary node i in at most 1..kWidth slots (parent_area: its parent's
+  // box's half area). Each node's plan depends on its subtree alone, so the parallel split (by a
+  // fixed primitive count) gives the serial plans.
+  Costs solve(uint32_t i, float parent_area = kInfinity) const {
     Costs out;
     if (is_leaf(i)) {  // the same in any budget: one collapsed leaf
       const uint32_t blocks = (range[i].count + leaf_size - 1) / leaf_size;
@@ -75,12 +76,17 @@ struct Planner : CollapsedTree {
       return out;
     }
     const uint32_t l = bvh.nodes[i].first, r = l + 1;
+    const float area_i = bvh.nodes[i].bbox().half_area();
+    // A node whose box is its parent's (a link of a chain: see kChainVisitWeight) weighs more as
+    // a wide node of its own, so the programme prefers to open it into its parent's slots.
+    const float visit =
+        float(kWideNodeCost) * area_i * (area_i >= 0.999f * parent_area ? float(kChainVisitWeight) : 1.0f);
     Costs left_cost, right_cost;
     if (range[i].count > kParallelPrimitives) {
-      tbb::parallel_invoke([&] { left_cost = solve(l); }, [&] { right_cost = solve(r); });
+      tbb::parallel_invoke([&] { left_cost = solve(l, area_i); }, [&] { right_cost = solve(r, area_i); });
     } else {
-      left_cost = solve(l);
-      right_cost = solve(r);
+      left_cost = solve(l, area_i);
+      right_cost = solve(r, area_i);
     }
     Plan& p = plan[i];
     // Distributing b slots between the children, k to the left: the best k for every b.
@@ -99,7 +105,7 @@ struct Planner : CollapsedTree {
     }
     // One slot: the node as a wide node of its own, its children spread over kWidth slots.
     p.open_left = spread_left[kWidth];
-    out[0] = float(kWideNodeCost) * bvh.nodes[i].bbox().half_area() + spread[kWidth];
+    out[0] = visit + spread[kWidth];
     p.split[0] = 0;
     // More slots: the node opened into its parent (its children take the slots), or the
     // answer for one slot fewer, whichever is cheaper.
@@ -134,20 +140,10 @@ struct Collapser : CollapsedTree {
   // binary node's two children, then the largest (by surface area) interior one opened until
   // kWidth are held. Leaf slots are final; an interior slot's child field holds its binary node
   // until the caller places it.
-  //
-  // The root (binary node 0) is opened greedily under either method. The programme minimises the
-  // expected cost of a walk that visits every box it enters; an any-hit walk stops at the first
-  // blocker and tests the root's children largest first, so what matters there is that large
-  // primitives sit in the root's own slots. A binary SAH tree can file a room's walls along a
-  // chain of room-sized nodes, each peeling off a slice of the model inside; greedy opening
-  // unrolls that chain (its nodes are the largest), and the walls' leaf becomes a root child. The
-  // programme had kept it a node deeper: the 1M sphere in a closed room traced its wall-blocked
-  // shadow rays 15 % slower (docs/trace-speed.md). Below the root every node follows the plan,
-  // so the cost still never exceeds the greedy collapse's.
   int gather(uint32_t binary, WideNode& node, uint32_t kids[kWidth]) const {
     const uint32_t left = bvh.nodes[binary].first, right = left + 1;
     int n = 0;
-    if (plan && binary != 0) {
+    if (plan) {
       read_out(left, plan[binary].open_left, kids, n);
       read_out(right, kWidth - plan[binary].open_left, kids, n);
     } else {

@@ -148,9 +148,10 @@ TEST(WideBvh, SahCollapseIsTheSameForAnyThreadCount) {
 // builder files walls along a chain of room-sized binary nodes, and an any-hit walk tests the
 // root's children largest first. Under either method the root's largest slot must be a leaf of
 // walls only, so a shadow ray blocked by one of them is decided by the first leaf it tests
-// instead of after a second node. The 1M-triangle sphere of bench_trace's closed room: with the
-// programme at the root too, its largest child was an interior node (smaller spheres, 20K to
-// 720K triangles, happened to pass either way).
+// instead of after a second node. The 1M-triangle sphere of bench_trace's closed room: without
+// kChainVisitWeight the programme kept the chain as a wide node of its own there, and the root's
+// largest child was an interior node (smaller spheres, 20K to 720K triangles, happened to pass
+// either way).
 TEST(WideBvh, RootsLargestChildIsALeafOfWallsInAClosedRoom) {
   const MeshData m = in_closed_room(uv_sphere(708, 708, 1.0f, 0.15f), 0.5f);
   const uint32_t first_wall = uint32_t(m.triangles.size() - 12);
