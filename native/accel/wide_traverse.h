@@ -82,6 +82,12 @@ template <bool AnyHit, class LeafFn>
   // Conservative distances, as in intersect_box: exits moved out, negative entries moved back.
   const vfloat widen = splat(1.0f + 2.0f * gamma(3)), shrink = splat(1.0f - 2.0f * gamma(3));
   const bool negative_start = tnear < 0.0f;
+  // Byte offsets of the near and far rows in a node: a load from the node plus an offset is one
+  // addressing mode, where an index needs a shift by the row's 32 bytes at every visit.
+  constexpr size_t kRow = sizeof(float) * kWidth;
+  const size_t near_x = size_t(ray.near[0]) * kRow, near_y = size_t(ray.near[1]) * kRow,
+               near_z = size_t(ray.near[2]) * kRow;
+  const size_t far_x = size_t(ray.far[0]) * kRow, far_y = size_t(ray.far[1]) * kRow, far_z = size_t(ray.far[2]) * kRow;
 
   struct Entry {
     uint32_t child, count;
@@ -94,9 +100,11 @@ template <bool AnyHit, class LeafFn>
   for (;;) {
     if (current.count == 0) {
       const WideNode& n = bvh.nodes[current.child];
-      const vfloat tnx = (load(n.bounds[ray.near[0]]) - ox) * ix, tfx = (load(n.bounds[ray.far[0]]) - ox) * ix;
-      const vfloat tny = (load(n.bounds[ray.near[1]]) - oy) * iy, tfy = (load(n.bounds[ray.far[1]]) - oy) * iy;
-      const vfloat tnz = (load(n.bounds[ray.near[2]]) - oz) * iz, tfz = (load(n.bounds[ray.far[2]]) - oz) * iz;
+      const char* base = reinterpret_cast<const char*>(n.bounds);
+      auto row = [base](size_t offset) { return load(reinterpret_cast<const float*>(base + offset)); };
+      const vfloat tnx = (row(near_x) - ox) * ix, tfx = (row(far_x) - ox) * ix;
+      const vfloat tny = (row(near_y) - oy) * iy, tfy = (row(far_y) - oy) * iy;
+      const vfloat tnz = (row(near_z) - oz) * iz, tfz = (row(far_z) - oz) * iz;
       // tfar joins the exits before the widening: a box entered just beyond tfar (within the
       // widening) is visited for nothing, rarely, and one broadcast and one min a visit are saved.
       vfloat tmin = max_keep(max_keep(max_keep(start, tnx), tny), tnz);
