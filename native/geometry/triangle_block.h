@@ -31,19 +31,12 @@ using vfloat = float __attribute__((vector_size(kBlockWidth * sizeof(float))));
 using vint = int32_t __attribute__((vector_size(kBlockWidth * sizeof(float))));
 using simd::load;
 using simd::splat;
-inline vfloat abs(vfloat x) {
-  vint bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  bits &= 0x7FFFFFFF;
-  std::memcpy(&x, &bits, sizeof x);
-  return x;
-}
+// A cast between vector types of one size reinterprets the bits (GCC's vector extension), in
+// registers; through memcpy GCC went by the stack for some of these.
+inline vint bits_of(vfloat x) { return reinterpret_cast<vint>(x); }
+inline vfloat abs(vfloat x) { return reinterpret_cast<vfloat>(bits_of(x) & 0x7FFFFFFF); }
 inline vfloat max(vfloat a, vfloat b) { return a > b ? a : b; }
-inline vint bits_of(vfloat x) {
-  vint bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  return bits;
-}
+using vint_in_memory = int32_t __attribute__((vector_size(kBlockWidth * sizeof(int32_t)), aligned(4), may_alias));
 using simd::mask_of;
 }  // namespace simdb
 
@@ -53,14 +46,23 @@ using simd::mask_of;
 struct BlockRay {
   simdb::vfloat ox, oy, oz;  // the origin's coordinates along kx, ky, kz
   simdb::vfloat sx, sy, sz;
-  int kx, ky, kz;
+  // Byte offsets of the kx, ky, kz rows within a vertex's rows of a block: a load from the block
+  // plus an offset is one addressing mode, where an axis index needs a shift a load.
+  size_t x_row, y_row, z_row;
 };
 
 inline BlockRay make_block_ray(const WatertightRay& r) {
   using simdb::splat;
   const float* org = &r.org.x;
-  return {
-      splat(org[r.kx]), splat(org[r.ky]), splat(org[r.kz]), splat(r.sx), splat(r.sy), splat(r.sz), r.kx, r.ky, r.kz};
+  return {splat(org[r.kx]),
+          splat(org[r.ky]),
+          splat(org[r.kz]),
+          splat(r.sx),
+          splat(r.sy),
+          splat(r.sz),
+          size_t(r.kx) * sizeof(float) * kBlockWidth,
+          size_t(r.ky) * sizeof(float) * kBlockWidth,
+          size_t(r.kz) * sizeof(float) * kBlockWidth};
 }
 
 // Tests the block's triangles against [tnear, tfar). For each lane hit, hit(lane, t) is called
@@ -74,17 +76,17 @@ template <bool AnyHit, class OnHit>
   // Translated and sheared vertices, exactly as intersect_triangle computes them.
   vfloat x[3], y[3], vz[3];
   for (int k = 0; k < 3; ++k) {
-    vz[k] = load(b.p[k][br.kz]) - oz;
-    x[k] = (load(b.p[k][br.kx]) - ox) - sx * vz[k];
-    y[k] = (load(b.p[k][br.ky]) - oy) - sy * vz[k];
+    const char* rows = reinterpret_cast<const char*>(b.p[k]);
+    auto row = [rows](size_t offset) { return load(reinterpret_cast<const float*>(rows + offset)); };
+    vz[k] = row(br.z_row) - oz;
+    x[k] = (row(br.x_row) - ox) - sx * vz[k];
+    y[k] = (row(br.y_row) - oy) - sy * vz[k];
   }
   const vfloat eu = x[2] * y[1] - y[2] * x[1];
   const vfloat ev = x[0] * y[2] - y[0] * x[2];
   const vfloat ew = x[1] * y[0] - y[1] * x[0];
   const vfloat zero = splat(0.0f);
-  vint used;
-  std::memcpy(&used, b.prim, sizeof used);
-  used = used != vint{} - 1;  // lanes holding a triangle
+  const vint used = *reinterpret_cast<const vint_in_memory*>(b.prim) != vint{} - 1;  // lanes holding a triangle
   const vint exact_zero = (eu == zero) | (ev == zero) | (ew == zero);
   // Edge functions of both signs: the ray passes outside. By sign bits (some negative and not
   // all), which is the comparison's answer on every lane without an exact zero; those lanes go
