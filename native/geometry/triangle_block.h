@@ -88,11 +88,11 @@ template <bool AnyHit, class OnHit>
   const vfloat zero = splat(0.0f);
   const vint used = *reinterpret_cast<const vint_in_memory*>(b.prim) != vint{} - 1;  // lanes holding a triangle
   const vint exact_zero = (eu == zero) | (ev == zero) | (ew == zero);
-  // Edge functions of both signs: the ray passes outside. By sign bits (some negative and not
-  // all), which is the comparison's answer on every lane without an exact zero; those lanes go
-  // to the scalar test whatever `mixed` says.
+  // Edge functions of both signs: the ray passes outside. By sign bits (not all equal), which is
+  // the comparison's answer on every lane without an exact zero; those lanes go to the scalar
+  // test whatever `mixed` says.
   const vint su = bits_of(eu), sv = bits_of(ev), sw = bits_of(ew);
-  const vint mixed = ((su | sv | sw) & ~(su & sv & sw)) < vint{};
+  const vint mixed = ((su ^ sv) | (su ^ sw)) < vint{};
   // Most blocks a ray reaches it misses on every lane: stop before the depth and distance.
   if (!mask_of(used & (~mixed | exact_zero))) return false;
   vfloat z[3];
