@@ -284,15 +284,9 @@ WideStats wide_stats(const WideBvh& wide, uint32_t block_width) {
     s.sah_cost = kBlockCost * blocks(wide.root_leaf_count);
     return s;
   }
-  auto slot_box = [](const WideNode& n, int i) {
-    BBox b;
-    b.lo = {n.bounds[0][i], n.bounds[1][i], n.bounds[2][i]};
-    b.hi = {n.bounds[3][i], n.bounds[4][i], n.bounds[5][i]};
-    return b;
-  };
   BBox root;
   for (int i = 0; i < kWidth; ++i)
-    if (wide.nodes[0].used(i)) root.extend(slot_box(wide.nodes[0], i));
+    if (wide.nodes[0].used(i)) root.extend(wide.nodes[0].box(i));
   const double root_area = root.half_area();
   size_t children = 0;
   double cost = kWideNodeCost;  // the root, visited by every ray
@@ -300,7 +294,7 @@ WideStats wide_stats(const WideBvh& wide, uint32_t block_width) {
     for (int i = 0; i < kWidth; ++i) {
       if (!n.used(i)) continue;
       ++children;
-      const double p = root_area > 0.0 ? slot_box(n, i).half_area() / root_area : 1.0;
+      const double p = root_area > 0.0 ? n.box(i).half_area() / root_area : 1.0;
       cost += p * (n.count[i] ? kBlockCost * blocks(n.count[i]) : kWideNodeCost);
     }
   s.nodes = wide.nodes.size();

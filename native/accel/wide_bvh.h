@@ -25,6 +25,13 @@ struct alignas(64) WideNode {
 
   // Whether slot i holds a child (an unused slot's box is empty).
   bool used(int i) const { return bounds[0][i] <= bounds[3][i]; }
+  // Slot i's box.
+  BBox box(int i) const {
+    BBox b;
+    b.lo = {bounds[0][i], bounds[1][i], bounds[2][i]};
+    b.hi = {bounds[3][i], bounds[4][i], bounds[5][i]};
+    return b;
+  }
 };
 static_assert(sizeof(WideNode) == 256, "WideNode: 4 cache lines for 8 children");
 

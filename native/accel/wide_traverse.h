@@ -23,6 +23,11 @@ using vint = int32_t __attribute__((vector_size(kWidth * sizeof(float))));
 // a vector local compiled, for x86-64-v3, to a load, a store to the stack and a reload.
 using vfloat_in_memory = float __attribute__((vector_size(kWidth * sizeof(float)), aligned(4), may_alias));
 inline vfloat load(const float* p) { return *reinterpret_cast<const vfloat_in_memory*>(p); }
+// The vector `offset` bytes past `base`: with the offset kept in a register the load is one
+// addressing mode, where a row index would need a shift at every load.
+inline vfloat load_at(const void* base, size_t offset) {
+  return load(reinterpret_cast<const float*>(static_cast<const char*>(base) + offset));
+}
 // A broadcast. (Written as `vfloat{} + x` it was an addition and then a broadcast: 0 + x is not x
 // for x = -0, so the compiler must add.)
 inline vfloat splat(float x) {
@@ -82,8 +87,7 @@ template <bool AnyHit, class LeafFn>
   // Conservative distances, as in intersect_box: exits moved out, negative entries moved back.
   const vfloat widen = splat(1.0f + 2.0f * gamma(3)), shrink = splat(1.0f - 2.0f * gamma(3));
   const bool negative_start = tnear < 0.0f;
-  // Byte offsets of the near and far rows in a node: a load from the node plus an offset is one
-  // addressing mode, where an index needs a shift by the row's 32 bytes at every visit.
+  // Byte offsets of the near and far rows in a node (for load_at).
   constexpr size_t kRow = sizeof(float) * kWidth;
   const size_t near_x = size_t(ray.near[0]) * kRow, near_y = size_t(ray.near[1]) * kRow,
                near_z = size_t(ray.near[2]) * kRow;
@@ -100,11 +104,9 @@ template <bool AnyHit, class LeafFn>
   for (;;) {
     if (current.count == 0) {
       const WideNode& n = bvh.nodes[current.child];
-      const char* base = reinterpret_cast<const char*>(n.bounds);
-      auto row = [base](size_t offset) { return load(reinterpret_cast<const float*>(base + offset)); };
-      const vfloat tnx = (row(near_x) - ox) * ix, tfx = (row(far_x) - ox) * ix;
-      const vfloat tny = (row(near_y) - oy) * iy, tfy = (row(far_y) - oy) * iy;
-      const vfloat tnz = (row(near_z) - oz) * iz, tfz = (row(far_z) - oz) * iz;
+      const vfloat tnx = (load_at(n.bounds, near_x) - ox) * ix, tfx = (load_at(n.bounds, far_x) - ox) * ix;
+      const vfloat tny = (load_at(n.bounds, near_y) - oy) * iy, tfy = (load_at(n.bounds, far_y) - oy) * iy;
+      const vfloat tnz = (load_at(n.bounds, near_z) - oz) * iz, tfz = (load_at(n.bounds, far_z) - oz) * iz;
       // tfar joins the exits before the widening: a box entered just beyond tfar (within the
       // widening) is visited for nothing, rarely, and one broadcast and one min a visit are saved.
       vfloat tmin = max_keep(max_keep(max_keep(start, tnx), tny), tnz);

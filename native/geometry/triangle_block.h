@@ -30,6 +30,7 @@ namespace simdb {  // vectors of one lane per triangle of a block
 using vfloat = float __attribute__((vector_size(kBlockWidth * sizeof(float))));
 using vint = int32_t __attribute__((vector_size(kBlockWidth * sizeof(float))));
 using simd::load;
+using simd::load_at;
 using simd::splat;
 // A cast between vector types of one size reinterprets the bits (GCC's vector extension), in
 // registers; through memcpy GCC went by the stack for some of these.
@@ -46,8 +47,7 @@ using simd::mask_of;
 struct BlockRay {
   simdb::vfloat ox, oy, oz;  // the origin's coordinates along kx, ky, kz
   simdb::vfloat sx, sy, sz;
-  // Byte offsets of the kx, ky, kz rows within a vertex's rows of a block: a load from the block
-  // plus an offset is one addressing mode, where an axis index needs a shift a load.
+  // Byte offsets of the kx, ky, kz rows within a vertex's rows of a block (for simd::load_at).
   size_t x_row, y_row, z_row;
 };
 
@@ -76,11 +76,9 @@ template <bool AnyHit, class OnHit>
   // Translated and sheared vertices, exactly as intersect_triangle computes them.
   vfloat x[3], y[3], vz[3];
   for (int k = 0; k < 3; ++k) {
-    const char* rows = reinterpret_cast<const char*>(b.p[k]);
-    auto row = [rows](size_t offset) { return load(reinterpret_cast<const float*>(rows + offset)); };
-    vz[k] = row(br.z_row) - oz;
-    x[k] = (row(br.x_row) - ox) - sx * vz[k];
-    y[k] = (row(br.y_row) - oy) - sy * vz[k];
+    vz[k] = load_at(b.p[k], br.z_row) - oz;
+    x[k] = (load_at(b.p[k], br.x_row) - ox) - sx * vz[k];
+    y[k] = (load_at(b.p[k], br.y_row) - oy) - sy * vz[k];
   }
   const vfloat eu = x[2] * y[1] - y[2] * x[1];
   const vfloat ev = x[0] * y[2] - y[0] * x[2];

@@ -165,11 +165,10 @@ TEST(WideBvh, RootsLargestChildIsALeafOfWallsInAClosedRoom) {
     float largest_area = -1.0f;
     for (int i = 0; i < kWidth; ++i) {
       if (!root.used(i)) continue;
-      const BBox b{{root.bounds[0][i], root.bounds[1][i], root.bounds[2][i]},
-                   {root.bounds[3][i], root.bounds[4][i], root.bounds[5][i]}};
-      if (b.half_area() > largest_area) {
+      const float area = root.box(i).half_area();
+      if (area > largest_area) {
         largest = i;
-        largest_area = b.half_area();
+        largest_area = area;
       }
     }
     EXPECT_EQ(largest, 0);  // slot order is decreasing area: the any-hit walk's first
