@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "accel/traverse.h"
+#include "accel/wide_traverse.h"
 #include "core/parallel.h"
 
 #include <tbb/blocked_range.h>
@@ -100,6 +101,20 @@ void Scene::clear_instances() {
 }
 
 namespace {
+
+// Whether a ray can be traced: finite origin and direction, a direction other than 0, and
+// tnear <= tfar (false for a NaN in either). The ray's eight floats (origin, tnear, direction,
+// tfar) are checked as one vector: every ray pays this, and one test per component was about 35
+// instructions a ray.
+bool is_traceable(const Ray& ray) {
+  static_assert(sizeof(Ray) == 8 * sizeof(float) && kWidth == 8, "Ray: origin, tnear, direction, tfar");
+  const simd::vfloat v = simd::load(&ray.org.x);
+  const uint32_t finite = simd::mask_of((v - v) == 0.0f);  // inf - inf and NaN - NaN are NaN
+  const uint32_t nonzero = simd::mask_of(v != 0.0f);
+  constexpr uint32_t kOrigin = 0x07, kDirection = 0x70;
+  return (finite & (kOrigin | kDirection)) == (kOrigin | kDirection) && (nonzero & kDirection) != 0 &&
+         ray.tnear <= ray.tfar;
+}
 void check_texture_id(const Material& m, size_t textures) {
   const int32_t texture = texture_of(m);
   if (texture < -1 || texture >= int64_t(textures))
@@ -372,9 +387,7 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
 
 template <bool AnyHit, bool ShadowCastersOnly, bool Visibility>
 bool Scene::trace(const Ray& ray, Hit& hit, uint64_t blockers, uint8_t seen_by) const {
-  if (!is_finite(ray.org) || !is_finite(ray.dir) || ray.dir == Vec3(0.0f) || std::isnan(ray.tnear) ||
-      std::isnan(ray.tfar) || !(ray.tnear <= ray.tfar))
-    return false;
+  if (!is_traceable(ray)) return false;
   float tfar = ray.tfar;
   auto trace_instance = [&](uint32_t id, float& t_max) {
     const Instance& inst = instances_[id];

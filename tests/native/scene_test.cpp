@@ -196,12 +196,19 @@ TEST(Scene, InvalidRaysMissInsteadOfFailing) {
   scene.add_instance(scene.add_mesh(m.vertices, m.triangles), Mat4(1.0f));
   scene.commit();
   const float nan = std::nanf("");
-  for (const Ray& r : {Ray{Vec3(0), 0.0f, Vec3(0), kInfinity}, Ray{Vec3(nan), 0.0f, Vec3(1, 0, 0), kInfinity},
-                       Ray{Vec3(0), 0.0f, Vec3(nan, 1, 0), kInfinity}, Ray{Vec3(0), 2.0f, Vec3(1, 0, 0), 1.0f},
-                       Ray{Vec3(0), 0.0f, Vec3(kInfinity, 0, 0), kInfinity}}) {
+  for (const Ray& r :
+       {Ray{Vec3(0), 0.0f, Vec3(0), kInfinity}, Ray{Vec3(nan), 0.0f, Vec3(1, 0, 0), kInfinity},
+        Ray{Vec3(0), 0.0f, Vec3(nan, 1, 0), kInfinity}, Ray{Vec3(0), 2.0f, Vec3(1, 0, 0), 1.0f},
+        Ray{Vec3(0), 0.0f, Vec3(kInfinity, 0, 0), kInfinity}, Ray{Vec3(0), 0.0f, Vec3(-0.0f), kInfinity},
+        Ray{Vec3(0, 0, -kInfinity), 0.0f, Vec3(1, 0, 0), kInfinity}, Ray{Vec3(0), nan, Vec3(1, 0, 0), kInfinity},
+        Ray{Vec3(0), 0.0f, Vec3(1, 0, 0), nan}, Ray{Vec3(0), 0.0f, Vec3(0, 1, -kInfinity), kInfinity}}) {
     EXPECT_FALSE(scene.intersect(r).found());
     EXPECT_FALSE(scene.occluded(r));
   }
+  // Infinite limits are valid: the whole line from the centre reaches the sphere.
+  const Ray line{Vec3(0), -kInfinity, Vec3(0, 0, -1), kInfinity};
+  EXPECT_TRUE(scene.intersect(line).found());
+  EXPECT_TRUE(scene.occluded(line));
 }
 
 TEST(Scene, EmptySceneAndEmptyMeshMissEverything) {
