@@ -143,33 +143,41 @@ template <bool AnyHit, class LeafFn>
         }
         if ((rest & (rest - 1)) == 0) {
           const int second = __builtin_ctz(rest);
-          Entry near{n.child[first], n.count[first], tmin[first]}, far{n.child[second], n.count[second], tmin[second]};
-          if (far.tentry < near.tentry) std::swap(near, far);  // ties keep slot order, as the sort below
-          stack[sp++] = far;
-          if (far.count == 0) __builtin_prefetch(&bvh.nodes[far.child]);
-          current = near;
+          // The nearer by a select, not a branch: which child is nearer is a coin toss to the
+          // branch predictor. Ties keep slot order, as the sort below.
+          const bool swapped = tmin[second] < tmin[first];
+          const int near = swapped ? second : first, far = swapped ? first : second;
+          stack[sp++] = Entry{n.child[far], n.count[far], tmin[far]};
+          if (n.count[far] == 0) __builtin_prefetch(&bvh.nodes[n.child[far]]);
+          current = Entry{n.child[near], n.count[near], tmin[near]};
           continue;
         }
-        // Three or more: sorted by entry distance (insertion sort, stable).
-        Entry hits[kWidth];
+        // Three or more: sorted by entry distance, ties in slot order (a stable sort), as
+        // 64-bit keys, the distance's bits made orderable as integers above the slot, by
+        // compare-exchanges that compile to conditional moves (branches here were mispredicted
+        // as often as not). +0 first turns a -0 into 0, which the float comparison calls equal.
+        const vint bits = reinterpret_cast<vint>(tmin + 0.0f);
+        const vint ordered = bits ^ ((bits >> 31) | int32_t(0x80000000u));  // negatives: all bits flipped
+        uint64_t keys[kWidth];
         int count = 0;
-        while (mask) {
+        for (; mask; mask &= mask - 1) {
           const int i = __builtin_ctz(mask);
-          mask &= mask - 1;
-          const Entry e{n.child[i], n.count[i], tmin[i]};
-          int k = count++;
-          while (k > 0 && hits[k - 1].tentry > e.tentry) {
-            hits[k] = hits[k - 1];
-            --k;
+          keys[count++] = uint64_t(uint32_t(ordered[i])) << 32 | uint32_t(i);
+        }
+        for (int i = 1; i < count; ++i)
+          for (int j = i; j > 0; --j) {
+            const uint64_t a = keys[j - 1], b = keys[j];
+            keys[j - 1] = a < b ? a : b;
+            keys[j] = a < b ? b : a;
           }
-          hits[k] = e;
-        }
         for (int k = count - 1; k > 0; --k) {
-          stack[sp++] = hits[k];
+          const int i = int(keys[k] & (kWidth - 1));
+          stack[sp++] = Entry{n.child[i], n.count[i], tmin[i]};
           // Start fetching the stacked subtrees now: traversal is bound by memory latency.
-          if (hits[k].count == 0) __builtin_prefetch(&bvh.nodes[hits[k].child]);
+          if (n.count[i] == 0) __builtin_prefetch(&bvh.nodes[n.child[i]]);
         }
-        current = hits[0];
+        const int i = int(keys[0] & (kWidth - 1));
+        current = Entry{n.child[i], n.count[i], tmin[i]};
         continue;
       }
     } else if (leaf(current.child, current.count, tfar)) {
