@@ -11,7 +11,6 @@
 #endif
 
 #include <cstring>
-#include <utility>
 
 namespace toyrt {
 
