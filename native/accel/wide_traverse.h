@@ -19,7 +19,9 @@ using vfloat = float __attribute__((vector_size(kWidth * sizeof(float))));
 using vint = int32_t __attribute__((vector_size(kWidth * sizeof(float))));
 
 // A vector read through a may_alias type (GCC's own idiom for its load intrinsics). A memcpy into
-// a vector local compiled, for x86-64-v3, to a load, a store to the stack and a reload.
+// a vector local compiled, for x86-64-v3, to a load, a store to the stack and a reload. GCC
+// honours the typedef's 4-byte alignment; clang keeps the vector's 32, so every caller passes
+// 32-byte aligned rows (nodes and blocks are laid out so).
 using vfloat_in_memory = float __attribute__((vector_size(kWidth * sizeof(float)), aligned(4), may_alias));
 inline vfloat load(const float* p) { return *reinterpret_cast<const vfloat_in_memory*>(p); }
 // The vector `offset` bytes past `base`: with the offset kept in a register the load is one
