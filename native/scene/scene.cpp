@@ -120,6 +120,7 @@ bool is_traceable(const Ray& ray) {
   return (finite & (kOrigin | kDirection)) == (kOrigin | kDirection) && (nonzero & kDirection) != 0 &&
          ray.tnear <= ray.tfar;
 }
+
 void check_texture_id(const Material& m, size_t textures) {
   const int32_t texture = texture_of(m);
   if (texture < -1 || texture >= int64_t(textures))
