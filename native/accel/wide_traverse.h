@@ -76,23 +76,153 @@ inline uint32_t mask_of(V lanes) {
 }
 }  // namespace simd
 
-template <bool AnyHit, class LeafFn>
-[[gnu::always_inline]] inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear, float& tfar,
-                                                 LeafFn&& leaf) {
+// A ray's slab test against the kWidth child boxes of a wide node: its constants broadcast once a
+// ray, shared by both walks.
+struct WideSlabTest {
+  simd::vfloat ox, oy, oz, ix, iy, iz, start;
+  bool negative_start;
+  // Byte offsets of the near and far rows in a node (for load_at).
+  size_t near_x, near_y, near_z, far_x, far_y, far_z;
+
+  WideSlabTest(const RayBoxData& ray, float tnear) {
+    using simd::splat;
+    constexpr size_t kRow = sizeof(float) * kWidth;
+    ox = splat(ray.org.x), oy = splat(ray.org.y), oz = splat(ray.org.z);
+    ix = splat(ray.inv_dir.x), iy = splat(ray.inv_dir.y), iz = splat(ray.inv_dir.z);
+    start = splat(tnear);
+    negative_start = tnear < 0.0f;
+    near_x = size_t(ray.near[0]) * kRow, near_y = size_t(ray.near[1]) * kRow, near_z = size_t(ray.near[2]) * kRow;
+    far_x = size_t(ray.far[0]) * kRow, far_y = size_t(ray.far[1]) * kRow, far_z = size_t(ray.far[2]) * kRow;
+  }
+
+  // The slots whose boxes the ray enters before `end` (tfar broadcast), one bit each; their
+  // entry distances in `tmin`.
+  [[gnu::always_inline]] uint32_t enter(const WideNode& n, simd::vfloat end, simd::vfloat& tmin) const {
+    using namespace simd;
+    // Conservative distances, as in intersect_box: exits moved out, negative entries moved back.
+    const vfloat widen = splat(1.0f + 2.0f * gamma(3)), shrink = splat(1.0f - 2.0f * gamma(3));
+    const vfloat tnx = (load_at(n.bounds, near_x) - ox) * ix, tfx = (load_at(n.bounds, far_x) - ox) * ix;
+    const vfloat tny = (load_at(n.bounds, near_y) - oy) * iy, tfy = (load_at(n.bounds, far_y) - oy) * iy;
+    const vfloat tnz = (load_at(n.bounds, near_z) - oz) * iz, tfz = (load_at(n.bounds, far_z) - oz) * iz;
+    // tfar joins the exits before the widening: a box entered just beyond tfar (within the
+    // widening) is visited for nothing, rarely, and one broadcast and one min a visit are saved.
+    tmin = max_keep(max_keep(max_keep(start, tnx), tny), tnz);
+    vfloat tmax = min_keep(min_keep(min_keep(end, tfx), tfy), tfz);
+    if (negative_start) {  // rare (rays reaching back before their origin): the general form
+      tmin = tmin < 0.0f ? tmin * widen : tmin;
+      tmax = tmax * (tmax < 0.0f ? shrink : widen);
+    } else {  // tmin >= 0, so a negative exit is a miss however it is scaled: Ize's form
+      tmax = tmax * widen;
+    }
+    return mask_of(tmin <= tmax);
+  }
+};
+
+#if defined(__AVX2__)
+// For each set of slots (a bit mask), the slots from the highest to the lowest, three bits each
+// (the rest of the word: slot 0, filler): the order in which the any-hit walk stacks them, so that
+// the lowest slot (the largest box) pops first.
+struct DescendingSlots {
+  uint32_t packed[1 << kWidth];
+  constexpr DescendingSlots() : packed{} {
+    for (uint32_t m = 0; m < (1u << kWidth); ++m) {
+      uint32_t word = 0, k = 0;
+      for (int slot = kWidth - 1; slot >= 0; --slot)
+        if (m >> slot & 1) word |= uint32_t(slot) << (3 * k++);
+      packed[m] = word;
+    }
+  }
+};
+inline constexpr DescendingSlots kDescendingSlots{};
+#endif
+
+// The any-hit walk: children entered in slot order, which collapse() makes decreasing box area
+// (the likeliest blockers first), no distances kept (any hit ends the walk, so nothing is pruned
+// by distance). Stacks of child and count side by side, so that a node's other children are
+// stacked by two vector stores.
+template <class LeafFn>
+[[gnu::always_inline]] inline bool any_hit_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear, float tfar,
+                                                LeafFn&& leaf) {
   using namespace simd;
   if (bvh.nodes.empty()) return bvh.root_leaf_count && leaf(bvh.root_leaf_first, bvh.root_leaf_count, tfar);
 
-  const vfloat ox = splat(ray.org.x), oy = splat(ray.org.y), oz = splat(ray.org.z);
-  const vfloat ix = splat(ray.inv_dir.x), iy = splat(ray.inv_dir.y), iz = splat(ray.inv_dir.z);
-  const vfloat start = splat(tnear);
-  // Conservative distances, as in intersect_box: exits moved out, negative entries moved back.
-  const vfloat widen = splat(1.0f + 2.0f * gamma(3)), shrink = splat(1.0f - 2.0f * gamma(3));
-  const bool negative_start = tnear < 0.0f;
-  // Byte offsets of the near and far rows in a node (for load_at).
-  constexpr size_t kRow = sizeof(float) * kWidth;
-  const size_t near_x = size_t(ray.near[0]) * kRow, near_y = size_t(ray.near[1]) * kRow,
-               near_z = size_t(ray.near[2]) * kRow;
-  const size_t far_x = size_t(ray.far[0]) * kRow, far_y = size_t(ray.far[1]) * kRow, far_z = size_t(ray.far[2]) * kRow;
+  const WideSlabTest slab(ray, tnear);
+  const vfloat end = splat(tfar);  // an any-hit walk never shortens its segment
+
+  // kWidth - 1 a level at most, and room for a whole vector store at the top.
+  constexpr int kStack = (kWidth - 1) * kMaxBvhDepth + kWidth;
+  uint32_t stack_child[kStack], stack_count[kStack];
+  int sp = 0;
+  // Stacks the slots `slots` of node `n`, highest first.
+  auto push = [&](const WideNode& n, uint32_t slots) __attribute__((always_inline)) {
+#if defined(__AVX2__)
+    const __m256i order = _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(kDescendingSlots.packed[slots])),
+                                                             _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21)),
+                                           _mm256_set1_epi32(7));
+    const __m256i counts = _mm256_load_si256(reinterpret_cast<const __m256i*>(n.count));
+    _mm256_storeu_si256(
+        reinterpret_cast<__m256i*>(stack_child + sp),
+        _mm256_permutevar8x32_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(n.child)), order));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack_count + sp), _mm256_permutevar8x32_epi32(counts, order));
+    sp += __builtin_popcount(slots);
+    // Start fetching the stacked subtrees now: traversal is bound by memory latency.
+    const uint32_t interior =
+        slots & uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(counts, _mm256_setzero_si256()))));
+    for (uint32_t m = interior; m; m &= m - 1) __builtin_prefetch(&bvh.nodes[n.child[__builtin_ctz(m)]]);
+#else
+    for (uint32_t m = slots; m; m &= ~(1u << (31 - __builtin_clz(m)))) {
+      const int i = 31 - __builtin_clz(m);
+      stack_child[sp] = n.child[i];
+      stack_count[sp++] = n.count[i];
+      if (n.count[i] == 0) __builtin_prefetch(&bvh.nodes[n.child[i]]);
+    }
+#endif
+  };
+  uint32_t child = 0, count = 0;  // the root
+  // A leaf first among a node's children is tested before the others are stacked: when it
+  // blocks (a wall beside a dense model) the stacking would be wasted.
+  const WideNode* deferred_node = nullptr;
+  uint32_t deferred = 0;
+  for (;;) {
+    if (count == 0) {
+      const WideNode& n = bvh.nodes[child];
+      vfloat tmin;
+      const uint32_t mask = slab.enter(n, end, tmin);
+      if (mask != 0) {
+        const int first = __builtin_ctz(mask);
+        const uint32_t rest = mask & (mask - 1);
+        child = n.child[first];
+        count = n.count[first];
+        if (count != 0) {
+          deferred_node = &n;
+          deferred = rest;
+        } else if (rest != 0) {
+          push(n, rest);
+        }
+        continue;
+      }
+    } else {
+      if (leaf(child, count, tfar)) return true;
+      if (deferred != 0) {
+        push(*deferred_node, deferred);
+        deferred = 0;
+      }
+    }
+    if (sp == 0) return false;
+    --sp;
+    child = stack_child[sp];
+    count = stack_count[sp];
+  }
+}
+
+// The closest-hit walk: the children entered visited nearest first, the others stacked with
+// their entry distance and skipped when they pop beyond the nearest hit found by then.
+template <class LeafFn>
+[[gnu::always_inline]] inline bool closest_hit_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear, float& tfar,
+                                                    LeafFn&& leaf) {
+  using namespace simd;
+  if (bvh.nodes.empty()) return bvh.root_leaf_count && leaf(bvh.root_leaf_first, bvh.root_leaf_count, tfar);
+  const WideSlabTest slab(ray, tnear);
 
   struct Entry {
     uint32_t child, count;
@@ -105,35 +235,8 @@ template <bool AnyHit, class LeafFn>
   for (;;) {
     if (current.count == 0) {
       const WideNode& n = bvh.nodes[current.child];
-      const vfloat tnx = (load_at(n.bounds, near_x) - ox) * ix, tfx = (load_at(n.bounds, far_x) - ox) * ix;
-      const vfloat tny = (load_at(n.bounds, near_y) - oy) * iy, tfy = (load_at(n.bounds, far_y) - oy) * iy;
-      const vfloat tnz = (load_at(n.bounds, near_z) - oz) * iz, tfz = (load_at(n.bounds, far_z) - oz) * iz;
-      // tfar joins the exits before the widening: a box entered just beyond tfar (within the
-      // widening) is visited for nothing, rarely, and one broadcast and one min a visit are saved.
-      vfloat tmin = max_keep(max_keep(max_keep(start, tnx), tny), tnz);
-      vfloat tmax = min_keep(min_keep(min_keep(splat(tfar), tfx), tfy), tfz);
-      if (negative_start) {  // rare (rays reaching back before their origin): the general form
-        tmin = tmin < 0.0f ? tmin * widen : tmin;
-        tmax = tmax * (tmax < 0.0f ? shrink : widen);
-      } else {  // tmin >= 0, so a negative exit is a miss however it is scaled: Ize's form
-        tmax = tmax * widen;
-      }
-      uint32_t mask = mask_of(tmin <= tmax);
-      if (mask != 0 && AnyHit) {
-        // Any hit ends the walk: no distance sort, the children hit in slot order, which
-        // collapse() makes decreasing box area (the likeliest blockers first): the first now,
-        // the rest stacked so that the next largest pops next. Entry tnear, never popped as
-        // "beyond tfar" (an entry of 0 was, for segments ending before 0: occluded() missed what
-        // intersect() found; found by tests/fuzz).
-        const int first = __builtin_ctz(mask);
-        current = Entry{n.child[first], n.count[first], tnear};
-        for (mask &= mask - 1; mask; mask &= ~(1u << (31 - __builtin_clz(mask)))) {
-          const int i = 31 - __builtin_clz(mask);
-          stack[sp++] = Entry{n.child[i], n.count[i], tnear};
-          if (n.count[i] == 0) __builtin_prefetch(&bvh.nodes[n.child[i]]);
-        }
-        continue;
-      }
+      vfloat tmin;
+      uint32_t mask = slab.enter(n, splat(tfar), tmin);
       if (mask != 0) {
         // One or two children hit is the common case: no sort, no array.
         const int first = __builtin_ctz(mask);
@@ -184,7 +287,6 @@ template <bool AnyHit, class LeafFn>
       }
     } else if (leaf(current.child, current.count, tfar)) {
       found = true;
-      if constexpr (AnyHit) return true;
     }
     // Pop the next subtree that may still hold a nearer hit.
     for (;;) {
@@ -193,6 +295,16 @@ template <bool AnyHit, class LeafFn>
       if (current.tentry <= tfar) break;
     }
   }
+}
+
+// Both walks behind one name: AnyHit stops at the first hit (occlusion), else the nearest.
+template <bool AnyHit, class LeafFn>
+[[gnu::always_inline]] inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear, float& tfar,
+                                                 LeafFn&& leaf) {
+  if constexpr (AnyHit)
+    return any_hit_wide(bvh, ray, tnear, tfar, leaf);
+  else
+    return closest_hit_wide(bvh, ray, tnear, tfar, leaf);
 }
 
 }  // namespace toyrt
