@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <memory>
 #include <vector>
 
 namespace toyrt {
@@ -61,7 +62,7 @@ struct Bins {
 class Builder {
  public:
   Builder(const BBox* bounds, const Vec3* centers, size_t count, const BinnedSahConfig& cfg)
-      : bounds_(bounds), centers_(centers), cfg_(cfg), ids_(count), nodes_(2 * count - 1) {
+      : bounds_(bounds), centers_(centers), cfg_(cfg), ids_(count), nodes_(new Node[2 * count - 1]) {
     cfg_.bins = std::clamp(cfg_.bins, 2, kMaxBins);
     cfg_.max_leaf = std::max(cfg_.max_leaf, 1u);
     for (size_t i = 0; i < count; ++i) ids_[i] = uint32_t(i);
@@ -71,9 +72,7 @@ class Builder {
     const RangeBounds root = range_bounds(0, ids_.size());
     next_node_ = 1;
     build(0, 0, ids_.size(), root, 1);
-    Bvh bvh = flatten();
-    bvh.prim_ids = std::move(ids_);
-    return bvh;
+    return flatten();
   }
 
  private:
@@ -284,6 +283,7 @@ class Builder {
   // result including ties, independent of the thread count, and keeps subtrees close in memory.
   Bvh flatten() const {
     Bvh bvh;
+    bvh.prim_ids = ids_;
     bvh.nodes.reserve(next_node_);
     bvh.nodes.push_back(nodes_[0]);
     std::vector<std::pair<uint32_t, uint32_t>> stack{{0u, 0u}};  // (old index, new index)
@@ -305,12 +305,11 @@ class Builder {
   const BBox* bounds_;
   const Vec3* centers_;
   BinnedSahConfig cfg_;
-  HugeVector<uint32_t> ids_;
+  std::vector<uint32_t> ids_;
   // Written before read, node by node, so not zeroed: 2n - 1 nodes is the bound (64 MB at a
   // million triangles), of which leaves of several primitives use a fraction, and zeroing all
-  // of it made the kernel supply and clear every page. Huge pages, as ids_: fewer first-touch
-  // faults (the whole 1M-triangle commit on two threads -3 % from these two).
-  HugeVector<Node> nodes_;
+  // of it made the kernel supply and clear every page.
+  std::unique_ptr<Node[]> nodes_;
   std::atomic<uint32_t> next_node_{0};
 };
 

@@ -24,7 +24,7 @@ struct Bvh {
   // Huge pages, not zeroed on resize (core/huge_page_allocator.h): the LBVH's two million nodes at
   // 1M triangles were zeroed on one thread before its kernel wrote every one of them.
   std::vector<Node, HugePageAllocator<Node>> nodes;
-  HugeVector<uint32_t> prim_ids;  // leaf slots -> primitive index in the builder's input
+  std::vector<uint32_t> prim_ids;  // leaf slots -> primitive index in the builder's input
   // (first, count) of the prim_ids slots under each node, when a builder has them at no cost (the
   // LBVH kernels write them); empty otherwise, and collapse() derives them by a walk.
   std::vector<SlotRange, HugePageAllocator<SlotRange>> ranges;

@@ -297,7 +297,7 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
         .run(2 * count - 1);
     flat.sync_to_host(bytes);
     flat_range.sync_to_host(range_bytes);
-    bvh->prim_ids.assign(order.begin(), order.end());
+    bvh->prim_ids = order;
     stage("flat nodes");
   }
   if (hierarchy) {
@@ -325,7 +325,7 @@ Bvh to_bvh(const LbvhHierarchy& h, const BBox* prim_bounds) {
   Bvh bvh;
   const size_t count = h.values.size();
   if (count == 0) return bvh;
-  bvh.prim_ids.assign(h.values.begin(), h.values.end());
+  bvh.prim_ids = h.values;
   bvh.nodes.resize(2 * count - 1);
   if (count == 1) {
     bvh.nodes[0].set_bbox(prim_bounds[h.values[0]]);

@@ -17,7 +17,6 @@
 #include <new>
 #include <type_traits>
 #include <utility>
-#include <vector>
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -96,10 +95,5 @@ struct HugePageAllocator {
     return false;
   }
 };
-
-// A vector in huge pages, not zeroed on resize: for the large arrays of a commit, whose
-// first-touch page faults on 4 KB pages cost more than filling them (docs/trace-speed.md).
-template <class T>
-using HugeVector = std::vector<T, HugePageAllocator<T>>;
 
 }  // namespace toyrt

@@ -38,12 +38,12 @@ Mesh::Mesh(std::vector<Vec3> vertices, std::vector<Triangle> triangles)
   }
 }
 
-void Mesh::prepare(HugeVector<BBox>& boxes, HugeVector<Vec3>& centers, HugeVector<uint32_t>& valid) {
+void Mesh::prepare(std::vector<BBox>& boxes, std::vector<Vec3>& centers, std::vector<uint32_t>& valid) {
   // In parallel: on a million triangles the degenerate test (a cross product in double) and the
   // boxes took 35-80 ms, a tenth of the commit, on one thread.
   constexpr size_t kGrain = 16384;
   const size_t n = triangles_.size();
-  HugeVector<uint8_t> keep(n);
+  std::vector<uint8_t> keep(n);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i != r.end(); ++i) {
       const Triangle& t = triangles_[i];
@@ -78,19 +78,16 @@ void Mesh::prepare(HugeVector<BBox>& boxes, HugeVector<Vec3>& centers, HugeVecto
 }
 
 void Mesh::build(BuilderKind kind, const BuildConfig& config, BuildStats* stats) {
-  // In huge pages: 4 KB pages made prepare() half page faults (22 -> 9-11 ms at 1M triangles on
-  // two threads), and the builder, which reads boxes and centres at random through its ids,
-  // missed the TLB on most of them (docs/trace-speed.md, twenty-first session).
-  HugeVector<BBox> boxes;
-  HugeVector<Vec3> centers;
-  HugeVector<uint32_t> valid;
+  std::vector<BBox> boxes;
+  std::vector<Vec3> centers;
+  std::vector<uint32_t> valid;
   prepare(boxes, centers, valid);
   BuildConfig mine = config;
   mine.sah.leaf_without_search = kBlockWidth;  // finish() collapses with leaves of one block
   finish(build_bvh(kind, boxes.data(), centers.data(), boxes.size(), mine, stats), valid);
 }
 
-void Mesh::finish(Bvh bvh, const HugeVector<uint32_t>& valid) {
+void Mesh::finish(Bvh bvh, const std::vector<uint32_t>& valid) {
   bvh_ = std::move(bvh);
   for (uint32_t& id : bvh_.prim_ids) id = valid[id];  // builder slots -> triangle indices
   wide_ = collapse(bvh_, kBlockWidth);

@@ -45,9 +45,9 @@ class Mesh {
 
  private:
   // Boxes and centres of the triangles that can be hit, and their indices.
-  void prepare(HugeVector<BBox>& boxes, HugeVector<Vec3>& centers, HugeVector<uint32_t>& valid);
+  void prepare(std::vector<BBox>& boxes, std::vector<Vec3>& centers, std::vector<uint32_t>& valid);
   // From a builder's Bvh over `valid`: translate ids, collapse, fill the triangle blocks.
-  void finish(Bvh bvh, const HugeVector<uint32_t>& valid);
+  void finish(Bvh bvh, const std::vector<uint32_t>& valid);
 
   template <bool AnyHit>
   bool trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim,
