@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -38,36 +39,52 @@ Mesh::Mesh(std::vector<Vec3> vertices, std::vector<Triangle> triangles)
   }
 }
 
-void Mesh::prepare(std::vector<BBox>& boxes, std::vector<Vec3>& centers, std::vector<uint32_t>& valid) {
-  // In parallel: on a million triangles the degenerate test (a cross product in double) and the
-  // boxes took 35-80 ms, a tenth of the commit, on one thread.
+Mesh::Prepared Mesh::prepare() {
+  // Two parallel passes over fixed chunks, so that the builder's slots (and so the tree) are the
+  // same whatever the thread count: the first marks the triangles that can be hit and counts them
+  // chunk by chunk; the second writes each chunk's boxes, centres and indices from its offset.
+  // Nothing is constructed or zeroed beforehand on one thread (UninitializedArray).
   constexpr size_t kGrain = 16384;
   const size_t n = triangles_.size();
-  std::vector<uint8_t> keep(n);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i != r.end(); ++i) {
+  const size_t chunks = (n + kGrain - 1) / kGrain;
+  UninitializedArray<uint8_t> keep(n);
+  std::vector<uint32_t> offset(chunks + 1, 0u);
+  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    const size_t end = std::min(n, (c + 1) * kGrain);
+    uint32_t kept = 0;
+    for (size_t i = c * kGrain; i < end; ++i) {
       const Triangle& t = triangles_[i];
-      keep[i] = !is_degenerate(vertices_[t.x], vertices_[t.y], vertices_[t.z]);
+      const bool hittable = !is_degenerate(vertices_[t.x], vertices_[t.y], vertices_[t.z]);
+      keep.emplace(i, uint8_t(hittable));
+      kept += hittable;
     }
+    offset[c + 1] = kept;
   });
-  valid.clear();
-  valid.reserve(n);
-  for (size_t i = 0; i < n; ++i)
-    if (keep[i]) valid.push_back(uint32_t(i));
-  boxes.resize(valid.size());
-  centers.resize(valid.size());
+  for (size_t c = 0; c < chunks; ++c) offset[c + 1] += offset[c];
+  Prepared p;
+  p.count = offset[chunks];
+  p.boxes = UninitializedArray<BBox>(p.count);
+  p.centers = UninitializedArray<Vec3>(p.count);
+  if (p.count < n) p.valid = UninitializedArray<uint32_t>(p.count);  // else slot i is triangle i
   bounds_ = tbb::parallel_reduce(
-      tbb::blocked_range<size_t>(0, valid.size(), kGrain), BBox{},
+      tbb::blocked_range<size_t>(0, chunks, 1), BBox{},
       [&](const tbb::blocked_range<size_t>& r, BBox acc) {
-        for (size_t k = r.begin(); k != r.end(); ++k) {
-          const Triangle& t = triangles_[valid[k]];
-          BBox b;
-          b.extend(vertices_[t.x]);
-          b.extend(vertices_[t.y]);
-          b.extend(vertices_[t.z]);
-          boxes[k] = b;
-          centers[k] = b.center();
-          acc.extend(b);
+        for (size_t c = r.begin(); c != r.end(); ++c) {
+          size_t slot = offset[c];
+          const size_t end = std::min(n, (c + 1) * kGrain);
+          for (size_t i = c * kGrain; i < end; ++i) {
+            if (!keep[i]) continue;
+            const Triangle& t = triangles_[i];
+            BBox b;
+            b.extend(vertices_[t.x]);
+            b.extend(vertices_[t.y]);
+            b.extend(vertices_[t.z]);
+            p.boxes.emplace(slot, b);
+            p.centers.emplace(slot, b.center());
+            if (p.valid.size()) p.valid.emplace(slot, uint32_t(i));
+            ++slot;
+            acc.extend(b);
+          }
         }
         return acc;
       },
@@ -75,21 +92,28 @@ void Mesh::prepare(std::vector<BBox>& boxes, std::vector<Vec3>& centers, std::ve
         a.extend(b);
         return a;
       });
+  return p;
 }
 
 void Mesh::build(BuilderKind kind, const BuildConfig& config, BuildStats* stats) {
-  std::vector<BBox> boxes;
-  std::vector<Vec3> centers;
-  std::vector<uint32_t> valid;
-  prepare(boxes, centers, valid);
+  Prepared prepared = prepare();
   BuildConfig mine = config;
   mine.sah.leaf_without_search = kBlockWidth;  // finish() collapses with leaves of one block
-  finish(build_bvh(kind, boxes.data(), centers.data(), boxes.size(), mine, stats), valid);
+  Bvh bvh = build_bvh(kind, prepared.boxes.data(), prepared.centers.data(), prepared.count, mine, stats);
+  prepared.boxes = {};  // freed before the collapse and the blocks are made: 36 MB less at the peak at 1M
+  prepared.centers = {};
+  finish(std::move(bvh), prepared.valid);
 }
 
-void Mesh::finish(Bvh bvh, const std::vector<uint32_t>& valid) {
+void Mesh::finish(Bvh bvh, const UninitializedArray<uint32_t>& valid) {
   bvh_ = std::move(bvh);
-  for (uint32_t& id : bvh_.prim_ids) id = valid[id];  // builder slots -> triangle indices
+  if (valid.size()) {  // builder slots -> triangle indices
+    uint32_t* ids = bvh_.prim_ids.data();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, bvh_.prim_ids.size(), 16384),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                        for (size_t k = r.begin(); k != r.end(); ++k) ids[k] = valid[ids[k]];
+                      });
+  }
   wide_ = collapse(bvh_, kBlockWidth);
   bvh_.ranges = {};  // only the collapse reads them (16 MB at 1M triangles from the LBVH)
   // Copy every leaf's triangles into blocks and point the wide leaves at them. Each node's first

@@ -3,6 +3,7 @@
 
 #include "accel/builder.h"
 #include "accel/wide_bvh.h"
+#include "core/uninitialized_array.h"
 #include "geometry/triangle_block.h"
 
 #include <vector>
@@ -44,10 +45,17 @@ class Mesh {
   size_t memory_bytes() const;
 
  private:
-  // Boxes and centres of the triangles that can be hit, and their indices.
-  void prepare(std::vector<BBox>& boxes, std::vector<Vec3>& centers, std::vector<uint32_t>& valid);
-  // From a builder's Bvh over `valid`: translate ids, collapse, fill the triangle blocks.
-  void finish(Bvh bvh, const std::vector<uint32_t>& valid);
+  // The builder's input: boxes and centres of the `count` triangles that can be hit, and each
+  // one's triangle index in `valid` (left empty when every triangle can be hit: slot = index).
+  struct Prepared {
+    UninitializedArray<BBox> boxes;
+    UninitializedArray<Vec3> centers;
+    UninitializedArray<uint32_t> valid;
+    size_t count = 0;
+  };
+  Prepared prepare();  // also sets bounds_
+  // From a builder's Bvh over prepare()'s slots: translate ids, collapse, fill the triangle blocks.
+  void finish(Bvh bvh, const UninitializedArray<uint32_t>& valid);
 
   template <bool AnyHit>
   bool trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim,

@@ -190,6 +190,52 @@ TEST(Scene, BatchResultsDoNotDependOnThreadCount) {
   for (size_t i = 0; i < rays.size(); i += 101) EXPECT_EQ(one.first[i], scene.intersect(rays[i]).t);
 }
 
+TEST(Scene, DegenerateTrianglesAreLeftOutAndOthersKeepTheirIndices) {
+  // The clean sphere's triangles with zero-area ones between them (two equal corners, or three
+  // exactly collinear points), spread over several of the commit's 16384-triangle chunks. The
+  // builder sees exactly the clean mesh's triangles in the same order, so every hit is the
+  // clean mesh's, bit for bit, under the triangle's index in the padded mesh.
+  const MeshData clean = uv_sphere(100, 200, 1.0f, 0.2f);
+  MeshData padded;
+  padded.vertices = clean.vertices;
+  const uint32_t line = uint32_t(padded.vertices.size());
+  padded.vertices.insert(padded.vertices.end(), {Vec3(0.0f), Vec3(0.25f, 0.5f, 1.0f), Vec3(0.5f, 1.0f, 2.0f)});
+  std::vector<int32_t> index_in_padded;
+  for (size_t i = 0; i < clean.triangles.size(); ++i) {
+    if (i % 7 == 3) padded.triangles.push_back({line, line + 1, line + 2});                       // collinear
+    if (i % 11 == 5) padded.triangles.push_back({uint32_t(i % line), uint32_t(i % line), line});  // two equal
+    index_in_padded.push_back(int32_t(padded.triangles.size()));
+    padded.triangles.push_back(clean.triangles[i]);
+  }
+  ASSERT_GT(padded.triangles.size(), 2 * 16384u);  // three chunks
+  Scene reference, with_degenerates[2];
+  reference.add_instance(reference.add_mesh(clean.vertices, clean.triangles), Mat4(1.0f));
+  reference.commit();
+  for (int k = 0; k < 2; ++k) {
+    with_degenerates[k].add_instance(with_degenerates[k].add_mesh(padded.vertices, padded.triangles), Mat4(1.0f));
+    CommitOptions options;
+    options.builder = BuilderKind::Sah;
+    options.threads = k + 1;  // the same slots on one thread and on two
+    with_degenerates[k].commit(options);
+  }
+  size_t hits = 0;
+  for (const Ray& r : random_rays(20000, 2.0f, 29)) {
+    const Hit want = reference.intersect(r);
+    for (const Scene& s : with_degenerates) {
+      const Hit got = s.intersect(r);
+      ASSERT_EQ(got.found(), want.found());
+      if (!want.found()) continue;
+      EXPECT_EQ(got.t, want.t);
+      EXPECT_EQ(got.u, want.u);
+      EXPECT_EQ(got.v, want.v);
+      EXPECT_EQ(got.prim, index_in_padded[want.prim]);
+      EXPECT_EQ(s.occluded(r), reference.occluded(r));
+    }
+    hits += want.found();
+  }
+  EXPECT_GT(hits, 2000u);  // the property was checked on many hits, not vacuously
+}
+
 TEST(Scene, InvalidRaysMissInsteadOfFailing) {
   const MeshData m = uv_sphere(10, 20);
   Scene scene;
