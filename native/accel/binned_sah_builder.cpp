@@ -3,13 +3,17 @@
 // parallel once they are large. Large ranges are also binned in parallel (a TBB reduction).
 #include "accel/binned_sah_builder.h"
 
+#include "core/uninitialized_array.h"
+
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cstring>
 #include <memory>
 #include <vector>
 
@@ -48,6 +52,29 @@ struct BinBox {
   BBox bbox() const { return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
 };
 
+// A primitive as the builder moves it: its box, with its index in the fourth lane of `lo`, in
+// 32 bytes. The builder reorders these rather than indices into the caller's arrays, so binning,
+// partitioning and bounding a range read it in order: with indices, every pass over a range read
+// two arrays at random, and at a million triangles those reads were most of the build.
+struct PrimRef {
+  float4 lo;  // lane 3: the index (bits), read by id() only
+  float4 hi;
+  uint32_t id() const {
+    uint32_t bits;
+    std::memcpy(&bits, reinterpret_cast<const char*>(&lo) + 3 * sizeof(float), sizeof bits);
+    return bits;
+  }
+  // The centroid as BBox::center computes it: 0.5 lo + 0.5 hi is exact (halving is) up to its one
+  // rounding, so it also equals the fused multiply-add the compiler may make of it. The index is
+  // masked out first: as a float it is a denormal for any index below 2^23, and arithmetic on a
+  // denormal takes a microcode assist (it doubled the binning's time). Lane 3 is 0.
+  float4 center() const {
+    const int4 xyz{-1, -1, -1, 0};
+    return 0.5f * reinterpret_cast<float4>(reinterpret_cast<int4>(lo) & xyz) + 0.5f * hi;
+  }
+};
+static_assert(sizeof(PrimRef) == 32, "two primitives a cache line");
+
 struct Bins {
   std::array<BinBox, 3 * kMaxBins> box;
   std::array<uint32_t, 3 * kMaxBins> count{};
@@ -61,27 +88,40 @@ struct Bins {
 
 class Builder {
  public:
-  Builder(const BBox* bounds, const Vec3* centers, size_t count, const BinnedSahConfig& cfg)
-      : bounds_(bounds), centers_(centers), cfg_(cfg), ids_(count), nodes_(new Node[2 * count - 1]) {
+  Builder(const BBox* bounds, size_t count, const BinnedSahConfig& cfg)
+      : cfg_(cfg), count_(count), refs_(count), nodes_(new Node[2 * count - 1]) {
     cfg_.bins = std::clamp(cfg_.bins, 2, kMaxBins);
     cfg_.max_leaf = std::max(cfg_.max_leaf, 1u);
-    for (size_t i = 0; i < count; ++i) ids_[i] = uint32_t(i);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 16384), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i != r.end(); ++i) {
+        const BBox& b = bounds[i];
+        float id_bits;
+        const uint32_t id = uint32_t(i);
+        std::memcpy(&id_bits, &id, sizeof id);
+        refs_.emplace(i, PrimRef{float4{b.lo.x, b.lo.y, b.lo.z, id_bits}, float4{b.hi.x, b.hi.y, b.hi.z, 0.0f}});
+      }
+    });
   }
 
   Bvh run() {
-    const RangeBounds root = range_bounds(0, ids_.size());
+    const RangeBounds root = range_bounds(0, count_);
     next_node_ = 1;
-    build(0, 0, ids_.size(), root, 1);
+    build(0, 0, count_, root, 1);
     return flatten();
   }
 
  private:
   RangeBounds range_bounds(size_t begin, size_t end) const {
+    const PrimRef* refs = refs_.data();
     auto accumulate = [&](const tbb::blocked_range<size_t>& r, RangeBounds acc) {
+      BinBox box, centers;
       for (size_t i = r.begin(); i != r.end(); ++i) {
-        acc.box.extend(bounds_[ids_[i]]);
-        acc.centers.extend(centers_[ids_[i]]);
+        box.extend(refs[i].lo, refs[i].hi);
+        const float4 c = refs[i].center();
+        centers.extend(c, c);
       }
+      acc.box.extend(box.bbox());
+      acc.centers.extend(centers.bbox());
       return acc;
     };
     if (end - begin < cfg_.parallel_threshold) return accumulate({begin, end}, RangeBounds{});
@@ -97,7 +137,7 @@ class Builder {
   // range of 16 has at most 15 distinct planes per axis anyway).
   int bins_for(size_t n) const { return int(std::clamp<size_t>(n / 2, 4, size_t(cfg_.bins))); }
 
-  int bin_of(const Vec3& c, int axis, const BBox& centers, const Vec3& scale, int bins) const {
+  int bin_of(const float4& c, int axis, const BBox& centers, const Vec3& scale, int bins) const {
     // Clamped before the cast: centroids spanning more than FLT_MAX give inf * 0 = NaN here, and
     // a denormal extent an infinite scale; converting either to int is undefined (found by the
     // fuzzer, tests/fuzz). Such ranges all land in bin 0 and are split at the median.
@@ -121,16 +161,14 @@ class Builder {
     const float4 origin{centers.lo.x, centers.lo.y, centers.lo.z, 0.0f}, factor{scale.x, scale.y, scale.z, 0.0f};
     const float4 last = float4{} + float(bins_used - 1), zero{};
     auto accumulate = [&](const tbb::blocked_range<size_t>& r, Bins& bins) {
+      const PrimRef* refs = refs_.data();
       for (size_t i = r.begin(); i != r.end(); ++i) {
-        const uint32_t p = ids_[i];
-        const BBox& b = bounds_[p];
-        const Vec3& c = centers_[p];
-        const float4 k = (float4{c.x, c.y, c.z, 0.0f} - origin) * factor;
+        const float4 lo = refs[i].lo, hi = refs[i].hi;
+        const float4 k = (refs[i].center() - origin) * factor;
         // k >= 1 ? min(k, last) : 0, with NaN to 0 as bin_of: min keeps a NaN k, max drops it.
         float4 clamped = last < k ? last : k;
         clamped = clamped > zero ? clamped : zero;
-        const int4 bin = __builtin_convertvector(clamped, int4);
-        const float4 lo{b.lo.x, b.lo.y, b.lo.z, 0.0f}, hi{b.hi.x, b.hi.y, b.hi.z, 0.0f};
+        const int4 bin = __builtin_convertvector(clamped, int4);  // lane 3 (garbage) unused
         for (int a = 0; a < 3; ++a) {
           const int slot = a * kMaxBins + bin[a];
           bins.box[slot].extend(lo, hi);
@@ -192,27 +230,28 @@ class Builder {
     return best;
   }
 
-  // Splits the range's ids into those left_of accepts (first, in their order) and the rest
+  // Splits the range into the primitives left_of accepts (first, in their order) and the rest
   // (after them, in reverse order); returns where the second part starts. Without a branch on
-  // the side: every id is written to both ends of a scratch array and only one end advances.
-  // (std::partition branched on every id, and neighbours in a range fall on either side about
-  // as often as not: a misprediction for most ids, at every level of the tree.)
+  // the side: every primitive is written to both ends of a scratch array and only one end
+  // advances. (std::partition branched on every one, and neighbours in a range fall on either
+  // side about as often as not: a misprediction for most, at every level of the tree.)
   template <class LeftOf>
-  size_t split_ids(size_t begin, size_t end, LeftOf left_of) {
-    thread_local std::vector<uint32_t> scratch;
+  size_t split_refs(size_t begin, size_t end, LeftOf left_of) {
+    thread_local std::vector<PrimRef> scratch;  // ranges below parallel_threshold: 256 KB at most
     const size_t n = end - begin;
     if (scratch.size() < n) scratch.resize(n);
-    uint32_t* out = scratch.data();
+    PrimRef* out = scratch.data();
+    PrimRef* refs = refs_.data();
     size_t lo = 0, hi = n - 1;
     for (size_t i = begin; i != end; ++i) {
-      const uint32_t p = ids_[i];
+      const PrimRef p = refs[i];
       const size_t left = left_of(p);
       out[lo] = p;
       out[hi] = p;
       lo += left;
       hi -= 1 - left;
     }
-    std::copy(out, out + n, ids_.begin() + begin);
+    std::copy(out, out + n, refs + begin);
     return begin + lo;
   }
 
@@ -245,13 +284,13 @@ class Builder {
       const float leaf_cost = cfg_.intersection_cost * float(n);
       if (n <= cfg_.max_leaf && leaf_cost <= split.cost) return make_leaf(node, begin, end);
       if (split.axis >= 0) {
-        auto left_of = [&](uint32_t p) {
-          return bin_of(centers_[p], split.axis, rb.centers, scale, bins) <= split.bin;
+        auto left_of = [&](const PrimRef& p) {
+          return bin_of(p.center(), split.axis, rb.centers, scale, bins) <= split.bin;
         };
         // (Large ranges, near the root, are few: std::partition in place there, no scratch.)
-        mid = n < cfg_.parallel_threshold
-                  ? split_ids(begin, end, left_of)
-                  : size_t(std::partition(ids_.begin() + begin, ids_.begin() + end, left_of) - ids_.begin());
+        PrimRef* refs = refs_.data();
+        mid = n < cfg_.parallel_threshold ? split_refs(begin, end, left_of)
+                                          : size_t(std::partition(refs + begin, refs + end, left_of) - refs);
       }
     } else if (n <= cfg_.max_leaf) {
       return make_leaf(node, begin, end);
@@ -261,8 +300,9 @@ class Builder {
       // centroid axis, which always halves the range.
       mid = begin + n / 2;
       const int axis = max_dimension(extent);
-      std::nth_element(ids_.begin() + begin, ids_.begin() + mid, ids_.begin() + end,
-                       [&](uint32_t a, uint32_t b) { return centers_[a][axis] < centers_[b][axis]; });
+      PrimRef* refs = refs_.data();
+      std::nth_element(refs + begin, refs + mid, refs + end,
+                       [&](const PrimRef& a, const PrimRef& b) { return a.center()[axis] < b.center()[axis]; });
     }
 
     const uint32_t left = next_node_.fetch_add(2);
@@ -283,7 +323,11 @@ class Builder {
   // result including ties, independent of the thread count, and keeps subtrees close in memory.
   Bvh flatten() const {
     Bvh bvh;
-    bvh.prim_ids = ids_;
+    bvh.prim_ids.resize(count_);
+    const PrimRef* refs = refs_.data();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, count_, 16384), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i != r.end(); ++i) bvh.prim_ids[i] = refs[i].id();
+    });
     bvh.nodes.reserve(next_node_);
     bvh.nodes.push_back(nodes_[0]);
     std::vector<std::pair<uint32_t, uint32_t>> stack{{0u, 0u}};  // (old index, new index)
@@ -302,10 +346,9 @@ class Builder {
     return bvh;
   }
 
-  const BBox* bounds_;
-  const Vec3* centers_;
   BinnedSahConfig cfg_;
-  std::vector<uint32_t> ids_;
+  size_t count_;
+  UninitializedArray<PrimRef> refs_;  // written in parallel by the constructor
   // Written before read, node by node, so not zeroed: 2n - 1 nodes is the bound (64 MB at a
   // million triangles), of which leaves of several primitives use a fraction, and zeroing all
   // of it made the kernel supply and clear every page.
@@ -317,7 +360,8 @@ class Builder {
 
 Bvh build_binned_sah(const BBox* prim_bounds, const Vec3* prim_centers, size_t count, const BinnedSahConfig& config) {
   if (count == 0) return {};
-  return Builder(prim_bounds, prim_centers, count, config).run();
+  (void)prim_centers;  // the boxes' own centres: recomputed from the boxes (PrimRef::center)
+  return Builder(prim_bounds, count, config).run();
 }
 
 }  // namespace toyrt

@@ -1,6 +1,6 @@
 // Top-down BVH builder with the surface area heuristic evaluated over bins of centroids
 // (Wald 2007, "On fast construction of SAH-based bounding volume hierarchies"). Works on any
-// primitives given their boxes and centres: triangles for a mesh, instances for the top level.
+// primitives given their boxes: triangles for a mesh, instances for the top level, lamps.
 #pragma once
 
 #include "accel/bvh.h"
@@ -35,7 +35,8 @@ struct BuildCancelled : std::runtime_error {
 
 // Builds over `count` primitives. Runs on the calling thread's TBB arena, so the caller chooses
 // the thread count. The result does not depend on the thread count: nodes are laid out in
-// depth-first order after the build.
+// depth-first order after the build. The centres must be the boxes' own (BBox::center), as every
+// caller's are: the builder recomputes them from the boxes rather than read a second array.
 Bvh build_binned_sah(const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
                      const BinnedSahConfig& config = {});
 

@@ -35,6 +35,7 @@ class UninitializedArray {
   // Only elements made with emplace() may be read.
   const T& operator[](size_t i) const { return data_[i]; }
   const T* data() const { return data_.get(); }
+  T* data() { return data_.get(); }
   size_t size() const { return size_; }
 
  private:
