@@ -9,6 +9,7 @@
 //                                         CPU milliseconds (the process's CPU clock: one thread,
 //                                         so other work on the machine does not inflate it)
 //   trace_only commit-all [rings] [repeats]   the same on every core, in wall-clock milliseconds
+//   trace_only commit[-all] N [repeats] soup  the same over bench_trace's triangle soup of N x 1000
 //   trace_only lbvh-all [rings] [repeats]     the whole LBVH commit on every core against Embree's
 //                                             Morton build (LOW quality, dynamic scene), interleaved,
 //                                             wall-clock medians, with the LBVH's stage times
@@ -37,7 +38,10 @@ int main(int argc, char** argv) {
   const int rings = argc > 2 ? std::atoi(argv[2]) : 224;
   const int repeats = argc > 3 ? std::atoi(argv[3]) : 1;
   const bool room = argc > 4 && std::string(argv[4]) == "room";
-  const MeshData mesh = uv_sphere(rings, rings, 1.0f, 0.15f);
+  // "soup" as the fourth argument of commit and commit-all: bench_trace's triangle soup of
+  // `rings` x 1000 triangles instead of the sphere.
+  const bool soup = argc > 4 && std::string(argv[4]) == "soup";
+  const MeshData mesh = soup ? triangle_soup(size_t(rings) * 1000, 0.02f, 1) : uv_sphere(rings, rings, 1.0f, 0.15f);
   if (kind == "lbvh-all") {
     auto wall_ms = [] {
       timespec ts;
