@@ -2,8 +2,12 @@
 
 #include "opencl/device.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <iterator>
 #include <stdexcept>
+#include <vector>
 
 namespace toyrt {
 
@@ -17,6 +21,14 @@ Bvh build_sah(const BBox* bounds, const Vec3* centers, size_t count, const Build
 // An LBVH build that cannot run (no OpenCL device, kernel build failure) falls back to SAH.
 Bvh build_linear(const BBox* bounds, const Vec3* centers, size_t count, const BuildConfig& config, BuildStats& st) {
   try {
+    std::vector<Vec3> made;  // the boxes' centres, when the caller left them out
+    if (!centers) {
+      made.resize(count);
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 16384), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) made[i] = bounds[i].center();
+      });
+      centers = made.data();
+    }
     LbvhStats lbvh_stats;
     Bvh bvh = build_lbvh(bounds, centers, count, config.lbvh, &lbvh_stats);
     st.used = BuilderKind::Lbvh;

@@ -68,8 +68,10 @@ struct BuildStats {
 };
 
 // Builds over `count` primitives given their boxes and centres, on the calling thread's TBB
-// arena. Auto resolves with config.cost_model for `count` primitives; an LBVH build that cannot
-// run falls back to SAH and says so in stats->warning. SAH builds throw BuildCancelled when
+// arena. The centres must be the boxes' own (BBox::center); null: the builders that read them
+// (the LBVH) make them from the boxes, and the SAH builder never does, so a mesh's SAH commit
+// does not write 12 bytes a triangle it would not read. Auto resolves with config.cost_model for `count` primitives; an
+// LBVH build that cannot run falls back to SAH and says so in stats->warning. SAH builds throw BuildCancelled when
 // config.sah.cancel is set.
 Bvh build_bvh(BuilderKind kind, const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
               const BuildConfig& config = {}, BuildStats* stats = nullptr);

@@ -45,11 +45,11 @@ class Mesh {
   size_t memory_bytes() const;
 
  private:
-  // The builder's input: boxes and centres of the `count` triangles that can be hit, and each
-  // one's triangle index in `valid` (left empty when every triangle can be hit: slot = index).
+  // The builder's input: boxes of the `count` triangles that can be hit (their centres are made
+  // by the builders that read them), and each one's triangle index in `valid` (left empty when
+  // every triangle can be hit: slot = index).
   struct Prepared {
     UninitializedArray<BBox> boxes;
-    UninitializedArray<Vec3> centers;
     UninitializedArray<uint32_t> valid;
     size_t count = 0;
   };
