@@ -89,7 +89,7 @@ struct Bins {
 class Builder {
  public:
   Builder(const BBox* bounds, size_t count, const BinnedSahConfig& cfg)
-      : cfg_(cfg), count_(count), refs_(count), nodes_(new Node[2 * count - 1]) {
+      : cfg_(cfg), count_(count), refs_(count), nodes_(new Node[2 * count - 1]), ranges_(2 * count - 1) {
     cfg_.bins = std::clamp(cfg_.bins, 2, kMaxBins);
     cfg_.max_leaf = std::max(cfg_.max_leaf, 1u);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 16384), [&](const tbb::blocked_range<size_t>& r) {
@@ -266,6 +266,7 @@ class Builder {
     if (cfg_.cancel && cfg_.cancel->load(std::memory_order_relaxed)) throw BuildCancelled();
     nodes_[node].set_bbox(rb.box);
     const size_t n = end - begin;
+    ranges_.emplace(node, SlotRange{uint32_t(begin), uint32_t(n)});
     if (n == 1 || n <= std::min(cfg_.leaf_without_search, cfg_.max_leaf)) return make_leaf(node, begin, end);
 
     size_t mid = begin;
@@ -329,7 +330,9 @@ class Builder {
       for (size_t i = r.begin(); i != r.end(); ++i) bvh.prim_ids[i] = refs[i].id();
     });
     bvh.nodes.reserve(next_node_);
+    bvh.ranges.reserve(next_node_);
     bvh.nodes.push_back(nodes_[0]);
+    bvh.ranges.push_back(ranges_[0]);
     std::vector<std::pair<uint32_t, uint32_t>> stack{{0u, 0u}};  // (old index, new index)
     while (!stack.empty()) {
       auto [old_index, new_index] = stack.back();
@@ -339,6 +342,8 @@ class Builder {
       const uint32_t child = uint32_t(bvh.nodes.size());
       bvh.nodes.push_back(nodes_[n.first]);
       bvh.nodes.push_back(nodes_[n.first + 1]);
+      bvh.ranges.push_back(ranges_[n.first]);
+      bvh.ranges.push_back(ranges_[n.first + 1]);
       bvh.nodes[new_index].first = child;
       stack.push_back({n.first + 1, child + 1});
       stack.push_back({n.first, child});
@@ -353,6 +358,10 @@ class Builder {
   // million triangles), of which leaves of several primitives use a fraction, and zeroing all
   // of it made the kernel supply and clear every page.
   std::unique_ptr<Node[]> nodes_;
+  // Every node's slots (first, count), as the builder knows them: collapse() reads them instead of
+  // finding them by a serial walk of the tree (7-8 ms of the 2-thread commit at 1M triangles,
+  // 40 ms at 4M).
+  UninitializedArray<SlotRange> ranges_;
   std::atomic<uint32_t> next_node_{0};
 };
 
