@@ -89,7 +89,12 @@ struct Bins {
 class Builder {
  public:
   Builder(const BBox* bounds, size_t count, const BinnedSahConfig& cfg)
-      : cfg_(cfg), count_(count), refs_(count), nodes_(new Node[2 * count - 1]), ranges_(2 * count - 1) {
+      : cfg_(cfg),
+        count_(count),
+        refs_(count),
+        nodes_(new Node[2 * count - 1]),
+        ranges_(2 * count - 1),
+        subtree_nodes_(2 * count - 1) {
     cfg_.bins = std::clamp(cfg_.bins, 2, kMaxBins);
     cfg_.max_leaf = std::max(cfg_.max_leaf, 1u);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 16384), [&](const tbb::blocked_range<size_t>& r) {
@@ -255,12 +260,15 @@ class Builder {
     return begin + lo;
   }
 
-  void make_leaf(uint32_t node, size_t begin, size_t end) {
+  uint32_t make_leaf(uint32_t node, size_t begin, size_t end) {
     nodes_[node].first = uint32_t(begin);
     nodes_[node].count = uint32_t(end - begin);
+    subtree_nodes_.emplace(node, 1u);
+    return 1;
   }
 
-  void build(uint32_t node, size_t begin, size_t end, const RangeBounds& rb, int depth) {
+  // Returns the number of nodes in the subtree.
+  uint32_t build(uint32_t node, size_t begin, size_t end, const RangeBounds& rb, int depth) {
     // One relaxed load per node; the exception crosses parallel_invoke, which cancels the
     // sibling tasks and rethrows it on the calling thread.
     if (cfg_.cancel && cfg_.cancel->load(std::memory_order_relaxed)) throw BuildCancelled();
@@ -309,14 +317,17 @@ class Builder {
     const uint32_t left = next_node_.fetch_add(2);
     nodes_[node].first = left;
     nodes_[node].count = 0;
-    auto build_left = [&] { build(left, begin, mid, range_bounds(begin, mid), depth + 1); };
-    auto build_right = [&] { build(left + 1, mid, end, range_bounds(mid, end), depth + 1); };
+    uint32_t left_nodes = 0, right_nodes = 0;
+    auto build_left = [&] { left_nodes = build(left, begin, mid, range_bounds(begin, mid), depth + 1); };
+    auto build_right = [&] { right_nodes = build(left + 1, mid, end, range_bounds(mid, end), depth + 1); };
     if (n >= cfg_.parallel_threshold) {
       tbb::parallel_invoke(build_left, build_right);
     } else {
       build_left();
       build_right();
     }
+    subtree_nodes_.emplace(node, 1 + left_nodes + right_nodes);
+    return 1 + left_nodes + right_nodes;
   }
 
   // Re-lays the nodes in depth-first order, children pairs adjacent. Parallel builds allocate
@@ -329,26 +340,47 @@ class Builder {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, count_, 16384), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t i = r.begin(); i != r.end(); ++i) bvh.prim_ids[i] = refs[i].id();
     });
-    bvh.nodes.reserve(next_node_);
-    bvh.ranges.reserve(next_node_);
-    bvh.nodes.push_back(nodes_[0]);
-    bvh.ranges.push_back(ranges_[0]);
-    std::vector<std::pair<uint32_t, uint32_t>> stack{{0u, 0u}};  // (old index, new index)
-    while (!stack.empty()) {
-      auto [old_index, new_index] = stack.back();
-      stack.pop_back();
-      const Node& n = nodes_[old_index];
-      if (n.is_leaf()) continue;
-      const uint32_t child = uint32_t(bvh.nodes.size());
-      bvh.nodes.push_back(nodes_[n.first]);
-      bvh.nodes.push_back(nodes_[n.first + 1]);
-      bvh.ranges.push_back(ranges_[n.first]);
-      bvh.ranges.push_back(ranges_[n.first + 1]);
-      bvh.nodes[new_index].first = child;
-      stack.push_back({n.first + 1, child + 1});
-      stack.push_back({n.first, child});
-    }
+    bvh.nodes.resize(next_node_);  // not zeroed (HugePageAllocator): place() writes every one
+    bvh.ranges.resize(next_node_);
+    bvh.nodes[0] = nodes_[0];
+    bvh.ranges[0] = ranges_[0];
+    place(0, 0, 1, bvh);
     return bvh;
+  }
+
+  // Lays out the subtree below binary node `from` (already written at `to`): its children's pair
+  // at `free`, then the left child's subtree, then the right's. The subtree sizes say where the
+  // right one starts, so large subtrees are laid out in parallel, in the places a serial walk
+  // would give them.
+  void place(uint32_t from, uint32_t to, uint32_t free, Bvh& bvh) const {
+    const Node& n = nodes_[from];
+    if (n.is_leaf()) return;
+    if (ranges_[from].count < cfg_.parallel_threshold) {
+      std::vector<std::pair<uint32_t, uint32_t>> stack{{from, to}};  // (old index, new index)
+      while (!stack.empty()) {
+        const auto [old_index, new_index] = stack.back();
+        stack.pop_back();
+        const Node& m = nodes_[old_index];
+        if (m.is_leaf()) continue;
+        copy_children(m, new_index, free, bvh);
+        stack.push_back({m.first + 1, free + 1});
+        stack.push_back({m.first, free});
+        free += 2;
+      }
+      return;
+    }
+    copy_children(n, to, free, bvh);
+    const uint32_t right_free = free + 2 + (subtree_nodes_[n.first] - 1);
+    tbb::parallel_invoke([&] { place(n.first, free, free + 2, bvh); },
+                         [&] { place(n.first + 1, free + 1, right_free, bvh); });
+  }
+
+  void copy_children(const Node& n, uint32_t to, uint32_t at, Bvh& bvh) const {
+    bvh.nodes[at] = nodes_[n.first];
+    bvh.nodes[at + 1] = nodes_[n.first + 1];
+    bvh.ranges[at] = ranges_[n.first];
+    bvh.ranges[at + 1] = ranges_[n.first + 1];
+    bvh.nodes[to].first = at;
   }
 
   BinnedSahConfig cfg_;
@@ -362,6 +394,7 @@ class Builder {
   // finding them by a serial walk of the tree (7-8 ms of the 2-thread commit at 1M triangles,
   // 40 ms at 4M).
   UninitializedArray<SlotRange> ranges_;
+  UninitializedArray<uint32_t> subtree_nodes_;  // nodes in each node's subtree, for flatten()
   std::atomic<uint32_t> next_node_{0};
 };
 
