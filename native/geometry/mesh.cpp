@@ -98,7 +98,9 @@ void Mesh::build(BuilderKind kind, const BuildConfig& config, BuildStats* stats)
   BuildConfig mine = config;
   mine.sah.leaf_without_search = kBlockWidth;  // finish() collapses with leaves of one block
   Bvh bvh = build_bvh(kind, prepared.boxes.data(), nullptr, prepared.count, mine, stats);
-  prepared.boxes = {};  // freed before the collapse and the blocks are made: 24 MB less at the peak at 1M
+  // The boxes are freed only after finish(): freeing them before it (24 MB less at the peak at 1M)
+  // made the 4M commit on two threads 845 -> 1600 ms in bench_trace, its collapse and blocks
+  // stalling up to 0.5 s on fresh pages (docs/trace-speed.md, twenty-second session).
   finish(std::move(bvh), prepared.valid);
 }
 
