@@ -59,6 +59,11 @@ struct BinBox {
 struct PrimRef {
   float4 lo;  // lane 3: the index (bits), read by id() only
   float4 hi;
+  static PrimRef of(const BBox& b, uint32_t id) {
+    float id_bits;
+    std::memcpy(&id_bits, &id, sizeof id);
+    return {float4{b.lo.x, b.lo.y, b.lo.z, id_bits}, float4{b.hi.x, b.hi.y, b.hi.z, 0.0f}};
+  }
   uint32_t id() const {
     uint32_t bits;
     std::memcpy(&bits, reinterpret_cast<const char*>(&lo) + 3 * sizeof(float), sizeof bits);
@@ -98,13 +103,7 @@ class Builder {
     cfg_.bins = std::clamp(cfg_.bins, 2, kMaxBins);
     cfg_.max_leaf = std::max(cfg_.max_leaf, 1u);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 16384), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i != r.end(); ++i) {
-        const BBox& b = bounds[i];
-        float id_bits;
-        const uint32_t id = uint32_t(i);
-        std::memcpy(&id_bits, &id, sizeof id);
-        refs_.emplace(i, PrimRef{float4{b.lo.x, b.lo.y, b.lo.z, id_bits}, float4{b.hi.x, b.hi.y, b.hi.z, 0.0f}});
-      }
+      for (size_t i = r.begin(); i != r.end(); ++i) refs_.emplace(i, PrimRef::of(bounds[i], uint32_t(i)));
     });
   }
 

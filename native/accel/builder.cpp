@@ -1,5 +1,6 @@
 #include "accel/builder.h"
 
+#include "core/uninitialized_array.h"
 #include "opencl/device.h"
 
 #include <tbb/blocked_range.h>
@@ -7,7 +8,6 @@
 
 #include <iterator>
 #include <stdexcept>
-#include <vector>
 
 namespace toyrt {
 
@@ -21,11 +21,11 @@ Bvh build_sah(const BBox* bounds, const Vec3* centers, size_t count, const Build
 // An LBVH build that cannot run (no OpenCL device, kernel build failure) falls back to SAH.
 Bvh build_linear(const BBox* bounds, const Vec3* centers, size_t count, const BuildConfig& config, BuildStats& st) {
   try {
-    std::vector<Vec3> made;  // the boxes' centres, when the caller left them out
+    UninitializedArray<Vec3> made;  // the boxes' centres, when the caller left them out
     if (!centers) {
-      made.resize(count);
+      made = UninitializedArray<Vec3>(count);
       tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 16384), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) made[i] = bounds[i].center();
+        for (size_t i = r.begin(); i != r.end(); ++i) made.emplace(i, bounds[i].center());
       });
       centers = made.data();
     }
