@@ -1,8 +1,9 @@
 """CPU-time A/B of the multi-hit queries between builds of the toyrt module (docs/queries.md).
 
 Each module runs in its own child process, the modules' children alternating; a child builds the
-icosphere, warms up, then times `count_intersections` (or `list_intersections`, or
-`compute_occupancy`) on one thread a few times by the process's CPU time and prints the median.
+icosphere, warms up, then times `count_intersections` (or `list_intersections`,
+`compute_occupancy`, or `compute_closest_points` of the rays' origins) on one thread a few times
+by the process's CPU time and prints the median.
 The report gives, per size, each module's median over the repeats and the median of the
 per-repeat ratios against the first module (a busy spell of the machine hits both modules of one
 repeat alike). CPU time, not wall time: two other builds on two cores move wall time by 40 %.
@@ -36,7 +37,8 @@ def child(path, level, kind, n, runs, threads):
     s.commit()
     call = {"count": lambda: s.count_intersections(o, d, threads=threads),
             "list": lambda: s.list_intersections(o, d, threads=threads),
-            "occupancy": lambda: s.compute_occupancy(o, threads=threads)}[kind]
+            "occupancy": lambda: s.compute_occupancy(o, threads=threads),
+            "closest": lambda: s.compute_closest_points(o, threads=threads)}[kind]
     call()
     times = []
     for _ in range(runs):
@@ -50,7 +52,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--module", action="append", required=True, help="NAME=DIR of a built toyrt module")
     ap.add_argument("--levels", type=int, nargs="*", default=[6, 8], help="icosphere levels (6: 82K, 8: 1.3M)")
-    ap.add_argument("--kind", default="count", choices=("count", "list", "occupancy"))
+    ap.add_argument("--kind", default="count", choices=("count", "list", "occupancy", "closest"))
     ap.add_argument("--rays", type=int, default=200_000)
     ap.add_argument("--runs", type=int, default=3, help="timed calls per child (median)")
     ap.add_argument("--repeats", type=int, default=4, help="children per module (alternating)")

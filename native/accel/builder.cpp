@@ -18,38 +18,70 @@ Bvh build_sah(const BBox* bounds, const Vec3* centers, size_t count, const Build
   return build_binned_sah(bounds, centers, count, config.sah);
 }
 
+WideBuild build_sah_wide(const BBox* bounds, const Vec3* centers, size_t count, uint32_t leaf_size,
+                         const BuildConfig& config, BuildStats& st) {
+  Bvh bvh = build_sah(bounds, centers, count, config, st);
+  WideBuild built{collapse(bvh, leaf_size), std::move(bvh.prim_ids)};
+  return built;
+}
+
+// The boxes' centres, when the caller left them out (the LBVH's Morton codes read them).
+UninitializedArray<Vec3> centers_of(const BBox* bounds, size_t count) {
+  UninitializedArray<Vec3> made(count);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 16384), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) made.emplace(i, bounds[i].center());
+  });
+  return made;
+}
+
+const char* const kLbvhFallback = "LBVH builder unavailable, using the SAH builder instead: ";
+
 // An LBVH build that cannot run (no OpenCL device, kernel build failure) falls back to SAH.
 Bvh build_linear(const BBox* bounds, const Vec3* centers, size_t count, const BuildConfig& config, BuildStats& st) {
   try {
-    UninitializedArray<Vec3> made;  // the boxes' centres, when the caller left them out
-    if (!centers) {
-      made = UninitializedArray<Vec3>(count);
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 16384), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) made.emplace(i, bounds[i].center());
-      });
-      centers = made.data();
-    }
+    UninitializedArray<Vec3> made;
+    if (!centers) centers = (made = centers_of(bounds, count)).data();
     LbvhStats lbvh_stats;
     Bvh bvh = build_lbvh(bounds, centers, count, config.lbvh, &lbvh_stats);
     st.used = BuilderKind::Lbvh;
     st.lbvh_compile_ms = lbvh_stats.compile_ms;
     return bvh;
   } catch (const opencl::OpenClError& e) {
-    st.warning = std::string("LBVH builder unavailable, using the SAH builder instead: ") + e.what();
+    st.warning = std::string(kLbvhFallback) + e.what();
   }
   return build_sah(bounds, centers, count, config, st);
+}
+
+WideBuild build_linear_wide(const BBox* bounds, const Vec3* centers, size_t count, uint32_t leaf_size,
+                            const BuildConfig& config, BuildStats& st) {
+  try {
+    UninitializedArray<Vec3> made;
+    if (!centers) centers = (made = centers_of(bounds, count)).data();
+    LbvhStats lbvh_stats;
+    WideBuild built = build_lbvh_wide(bounds, centers, count, leaf_size, config.lbvh, &lbvh_stats);
+    st.used = BuilderKind::Lbvh;
+    st.lbvh_compile_ms = lbvh_stats.compile_ms;
+    return built;
+  } catch (const opencl::OpenClError& e) {
+    st.warning = std::string(kLbvhFallback) + e.what();
+  }
+  return build_sah_wide(bounds, centers, count, leaf_size, config, st);
 }
 
 struct BuilderEntry {
   const char* name;
   BuilderKind kind;
-  // Null for Auto, which build_bvh resolves to another entry first.
+  // Null for Auto, which build_bvh resolves to another entry first. `build` makes the binary
+  // tree; `build_wide` the traced layout, by collapsing it or (the LBVH) straight from the
+  // builder's own tree.
   Bvh (*build)(const BBox* bounds, const Vec3* centers, size_t count, const BuildConfig& config, BuildStats& st);
+  WideBuild (*build_wide)(const BBox* bounds, const Vec3* centers, size_t count, uint32_t leaf_size,
+                          const BuildConfig& config, BuildStats& st);
 };
 // The one table of builders: a new builder adds its row here.
-constexpr BuilderEntry kBuilders[] = {{"auto", BuilderKind::Auto, nullptr},
-                                      {"sah", BuilderKind::Sah, build_sah},
-                                      {"lbvh", BuilderKind::Lbvh, build_linear}};
+constexpr BuilderEntry kBuilders[] = {{"auto", BuilderKind::Auto, nullptr, nullptr},
+                                      {"sah", BuilderKind::Sah, build_sah, build_sah_wide},
+                                      {"lbvh", BuilderKind::Lbvh, build_linear, build_linear_wide}};
 
 }  // namespace
 
@@ -69,15 +101,29 @@ const char* builder_name(BuilderKind kind) {
   return "?";
 }
 
+namespace {
+// The table row that builds `kind`, Auto resolved by the cost model; resets the stats.
+const BuilderEntry& entry_for(BuilderKind kind, size_t count, const BuildConfig& config, BuildStats& st) {
+  st = BuildStats{};
+  if (kind == BuilderKind::Auto) kind = config.cost_model.choose(count, config.expected_rays);
+  for (const BuilderEntry& b : kBuilders)
+    if (b.kind == kind && b.build) return b;
+  throw std::invalid_argument("build_bvh: unknown builder kind");
+}
+}  // namespace
+
 Bvh build_bvh(BuilderKind kind, const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
               const BuildConfig& config, BuildStats* stats) {
   BuildStats local;
   BuildStats& st = stats ? *stats : local;
-  st = BuildStats{};
-  if (kind == BuilderKind::Auto) kind = config.cost_model.choose(count, config.expected_rays);
-  for (const BuilderEntry& b : kBuilders)
-    if (b.kind == kind && b.build) return b.build(prim_bounds, prim_centers, count, config, st);
-  throw std::invalid_argument("build_bvh: unknown builder kind");
+  return entry_for(kind, count, config, st).build(prim_bounds, prim_centers, count, config, st);
+}
+
+WideBuild build_wide_bvh(BuilderKind kind, const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
+                         uint32_t leaf_size, const BuildConfig& config, BuildStats* stats) {
+  BuildStats local;
+  BuildStats& st = stats ? *stats : local;
+  return entry_for(kind, count, config, st).build_wide(prim_bounds, prim_centers, count, leaf_size, config, st);
 }
 
 }  // namespace toyrt

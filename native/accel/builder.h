@@ -75,5 +75,10 @@ struct BuildStats {
 // config.sah.cancel is set.
 Bvh build_bvh(BuilderKind kind, const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
               const BuildConfig& config = {}, BuildStats* stats = nullptr);
+// The same build, ending in the traced layout: wide nodes whose leaves hold subtrees of up to
+// leaf_size primitives (collapse() of the binary tree; the LBVH collapses its kernels' tree in
+// place and never writes a binary Bvh). What a mesh commits.
+WideBuild build_wide_bvh(BuilderKind kind, const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
+                         uint32_t leaf_size, const BuildConfig& config = {}, BuildStats* stats = nullptr);
 
 }  // namespace toyrt

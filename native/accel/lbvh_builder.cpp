@@ -139,10 +139,22 @@ LbvhHierarchy build_lbvh_hierarchy_reference(const BBox* prim_bounds, const Vec3
 
 namespace {
 
-// Runs the kernels. Fills `hierarchy` (Karras nodes and parents, and the keys when asked) and/or
-// `bvh` (the flat nodes written on the device), whichever is non-null.
+// What run_opencl fills, whichever is non-null: `hierarchy` (Karras nodes and parents, and the
+// keys when with_keys), `bvh` (the flat nodes written on the device), `wide` (the Karras tree
+// collapsed in place into wide nodes with leaves of up to leaf_size primitives).
+struct LbvhOutputs {
+  LbvhHierarchy* hierarchy = nullptr;
+  bool with_keys = false;
+  Bvh* bvh = nullptr;
+  WideBuild* wide = nullptr;
+  uint32_t leaf_size = 1;
+};
+
+// Runs the kernels and fills `out`.
 void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config, LbvhStats* stats,
-                LbvhHierarchy* hierarchy, bool with_keys, Bvh* bvh) {
+                const LbvhOutputs& out) {
+  LbvhHierarchy* hierarchy = out.hierarchy;
+  Bvh* bvh = out.bvh;
   using namespace opencl;
   if (count >= size_t(INT32_MAX) / 2) throw OpenClError("LBVH: more than 2^30 primitives");
   const Device& dev = device();
@@ -157,7 +169,9 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
     const BBox tiny[3] = {{Vec3(0.0f), Vec3(1.0f)}, {Vec3(1.0f), Vec3(2.0f)}, {Vec3(2.0f), Vec3(3.0f)}};
     const Vec3 tiny_centers[3] = {Vec3(0.5f), Vec3(1.5f), Vec3(2.5f)};
     Bvh unused;
-    run_opencl(tiny, tiny_centers, 3, config, nullptr, nullptr, false, &unused);
+    LbvhOutputs warm_out;
+    warm_out.bvh = &unused;  // write_bvh_nodes too: tests and benchmarks still build flat trees
+    run_opencl(tiny, tiny_centers, 3, config, nullptr, warm_out);
     compile_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - warm).count();
   }
   if (stats) {
@@ -234,13 +248,18 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
 
   std::vector<uint32_t> order(count);
   values[in].read(order.data(), count * sizeof(uint32_t));
-  if (hierarchy && with_keys) {
+  if (hierarchy && out.with_keys) {
     hierarchy->keys.resize(count);
     keys[in].read(hierarchy->keys.data(), count * sizeof(uint64_t));
   }
   if (count == 1) {
     if (hierarchy) hierarchy->values = order;
     if (bvh) *bvh = to_bvh(LbvhHierarchy{{}, order, {}, {}, {}}, prim_bounds);
+    if (out.wide) {
+      out.wide->wide = WideBvh{};
+      out.wide->wide.root_leaf_count = 1;
+      out.wide->prim_ids = order;
+    }
     return;
   }
   const size_t internal = count - 1;
@@ -300,6 +319,21 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
     bvh->prim_ids = order;
     stage("flat nodes");
   }
+  if (out.wide) {
+    // Read in place (a map: no copy on a CPU device). The flat nodes are not written at all: at
+    // 1M triangles they were 80 MB of fresh pages and a third of the commit (docs/lbvh.md).
+    LbvhTree tree;
+    tree.nodes = static_cast<const LbvhNode*>(nodes.map_read(internal * sizeof(LbvhNode)));
+    tree.leaf_bounds = static_cast<const BBox*>(sorted_bounds.map_read(count * sizeof(BBox)));
+    tree.leaf_range = static_cast<const uint32_t*>(internal_range.map_read(internal * 2 * sizeof(cl_uint)));
+    tree.leaves = count;
+    out.wide->wide = collapse(tree, out.leaf_size);
+    nodes.unmap(tree.nodes);
+    sorted_bounds.unmap(tree.leaf_bounds);
+    internal_range.unmap(tree.leaf_range);
+    out.wide->prim_ids = hierarchy ? order : std::move(order);
+    stage("collapse");
+  }
   if (hierarchy) {
     hierarchy->values = std::move(order);
     hierarchy->nodes.resize(internal);
@@ -317,7 +351,10 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
 LbvhHierarchy build_lbvh_hierarchy_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count,
                                           const LbvhConfig& config, LbvhStats* stats, bool with_keys) {
   LbvhHierarchy h;
-  run_opencl(prim_bounds, centers, count, config, stats, &h, with_keys, nullptr);
+  LbvhOutputs out;
+  out.hierarchy = &h;
+  out.with_keys = with_keys;
+  run_opencl(prim_bounds, centers, count, config, stats, out);
   return h;
 }
 
@@ -360,10 +397,25 @@ Bvh to_bvh(const LbvhHierarchy& h, const BBox* prim_bounds) {
 Bvh build_lbvh(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config, LbvhStats* stats) {
   const auto start = std::chrono::steady_clock::now();
   Bvh bvh;
-  run_opencl(prim_bounds, centers, count, config, stats, nullptr, false, &bvh);
+  LbvhOutputs out;
+  out.bvh = &bvh;
+  run_opencl(prim_bounds, centers, count, config, stats, out);
   if (stats)
     stats->build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return bvh;
+}
+
+WideBuild build_lbvh_wide(const BBox* prim_bounds, const Vec3* centers, size_t count, uint32_t leaf_size,
+                          const LbvhConfig& config, LbvhStats* stats) {
+  const auto start = std::chrono::steady_clock::now();
+  WideBuild built;
+  LbvhOutputs out;
+  out.wide = &built;
+  out.leaf_size = leaf_size;
+  run_opencl(prim_bounds, centers, count, config, stats, out);
+  if (stats)
+    stats->build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return built;
 }
 
 Bvh build_lbvh_reference(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config) {

@@ -7,6 +7,7 @@
 
 #include "accel/bvh.h"
 #include "accel/lbvh_layout.h"
+#include "accel/wide_bvh.h"
 
 #include <string>
 #include <vector>
@@ -51,6 +52,11 @@ Bvh to_bvh(const LbvhHierarchy& h, const BBox* prim_bounds);
 // OpenCL build straight to a Bvh (the flat nodes are written on the device).
 Bvh build_lbvh(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config = {},
                LbvhStats* stats = nullptr);
+// OpenCL build straight to the traced layout: the kernels' Karras tree collapsed in place into
+// wide nodes with leaves of up to leaf_size primitives (the flat nodes are never written). The
+// same wide tree as collapse(build_lbvh(...), leaf_size).
+WideBuild build_lbvh_wide(const BBox* prim_bounds, const Vec3* centers, size_t count, uint32_t leaf_size,
+                          const LbvhConfig& config = {}, LbvhStats* stats = nullptr);
 // The reference build straight to a Bvh.
 Bvh build_lbvh_reference(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config = {});
 

@@ -40,6 +40,15 @@ static_assert(offsetof(Node, bounds) == 0 && offsetof(Node, first) == 24 && offs
               "Node must match BvhNode in kernels/lbvh.cl");
 static_assert(sizeof(float) == 4 && sizeof(uint64_t) == 8, "OpenCL float is 4 bytes, ulong 8");
 
+// The Karras tree as the kernels leave it after propagate_bounds, which collapse()
+// (accel/wide_bvh.h) reads in place: no flat Bvh in between.
+struct LbvhTree {
+  const LbvhNode* nodes = nullptr;       // leaves - 1 internal nodes, root 0, boxes filled
+  const BBox* leaf_bounds = nullptr;     // leaves boxes in sorted order (gather_bounds)
+  const uint32_t* leaf_range = nullptr;  // 2 (leaves - 1): first and last sorted leaf under internal node i
+  size_t leaves = 0;
+};
+
 // Morton code precision: 10 bits per axis (30-bit codes) or 21 (63-bit codes).
 enum class MortonBits : uint32_t { k30 = 10, k63 = 21 };
 

@@ -51,43 +51,97 @@ struct Plan {
   uint8_t split[kWidth];
   uint8_t open_left;
 };
-using Costs = std::array<float, kWidth>;  // by budget - 1
+using Costs = std::array<float, kWidth>;      // by budget - 1
+using Counts = std::array<uint32_t, kWidth>;  // wide nodes, by budget - 1
 
-// The binary tree as collapse() sees it: a subtree of at most leaf_size primitives is one leaf.
-struct CollapsedTree {
-  const Bvh& bvh;
-  const Ranges& range;
-  uint32_t leaf_size;
-
-  bool is_leaf(uint32_t i) const { return bvh.nodes[i].is_leaf() || range[i].count <= leaf_size; }
+// What solve() passes up: per budget, the least cost and the wide nodes that answer makes.
+struct Solved {
+  Costs cost;
+  Counts nodes;
 };
 
-struct Planner : CollapsedTree {
-  Plan* plan;  // by binary node; written for interior nodes that are not collapsed leaves
+// The binary trees collapse() reads, behind one interface (node 0 is the root): interior(i),
+// left(i), right(i), box(i), range(i) (the prim_ids slots under node i), and plan_slots() (node
+// ids that can be interior, which size the plan array).
+//
+// A builder's Bvh: children adjacent at `first`, ranges given by the builder or walked.
+struct FlatTree {
+  const Bvh& bvh;
+  const Ranges& ranges;
+
+  bool interior(uint32_t i) const { return !bvh.nodes[i].is_leaf(); }
+  uint32_t left(uint32_t i) const { return bvh.nodes[i].first; }
+  uint32_t right(uint32_t i) const { return bvh.nodes[i].first + 1; }
+  BBox box(uint32_t i) const { return bvh.nodes[i].bbox(); }
+  SlotRange range(uint32_t i) const { return ranges[i]; }
+  size_t plan_slots() const { return bvh.nodes.size(); }
+};
+
+// The LBVH kernels' Karras tree, read where the kernels left it: internal node i has id i, sorted
+// leaf k has id (n - 1) + k.
+struct KarrasTree {
+  const LbvhTree& t;
+
+  uint32_t internal() const { return uint32_t(t.leaves - 1); }
+  uint32_t id(int32_t child) const { return child >= 0 ? uint32_t(child) : internal() + uint32_t(~child); }
+  bool interior(uint32_t i) const { return i < internal(); }
+  uint32_t left(uint32_t i) const { return id(t.nodes[i].left); }
+  uint32_t right(uint32_t i) const { return id(t.nodes[i].right); }
+  BBox box(uint32_t i) const {
+    if (!interior(i)) return t.leaf_bounds[i - internal()];
+    const LbvhNode& n = t.nodes[i];
+    return {{n.lo[0], n.lo[1], n.lo[2]}, {n.hi[0], n.hi[1], n.hi[2]}};
+  }
+  SlotRange range(uint32_t i) const {
+    if (!interior(i)) return {i - internal(), 1u};
+    return {t.leaf_range[2 * size_t(i)], t.leaf_range[2 * size_t(i) + 1] - t.leaf_range[2 * size_t(i)] + 1u};
+  }
+  size_t plan_slots() const { return t.leaves - 1; }
+};
+
+// The tree as collapse() sees it: a subtree of at most leaf_size primitives is one leaf.
+template <class Tree>
+struct CollapsedTree {
+  const Tree& tree;
+  uint32_t leaf_size;
+
+  bool is_leaf(uint32_t i) const { return !tree.interior(i) || tree.range(i).count <= leaf_size; }
+};
+
+template <class Tree>
+struct Planner : CollapsedTree<Tree> {
+  using CollapsedTree<Tree>::tree;
+  using CollapsedTree<Tree>::leaf_size;
+  using CollapsedTree<Tree>::is_leaf;
+  Plan* plan;       // by binary node; written for interior nodes that are not collapsed leaves
+  uint32_t* heads;  // by binary node: the wide nodes of its subtree when it heads a wide node
 
   // Bottom up: the costs of binary node i in at most 1..kWidth slots (parent_area: its parent's
-  // box's half area). Each node's plan depends on its subtree alone, so the parallel split (by a
-  // fixed primitive count) gives the serial plans.
-  Costs solve(uint32_t i, float parent_area = kInfinity) const {
-    Costs out;
+  // box's half area), and the wide nodes each answer makes. Each node's plan depends on its
+  // subtree alone, so the parallel split (by a fixed primitive count) gives the serial plans.
+  Solved solve(uint32_t i, float parent_area = kInfinity) const {
+    Solved solved;
+    Costs& out = solved.cost;
     if (is_leaf(i)) {  // the same in any budget: one collapsed leaf
-      const uint32_t blocks = (range[i].count + leaf_size - 1) / leaf_size;
-      out.fill(float(kBlockCost) * bvh.nodes[i].bbox().half_area() * float(blocks));
-      return out;
+      const uint32_t blocks = (tree.range(i).count + leaf_size - 1) / leaf_size;
+      out.fill(float(kBlockCost) * tree.box(i).half_area() * float(blocks));
+      solved.nodes.fill(0);
+      return solved;
     }
-    const uint32_t l = bvh.nodes[i].first, r = l + 1;
-    const float area_i = bvh.nodes[i].bbox().half_area();
+    const uint32_t l = tree.left(i), r = tree.right(i);
+    const float area_i = tree.box(i).half_area();
     // A node whose box is its parent's (a link of a chain: see kChainVisitWeight) weighs more as
     // a wide node of its own, so the programme prefers to open it into its parent's slots.
     const float visit =
         float(kWideNodeCost) * area_i * (area_i >= 0.999f * parent_area ? float(kChainVisitWeight) : 1.0f);
-    Costs left_cost, right_cost;
-    if (range[i].count > kParallelPrimitives) {
-      tbb::parallel_invoke([&] { left_cost = solve(l, area_i); }, [&] { right_cost = solve(r, area_i); });
+    Solved left, right;
+    if (tree.range(i).count > kParallelPrimitives) {
+      tbb::parallel_invoke([&] { left = solve(l, area_i); }, [&] { right = solve(r, area_i); });
     } else {
-      left_cost = solve(l, area_i);
-      right_cost = solve(r, area_i);
+      left = solve(l, area_i);
+      right = solve(r, area_i);
     }
+    const Costs &left_cost = left.cost, &right_cost = right.cost;
     Plan& p = plan[i];
     // Distributing b slots between the children, k to the left: the best k for every b.
     float spread[kWidth + 1];
@@ -107,24 +161,32 @@ struct Planner : CollapsedTree {
     p.open_left = spread_left[kWidth];
     out[0] = visit + spread[kWidth];
     p.split[0] = 0;
+    heads[i] = 1u + left.nodes[size_t(p.open_left - 1)] + right.nodes[size_t(kWidth - p.open_left - 1)];
+    solved.nodes[0] = heads[i];
     // More slots: the node opened into its parent (its children take the slots), or the
     // answer for one slot fewer, whichever is cheaper.
     for (int b = 2; b <= kWidth; ++b) {
       if (spread[b] < out[size_t(b - 2)]) {
         out[size_t(b - 1)] = spread[b];
         p.split[b - 1] = uint8_t(spread_left[b] | (b - spread_left[b]) << 4);
+        solved.nodes[size_t(b - 1)] =
+            left.nodes[size_t(spread_left[b] - 1)] + right.nodes[size_t(b - spread_left[b] - 1)];
       } else {
         out[size_t(b - 1)] = out[size_t(b - 2)];
         p.split[b - 1] = p.split[b - 2];
+        solved.nodes[size_t(b - 1)] = solved.nodes[size_t(b - 2)];
       }
     }
-    return out;
+    return solved;
   }
 };
 
-struct Collapser : CollapsedTree {
-  using Nodes = std::vector<WideNode, HugePageAllocator<WideNode>>;
-  const Plan* plan;  // null: the greedy collapse
+template <class Tree>
+struct Collapser : CollapsedTree<Tree> {
+  using CollapsedTree<Tree>::tree;
+  using CollapsedTree<Tree>::is_leaf;
+  const Plan* plan;       // null: the greedy collapse
+  const uint32_t* heads;  // as Planner::heads (the greedy collapse's from count())
 
   // The slots binary node i takes with `budget` of them, by its plan.
   void read_out(uint32_t i, int budget, uint32_t kids[kWidth], int& n) const {
@@ -132,8 +194,8 @@ struct Collapser : CollapsedTree {
       kids[n++] = i;
       return;
     }
-    read_out(bvh.nodes[i].first, plan[i].split[budget - 1] & 15, kids, n);
-    read_out(bvh.nodes[i].first + 1, plan[i].split[budget - 1] >> 4, kids, n);
+    read_out(tree.left(i), plan[i].split[budget - 1] & 15, kids, n);
+    read_out(tree.right(i), plan[i].split[budget - 1] >> 4, kids, n);
   }
 
   // The wide node for binary interior node `binary`: the slots of its plan, or (greedy) the
@@ -141,7 +203,7 @@ struct Collapser : CollapsedTree {
   // kWidth are held. Leaf slots are final; an interior slot's child field holds its binary node
   // until the caller places it.
   int gather(uint32_t binary, WideNode& node, uint32_t kids[kWidth]) const {
-    const uint32_t left = bvh.nodes[binary].first, right = left + 1;
+    const uint32_t left = tree.left(binary), right = tree.right(binary);
     int n = 0;
     if (plan) {
       read_out(left, plan[binary].open_left, kids, n);
@@ -153,28 +215,35 @@ struct Collapser : CollapsedTree {
         int best = -1;
         float best_area = -1.0f;
         for (int i = 0; i < n; ++i) {
-          const Node& c = bvh.nodes[kids[i]];
-          if (!is_leaf(kids[i]) && c.bbox().half_area() > best_area) {
+          const float area = tree.box(kids[i]).half_area();
+          if (!is_leaf(kids[i]) && area > best_area) {
             best = i;
-            best_area = c.bbox().half_area();
+            best_area = area;
           }
         }
         if (best < 0) break;
         const uint32_t opened = kids[best];
-        kids[best] = bvh.nodes[opened].first;
-        kids[n++] = bvh.nodes[opened].first + 1;
+        kids[best] = tree.left(opened);
+        kids[n++] = tree.right(opened);
       }
     }
     // Children by decreasing surface area: the order an any-hit walk visits them in. A large box
     // is the likelier to block a shadow ray (a wall beside a dense model: found at once instead
     // of after the model's subtrees); the closest-hit walk sorts by distance and ignores it.
     // An insertion sort: stable, and no allocation.
+    BBox boxes[kWidth];
+    for (int i = 0; i < n; ++i) boxes[i] = tree.box(kids[i]);
     for (int i = 1; i < n; ++i) {
       const uint32_t kid = kids[i];
-      const float area = bvh.nodes[kid].bbox().half_area();
+      const BBox box = boxes[i];
+      const float area = box.half_area();
       int k = i;
-      for (; k > 0 && bvh.nodes[kids[k - 1]].bbox().half_area() < area; --k) kids[k] = kids[k - 1];
+      for (; k > 0 && boxes[k - 1].half_area() < area; --k) {
+        kids[k] = kids[k - 1];
+        boxes[k] = boxes[k - 1];
+      }
       kids[k] = kid;
+      boxes[k] = box;
     }
     for (int a = 0; a < 3; ++a)
       for (int i = 0; i < kWidth; ++i) {
@@ -183,97 +252,107 @@ struct Collapser : CollapsedTree {
       }
     for (int i = 0; i < kWidth; ++i) node.child[i] = node.count[i] = 0;
     for (int i = 0; i < n; ++i) {
-      const Node& c = bvh.nodes[kids[i]];
-      for (int b = 0; b < 6; ++b) node.bounds[b][i] = c.bounds[b];
+      for (int a = 0; a < 3; ++a) {
+        node.bounds[a][i] = boxes[i].lo[a];
+        node.bounds[a + 3][i] = boxes[i].hi[a];
+      }
       if (is_leaf(kids[i])) {
-        node.child[i] = range[kids[i]].first;
-        node.count[i] = range[kids[i]].count;
+        const SlotRange r = tree.range(kids[i]);
+        node.child[i] = r.first;
+        node.count[i] = r.count;
       }
     }
     return n;
   }
 
-  // Writes the wide node of `binary` at out[index] and its whole subtree after out's end: the
-  // interior children of a node side by side (one node's children are read together), each
-  // child's subtree after them, in slot order. Large children's subtrees are collapsed in
-  // parallel into their own arrays and appended in slot order, so the layout is the serial one's.
-  void expand(uint32_t binary, size_t index, Nodes& out) const {
+  // The greedy collapse's heads[]: the wide nodes under each node that heads one, by a dry run.
+  uint32_t count(uint32_t binary, uint32_t* heads_out) const {
     WideNode node;
     uint32_t kids[kWidth];
     const int n = gather(binary, node, kids);
-    const size_t first = out.size();
-    int interior[kWidth], m = 0;
+    uint32_t total = 1;
+    for (int i = 0; i < n; ++i)
+      if (!is_leaf(kids[i])) total += count(kids[i], heads_out);
+    return heads_out[binary] = total;
+  }
+
+  // Writes the wide node headed by binary node `binary` at out[index], its interior children's
+  // nodes side by side from out[first] (one node's children are read together), and each child's
+  // subtree after them, in slot order: a depth-first layout. heads[] sizes every subtree
+  // beforehand, so each lands straight in its place, and large children's subtrees are written in
+  // parallel with the layout of a serial walk (no per-task arrays, copies or regrowth).
+  void place(uint32_t binary, size_t index, size_t first, WideNode* out) const {
+    WideNode node;
+    uint32_t kids[kWidth], interior[kWidth];
+    size_t start[kWidth];
+    const int n = gather(binary, node, kids);
+    int m = 0;
     for (int i = 0; i < n; ++i)
       if (!is_leaf(kids[i])) {
         node.child[i] = uint32_t(first + size_t(m));
-        interior[m++] = i;
+        interior[m++] = kids[i];
       }
-    out.resize(first + size_t(m));
     out[index] = node;
-    // Each large child's subtree below it (its own node is local[0]), built in parallel.
-    Nodes local[kWidth];
-    bool large[kWidth] = {};
-    int large_count = 0;
-    for (int j = 0; j < m; ++j) large_count += large[j] = range[kids[interior[j]]].count > kParallelPrimitives;
-    if (large_count > 1) {
-      tbb::parallel_for(0, m, [&](int j) {
-        if (large[j]) expand_alone(kids[interior[j]], local[j]);
-      });
-    } else if (large_count == 1) {
-      for (int j = 0; j < m; ++j)
-        if (large[j]) expand_alone(kids[interior[j]], local[j]);
-    }
+    size_t next = first + size_t(m);
+    int large[kWidth], large_count = 0;
+    bool in_parallel[kWidth] = {};
     for (int j = 0; j < m; ++j) {
-      if (!large[j]) {
-        expand(kids[interior[j]], first + size_t(j), out);
-        continue;
-      }
-      // local[j][0] takes its slot among its siblings; local[j][1..] goes to the end, its
-      // interior child indices moved by where it lands.
-      const Nodes& sub = local[j];
-      const size_t base = out.size();
-      auto moved = [&](WideNode w) {
-        for (int i = 0; i < kWidth; ++i)
-          if (w.count[i] == 0 && w.used(i)) w.child[i] = uint32_t(base + w.child[i] - 1);
-        return w;
-      };
-      out[first + size_t(j)] = moved(sub[0]);
-      out.resize(base + sub.size() - 1);
-      for (size_t k = 1; k < sub.size(); ++k) out[base + k - 1] = moved(sub[k]);
+      start[j] = next;
+      next += heads[interior[j]] - 1u;
+      if (tree.range(interior[j]).count > kParallelPrimitives) large[large_count++] = j;
     }
-  }
-
-  void expand_alone(uint32_t binary, Nodes& out) const {
-    out.resize(1);
-    expand(binary, 0, out);
+    auto child = [&](int j) { place(interior[j], first + size_t(j), start[j], out); };
+    if (large_count > 1) {
+      for (int k = 0; k < large_count; ++k) in_parallel[large[k]] = true;
+      tbb::parallel_for(0, large_count, [&](int k) { child(large[k]); });
+    }
+    for (int j = 0; j < m; ++j)
+      if (!in_parallel[j]) child(j);
   }
 };
 }  // namespace
 
-WideBvh collapse(const Bvh& bvh, uint32_t leaf_size, CollapseMethod method) {
+namespace {
+template <class Tree>
+WideBvh collapse_tree(const Tree& tree, uint32_t leaf_size, CollapseMethod method) {
   WideBvh wide;
-  if (bvh.nodes.empty()) return wide;
-  // The builder's ranges where it wrote them (the LBVH's: its two million binary nodes at 1M
-  // triangles made this walk a tenth of the commit), else the walk's.
-  const bool given = bvh.ranges.size() == bvh.nodes.size();
-  const Ranges walked = given ? Ranges{} : subtree_ranges(bvh);
-  const Ranges& range = given ? bvh.ranges : walked;
   leaf_size = std::max(leaf_size, 1u);
-  // Not zeroed: only interior nodes' plans are written, and only they are read.
-  std::unique_ptr<Plan[]> plans;
-  if (method == CollapseMethod::Sah) {
-    plans.reset(new Plan[bvh.nodes.size()]);
-    Planner{{bvh, range, leaf_size}, plans.get()}.solve(0);
-  }
-  const Collapser c{{bvh, range, leaf_size}, plans.get()};
-  if (c.is_leaf(0)) {
-    wide.root_leaf_first = range[0].first;
-    wide.root_leaf_count = range[0].count;
+  if (CollapsedTree<Tree>{tree, leaf_size}.is_leaf(0)) {
+    const SlotRange r = tree.range(0);
+    wide.root_leaf_first = r.first;
+    wide.root_leaf_count = r.count;
     return wide;
   }
-  wide.nodes.reserve(bvh.nodes.size() / (kWidth - 1) + 1);
-  c.expand_alone(0, wide.nodes);
+  // Not zeroed: only the entries of interior nodes are written, and only they are read.
+  std::unique_ptr<Plan[]> plans;
+  std::unique_ptr<uint32_t[]> heads(new uint32_t[tree.plan_slots()]);
+  if (method == CollapseMethod::Sah) {
+    plans.reset(new Plan[tree.plan_slots()]);
+    Planner<Tree>{{tree, leaf_size}, plans.get(), heads.get()}.solve(0);
+  }
+  const Collapser<Tree> c{{tree, leaf_size}, plans.get(), heads.get()};
+  if (!plans) c.count(0, heads.get());
+  wide.nodes.resize(heads[0]);  // not zeroed (HugePageAllocator): place() writes every node
+  c.place(0, 0, 1, wide.nodes.data());
   return wide;
+}
+}  // namespace
+
+WideBvh collapse(const Bvh& bvh, uint32_t leaf_size, CollapseMethod method) {
+  if (bvh.nodes.empty()) return {};
+  // The builder's ranges where it wrote them, else the walk's.
+  const bool given = bvh.ranges.size() == bvh.nodes.size();
+  const Ranges walked = given ? Ranges{} : subtree_ranges(bvh);
+  return collapse_tree(FlatTree{bvh, given ? bvh.ranges : walked}, leaf_size, method);
+}
+
+WideBvh collapse(const LbvhTree& tree, uint32_t leaf_size, CollapseMethod method) {
+  if (tree.leaves < 2) {  // no internal node: at most one leaf
+    WideBvh wide;
+    wide.root_leaf_count = uint32_t(tree.leaves);
+    return wide;
+  }
+  return collapse_tree(KarrasTree{tree}, leaf_size, method);
 }
 
 WideStats wide_stats(const WideBvh& wide, uint32_t block_width) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "accel/bvh.h"
+#include "accel/lbvh_layout.h"
 #include "core/huge_page_allocator.h"
 
 #include <vector>
@@ -43,6 +44,13 @@ struct WideBvh {
   bool empty() const { return nodes.empty() && root_leaf_count == 0; }
 };
 
+// What a mesh traces: a builder's tree in the wide layout, and the primitive order its leaves
+// index (a leaf child's `child` is its first slot in prim_ids).
+struct WideBuild {
+  WideBvh wide;
+  std::vector<uint32_t> prim_ids;
+};
+
 // How collapse() chooses which binary nodes a wide node opens.
 enum class CollapseMethod {
   // Opens the largest (by surface area) interior child until kWidth children are held.
@@ -77,6 +85,9 @@ inline constexpr double kChainVisitWeight = 2.0;
 // one leaf (a subtree's primitives are contiguous in prim_ids, since builders partition
 // top-down), so small leaves do not leave wide nodes half empty.
 WideBvh collapse(const Bvh& bvh, uint32_t leaf_size = 1, CollapseMethod method = CollapseMethod::Sah);
+// The same from the LBVH kernels' Karras tree (sorted leaf k = prim_ids slot k): the same wide
+// tree as collapsing that tree's flat Bvh (to_bvh), without writing the 2n - 1 flat nodes.
+WideBvh collapse(const LbvhTree& tree, uint32_t leaf_size = 1, CollapseMethod method = CollapseMethod::Sah);
 
 struct WideStats {
   size_t nodes = 0;

@@ -97,24 +97,18 @@ void Mesh::build(BuilderKind kind, const BuildConfig& config, BuildStats* stats)
   Prepared prepared = prepare();
   BuildConfig mine = config;
   mine.sah.leaf_without_search = kBlockWidth;  // finish() collapses with leaves of one block
-  Bvh bvh = build_bvh(kind, prepared.boxes.data(), nullptr, prepared.count, mine, stats);
+  WideBuild built = build_wide_bvh(kind, prepared.boxes.data(), nullptr, prepared.count, kBlockWidth, mine, stats);
   // The boxes are freed only after finish(): freeing them before it (24 MB less at the peak at 1M)
   // made the 4M commit on two threads 845 -> 1600 ms in bench_trace, its collapse and blocks
   // stalling up to 0.5 s on fresh pages (docs/trace-speed.md, twenty-second session).
-  finish(std::move(bvh), prepared.valid);
+  finish(std::move(built), prepared.valid);
 }
 
-void Mesh::finish(Bvh bvh, const UninitializedArray<uint32_t>& valid) {
-  bvh_ = std::move(bvh);
-  if (valid.size()) {  // builder slots -> triangle indices
-    uint32_t* ids = bvh_.prim_ids.data();
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, bvh_.prim_ids.size(), 16384),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                        for (size_t k = r.begin(); k != r.end(); ++k) ids[k] = valid[ids[k]];
-                      });
-  }
-  wide_ = collapse(bvh_, kBlockWidth);
-  bvh_.ranges = {};  // only the collapse reads them (16 MB at 1M triangles from the LBVH)
+void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
+  wide_ = std::move(built.wide);
+  // Builder slots; freed on return, as the blocks hold the triangle indices.
+  const std::vector<uint32_t> prim_ids = std::move(built.prim_ids);
+  const uint32_t* triangle_of = valid.size() ? valid.data() : nullptr;  // builder slot -> triangle, if not equal
   // Copy every leaf's triangles into blocks and point the wide leaves at them. Each node's first
   // block comes from a serial count in node order, so the blocks are laid out the same whatever
   // the thread count; the copying (a random read of three vertices per triangle) runs in parallel.
@@ -138,7 +132,8 @@ void Mesh::finish(Bvh bvh, const UninitializedArray<uint32_t>& valid) {
             for (int a = 0; a < 3; ++a) b.p[v][a][lane] = 0.0f;
           continue;
         }
-        const uint32_t tri = bvh_.prim_ids[first + k + lane];
+        const uint32_t slot = prim_ids[first + k + lane];
+        const uint32_t tri = triangle_of ? triangle_of[slot] : slot;
         b.prim[lane] = tri;
         for (int v = 0; v < 3; ++v)
           for (int a = 0; a < 3; ++a) b.p[v][a][lane] = vertices_[triangles_[tri][v]][a];
@@ -223,7 +218,6 @@ bool Mesh::occluded(const Vec3& org, const Vec3& dir, float tnear, float tfar, b
 
 size_t Mesh::memory_bytes() const {
   return vertices_.capacity() * sizeof(Vec3) + triangles_.capacity() * sizeof(Triangle) +
-         bvh_.nodes.capacity() * sizeof(Node) + bvh_.prim_ids.capacity() * sizeof(uint32_t) +
          blocks_.capacity() * sizeof(TriangleBlock) + wide_.nodes.capacity() * sizeof(WideNode);
 }
 

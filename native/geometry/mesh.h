@@ -36,7 +36,6 @@ class Mesh {
 
   const std::vector<Vec3>& vertices() const { return vertices_; }
   const std::vector<Triangle>& triangles() const { return triangles_; }
-  const Bvh& bvh() const { return bvh_; }
   // The traced form (wide nodes, leaf triangles in blocks): for queries that walk it themselves.
   const WideBvh& wide_bvh() const { return wide_; }
   const std::vector<TriangleBlock, HugePageAllocator<TriangleBlock>>& blocks() const { return blocks_; }
@@ -54,8 +53,9 @@ class Mesh {
     size_t count = 0;
   };
   Prepared prepare();  // also sets bounds_
-  // From a builder's Bvh over prepare()'s slots: translate ids, collapse, fill the triangle blocks.
-  void finish(Bvh bvh, const UninitializedArray<uint32_t>& valid);
+  // From a builder's wide tree over prepare()'s slots: fill the triangle blocks (slots translated
+  // to triangle indices by `valid`) and point the wide leaves at them.
+  void finish(WideBuild built, const UninitializedArray<uint32_t>& valid);
 
   template <bool AnyHit>
   bool trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim,
@@ -63,8 +63,7 @@ class Mesh {
 
   std::vector<Vec3> vertices_;
   std::vector<Triangle> triangles_;
-  Bvh bvh_;
-  WideBvh wide_;  // bvh_ collapsed for tracing
+  WideBvh wide_;  // the builder's tree in the traced layout
   // The leaves' triangles in blocks of eight, in traversal order: a wide leaf child's `child`
   // is its first block, its `count` the number of triangles (blocks = count rounded up to 4).
   std::vector<TriangleBlock, HugePageAllocator<TriangleBlock>> blocks_;  // huge pages: read at random

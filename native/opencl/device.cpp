@@ -161,6 +161,18 @@ void Buffer::sync_to_host(size_t bytes) const {
   check(clEnqueueUnmapMemObject(device().queue, mem_, p, 0, nullptr, nullptr), "clEnqueueUnmapMemObject");
 }
 
+const void* Buffer::map_read(size_t bytes) const {
+  cl_int status = CL_SUCCESS;
+  void* p = clEnqueueMapBuffer(device().queue, mem_, CL_TRUE, CL_MAP_READ, 0, bytes, 0, nullptr, nullptr, &status);
+  check(status, "clEnqueueMapBuffer");
+  return p;
+}
+
+void Buffer::unmap(const void* mapped) const {
+  check(clEnqueueUnmapMemObject(device().queue, mem_, const_cast<void*>(mapped), 0, nullptr, nullptr),
+        "clEnqueueUnmapMemObject");
+}
+
 void Buffer::fill_zero(size_t bytes) const {
   const cl_int zero = 0;
   check(clEnqueueFillBuffer(device().queue, mem_, &zero, sizeof zero, 0, bytes, 0, nullptr, nullptr),

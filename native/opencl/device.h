@@ -78,6 +78,9 @@ class Buffer {
   void fill_zero(size_t bytes) const;
   // Makes kernel writes to a host-memory buffer visible to the host (a map, no copy on a CPU).
   void sync_to_host(size_t bytes) const;
+  // The first `bytes` mapped for reading (no copy on a CPU device); unmap() each pointer once.
+  const void* map_read(size_t bytes) const;
+  void unmap(const void* mapped) const;
 
  private:
   cl_mem mem_ = nullptr;

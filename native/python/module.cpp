@@ -420,7 +420,13 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
           py::arg("points"), py::arg("threads") = 0,
           "compute_distance, negative where compute_occupancy says inside (0 exactly on the surface).")
       .def("bvh_stats", &PyScene::bvh_stats, py::arg("mesh") = -1,
-           "Node count, leaf count, depth and SAH cost of a mesh's BVH, or of the top level for mesh=-1.")
+           "The shape of a tree, as a dict. mesh >= 0: the mesh's traced 8-wide tree: nodes (wide nodes),\n"
+           "leaves (child slots holding triangles, or 1 for a tree that is a single leaf), triangles (in its\n"
+           "leaves: the mesh's triangles but degenerate ones), depth (levels of wide nodes; 0 for a single\n"
+           "leaf), children_per_node (mean used slots of a node) and sah_cost (node visits and block tests,\n"
+           "weighted as the collapse weighs them: not on the top level's scale). mesh=-1: the binary top\n"
+           "level over instances: nodes (leaves included), leaves, depth (1 for a single leaf),\n"
+           "children_per_node (2; 0 for a single leaf) and sah_cost (traversal and intersection cost 1).")
       .def_property_readonly("mesh_count", &PyScene::mesh_count)
       .def_property_readonly("instance_count", &PyScene::instance_count)
       .def_property_readonly("triangle_count", &PyScene::triangle_count, "Triangles stored, each mesh counted once.")

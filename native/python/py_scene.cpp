@@ -3,8 +3,11 @@
 #include "python/convert.h"
 #include "render/renderer.h"
 
+#include <algorithm>
 #include <cstring>
 #include <mutex>
+#include <utility>
+#include <vector>
 
 namespace toyrt::binding {
 
@@ -432,29 +435,6 @@ py::array PyScene::occluded(py::handle origins, py::handle directions, py::handl
     scene_.occluded(batch, reinterpret_cast<uint8_t*>(blocked.mutable_data()), threads);
   }
   return shaped(blocked, r.leading);
-}
-
-py::dict PyScene::bvh_stats(int64_t mesh) {
-  struct Numbers {
-    size_t nodes, leaves;
-    int depth;
-    double sah_cost;
-  };
-  const Numbers n = read([&] {
-    scene_.check_committed();
-    const Bvh* bvh = &scene_.top_level();
-    if (mesh >= 0) {
-      if (size_t(mesh) >= scene_.mesh_count()) throw std::invalid_argument("unknown mesh id " + std::to_string(mesh));
-      bvh = &scene_.mesh(uint32_t(mesh)).bvh();
-    }
-    return Numbers{bvh->nodes.size(), bvh->leaf_count(), bvh->depth(), bvh->sah_cost()};
-  });
-  py::dict d;
-  d["nodes"] = n.nodes;
-  d["leaves"] = n.leaves;
-  d["depth"] = n.depth;
-  d["sah_cost"] = n.sah_cost;
-  return d;
 }
 
 size_t PyScene::mesh_count() {

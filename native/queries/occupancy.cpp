@@ -31,12 +31,14 @@ bool on_triangle(const DVec3& q, const Vec3& p0, const Vec3& p1, const Vec3& p2)
 bool on_surface(const Mesh& mesh, const Vec3& q) {
   bool found = false;
   const DVec3 dq(q);
-  const Bvh& bvh = mesh.bvh();
-  walk_containing(bvh, q, [&](uint32_t first, uint32_t count) {
-    for (uint32_t k = first; k < first + count && !found; ++k) {
-      const Triangle& t = mesh.triangles()[bvh.prim_ids[k]];
-      found = on_triangle(dq, mesh.vertices()[t.x], mesh.vertices()[t.y], mesh.vertices()[t.z]);
-    }
+  const TriangleBlock* blocks = mesh.blocks().data();
+  walk_containing(mesh.wide_bvh(), q, [&](uint32_t first, uint32_t count) {
+    const uint32_t stop = first + (count + kBlockWidth - 1) / kBlockWidth;
+    for (uint32_t k = first; k < stop && !found; ++k)
+      for (int lane = 0; lane < kBlockWidth && !found; ++lane) {
+        if (blocks[k].prim[lane] == kNoTriangle) continue;
+        found = on_triangle(dq, blocks[k].vertex(lane, 0), blocks[k].vertex(lane, 1), blocks[k].vertex(lane, 2));
+      }
     return found;
   });
   return found;

@@ -343,7 +343,7 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
       Instance& inst = instances_[i];
       const BBox& b = meshes_[inst.mesh]->bounds();
       inst.world_bounds = BBox{};
-      if (meshes_[inst.mesh]->bvh().empty()) continue;  // nothing to hit
+      if (meshes_[inst.mesh]->wide_bvh().empty()) continue;  // nothing to hit
       for (int corner = 0; corner < 8; ++corner) {
         const Vec3 p((corner & 1) ? b.hi.x : b.lo.x, (corner & 2) ? b.hi.y : b.lo.y, (corner & 4) ? b.hi.z : b.lo.z);
         inst.world_bounds.extend(Vec3(inst.to_world * glm::vec4(p, 1.0f)));

@@ -1,6 +1,7 @@
 // The binned SAH builder's output: structural invariants, determinism, hard inputs, and exact
 // agreement of traversal with testing every triangle.
 #include "accel/binned_sah_builder.h"
+#include "accel/builder.h"
 #include "core/parallel.h"
 #include "geometry/mesh.h"
 #include "test_scenes.h"
@@ -8,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <memory>
 
 using namespace toyrt;
 using namespace toyrt::testing;
@@ -15,6 +17,16 @@ using namespace toyrt::testing;
 namespace {
 
 std::vector<BBox> triangle_boxes(const MeshData& m) { return triangle_bounds(m).boxes; }
+
+// The binary tree a mesh's SAH commit builds (with its leaf setting) before the collapse.
+Bvh sah_tree(const MeshData& m, int threads = 0) {
+  const auto boxes = triangle_boxes(m);
+  BuildConfig config;
+  config.sah.leaf_without_search = kBlockWidth;
+  Bvh bvh;
+  run_with_threads(threads, [&] { bvh = build_bvh(BuilderKind::Sah, boxes.data(), nullptr, boxes.size(), config); });
+  return bvh;
+}
 
 Mesh built(const MeshData& m, int threads = 0) {
   Mesh mesh(m.vertices, m.triangles);
@@ -45,20 +57,44 @@ Hit brute_force(const MeshData& m, const Ray& ray) {
 TEST(BinnedSahBuilder, InvariantsHoldOnVariedMeshes) {
   for (const MeshData& m : {uv_sphere(40, 80), bicone_fan(3000), triangle_soup(20000, 0.02f, 1), slivers(5000, 2),
                             transformed(uv_sphere(30, 60, 1.0f, 0.2f), 1e-3f, Vec3(1e5f, -1e5f, 3e4f))}) {
-    const Mesh mesh = built(m);
+    const Bvh bvh = sah_tree(m);
     const auto boxes = triangle_boxes(m);
-    EXPECT_EQ(mesh.bvh().validate(boxes.data(), boxes.size()), "");
-    EXPECT_LE(mesh.bvh().depth(), kMaxBvhDepth);
+    EXPECT_EQ(bvh.validate(boxes.data(), boxes.size()), "");
+    EXPECT_LE(bvh.depth(), kMaxBvhDepth);
   }
 }
 
 TEST(BinnedSahBuilder, SameTreeForAnyThreadCount) {
   const MeshData m = uv_sphere(300, 600, 1.0f, 0.1f);  // large enough for the parallel paths
-  const Mesh one = built(m, 1), two = built(m, 2), all = built(m, 0);
-  for (const Mesh* other : {&two, &all}) {
-    ASSERT_EQ(one.bvh().nodes.size(), other->bvh().nodes.size());
-    EXPECT_EQ(0, std::memcmp(one.bvh().nodes.data(), other->bvh().nodes.data(), one.bvh().nodes.size() * sizeof(Node)));
-    EXPECT_EQ(one.bvh().prim_ids, other->bvh().prim_ids);
+  const Bvh one = sah_tree(m, 1), two = sah_tree(m, 2), all = sah_tree(m, 0);
+  for (const Bvh* other : {&two, &all}) {
+    ASSERT_EQ(one.nodes.size(), other->nodes.size());
+    EXPECT_EQ(0, std::memcmp(one.nodes.data(), other->nodes.data(), one.nodes.size() * sizeof(Node)));
+    EXPECT_EQ(one.prim_ids, other->prim_ids);
+  }
+}
+
+// What tracing reads (wide nodes and triangle blocks) is byte for byte the same on 1, 2 and all
+// threads, from either builder: traversal results cannot depend on the thread count.
+TEST(Mesh, TracedLayoutSameForAnyThreadCount) {
+  const MeshData m = uv_sphere(300, 600, 1.0f, 0.1f);  // above the collapse's parallel threshold
+  for (const BuilderKind kind : {BuilderKind::Sah, BuilderKind::Lbvh}) {
+    SCOPED_TRACE(builder_name(kind));
+    auto build = [&](int threads) {
+      auto mesh = std::make_unique<Mesh>(m.vertices, m.triangles);
+      run_with_threads(threads, [&] { mesh->build(kind); });
+      return mesh;
+    };
+    const auto one = build(1), two = build(2), all = build(0);
+    for (const Mesh* other : {two.get(), all.get()}) {
+      const auto& a = one->wide_bvh().nodes;
+      const auto& b = other->wide_bvh().nodes;
+      ASSERT_EQ(a.size(), b.size());
+      EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(WideNode)));
+      ASSERT_EQ(one->blocks().size(), other->blocks().size());
+      EXPECT_EQ(
+          0, std::memcmp(one->blocks().data(), other->blocks().data(), one->blocks().size() * sizeof(TriangleBlock)));
+    }
   }
 }
 
@@ -67,10 +103,10 @@ TEST(BinnedSahBuilder, CoincidentCentroidsStayShallow) {
   MeshData m;
   m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   m.triangles.assign(100000, Triangle(0, 1, 2));
-  const Mesh mesh = built(m);
+  const Bvh bvh = sah_tree(m);
   const auto boxes = triangle_boxes(m);
-  EXPECT_EQ(mesh.bvh().validate(boxes.data(), boxes.size()), "");
-  EXPECT_LE(mesh.bvh().depth(), 20);
+  EXPECT_EQ(bvh.validate(boxes.data(), boxes.size()), "");
+  EXPECT_LE(bvh.depth(), 20);
 }
 
 TEST(BinnedSahBuilder, AdversarialSpacingStaysWithinStackDepth) {
@@ -84,29 +120,29 @@ TEST(BinnedSahBuilder, AdversarialSpacingStaysWithinStackDepth) {
     m.vertices.push_back({x, 0, 1e-30f + x * 1e-3f});
     m.triangles.push_back({b, b + 1, b + 2});
   }
-  const Mesh mesh = built(m);
+  const Bvh bvh = sah_tree(m);
   const auto boxes = triangle_boxes(m);
-  EXPECT_EQ(mesh.bvh().validate(boxes.data(), boxes.size()), "");
+  EXPECT_EQ(bvh.validate(boxes.data(), boxes.size()), "");
 }
 
 TEST(BinnedSahBuilder, OneAndTwoPrimitives) {
   MeshData one;
   one.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   one.triangles = {{0, 1, 2}};
-  EXPECT_EQ(built(one).bvh().nodes.size(), 1u);
+  EXPECT_EQ(sah_tree(one).nodes.size(), 1u);
   MeshData two = one;
   two.triangles.push_back({0, 1, 3});
-  const Mesh mesh = built(two);
+  const Bvh bvh = sah_tree(two);
   const auto boxes = triangle_boxes(two);
-  EXPECT_EQ(mesh.bvh().validate(boxes.data(), boxes.size()), "");
+  EXPECT_EQ(bvh.validate(boxes.data(), boxes.size()), "");
 }
 
 TEST(BinnedSahBuilder, SahCostBeatsALeafOfEverything) {
   const MeshData m = uv_sphere(100, 200);
-  const Mesh mesh = built(m);
+  const Bvh bvh = sah_tree(m);
   // A single leaf costs one test per triangle; a good tree needs a few dozen.
-  EXPECT_LT(mesh.bvh().sah_cost(), 100.0);
-  EXPECT_GT(mesh.bvh().sah_cost(), 1.0);
+  EXPECT_LT(bvh.sah_cost(), 100.0);
+  EXPECT_GT(bvh.sah_cost(), 1.0);
 }
 
 TEST(Bvh, TraversalAgreesExactlyWithTestingEveryTriangle) {

@@ -68,6 +68,21 @@ void expect_same_as_reference(const MeshData& m, MortonBits bits) {
   if (!a.nodes.empty()) EXPECT_EQ(0, std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(WideNode)));
   EXPECT_EQ(a.root_leaf_first, b.root_leaf_first);
   EXPECT_EQ(a.root_leaf_count, b.root_leaf_count);
+  // The commit's path collapses the kernels' Karras tree in place, never writing the flat nodes:
+  // the same wide tree, byte for byte, as collapsing the reference's flat Bvh, for leaves of one
+  // block and of one primitive.
+  for (const uint32_t leaf_size : {uint32_t(kBlockWidth), 1u}) {
+    const WideBuild direct = build_lbvh_wide(p.boxes.data(), p.centers.data(), p.boxes.size(), leaf_size, config);
+    const WideBvh expected = collapse(ref, leaf_size);
+    EXPECT_EQ(direct.prim_ids, ref.prim_ids);
+    ASSERT_EQ(direct.wide.nodes.size(), expected.nodes.size());
+    if (!expected.nodes.empty()) {
+      EXPECT_EQ(0,
+                std::memcmp(direct.wide.nodes.data(), expected.nodes.data(), expected.nodes.size() * sizeof(WideNode)));
+    }
+    EXPECT_EQ(direct.wide.root_leaf_first, expected.root_leaf_first);
+    EXPECT_EQ(direct.wide.root_leaf_count, expected.root_leaf_count);
+  }
 }
 
 }  // namespace

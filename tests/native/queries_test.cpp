@@ -474,6 +474,31 @@ TEST(Occupancy, PointsOnRaysThroughVerticesAndEdgesOfASphere) {
   EXPECT_EQ(inside, expected);
 }
 
+// Under flush-to-zero (a caller's MXCSR) the float filter is off, and occupancy takes the separate
+// on-surface walk (queries/point_walk.h over the mesh's wide tree) before the parity: the same
+// answers, on a mesh that is a single leaf (the cube) and on one with wide nodes (the sphere,
+// whose vertices lie on the surface exactly).
+TEST(Occupancy, FlushToZeroGivesTheSameAnswersThroughTheOnSurfaceWalk) {
+  for (const MeshData& m : {cube(4.0f, Vec3(-2.0f)), icosphere(3)}) {
+    Committed c(m);
+    std::vector<float> pts;
+    std::vector<uint8_t> expected;  // both meshes are star-shaped about the origin
+    for (const Vec3& v : m.vertices)
+      for (float s : {0.5f, 1.0f, 1.5f}) {
+        pts.insert(pts.end(), {s * v.x, s * v.y, s * v.z});
+        expected.push_back(s <= 1.0f);  // inside, or on the surface at the vertex itself
+      }
+    std::vector<uint8_t> inside(expected.size());
+    const unsigned csr = _mm_getcsr();
+    _mm_setcsr(csr | 0x8040u);  // FTZ and DAZ, on this thread, which runs a one-thread query
+    const bool usable = queries::float_filter_usable();
+    queries::compute_occupancy(c.scene, pts.data(), expected.size(), inside.data(), 1);
+    _mm_setcsr(csr);
+    EXPECT_FALSE(usable);
+    EXPECT_EQ(inside, expected);
+  }
+}
+
 TEST(ClosestPoints, CubeDistancesHaveClosedForms) {
   Committed c(cube(2.0f));
   const std::vector<float> pts = {1, 1, 1, 5, 1, 1, 4, 4, 4, 1, 1, 2, -1, 3, 1};

@@ -255,10 +255,31 @@ def test_queries_from_several_threads_while_another_adds_meshes():
 
 def test_stats_report_the_trees():
     s = quad_scene()
+    # Two triangles make one leaf: no wide node, depth 0; the top level is one binary leaf.
     stats = s.bvh_stats(0)
-    assert stats["leaves"] >= 1 and stats["nodes"] >= 1 and stats["sah_cost"] > 0
+    assert (stats["nodes"], stats["leaves"], stats["triangles"], stats["depth"]) == (0, 1, 2, 0)
+    assert stats["children_per_node"] == 0.0 and stats["sah_cost"] > 0
+    top = s.bvh_stats()
+    assert (top["nodes"], top["leaves"], top["depth"], top["children_per_node"]) == (1, 1, 1, 0.0)
     assert s.triangle_count == 2 and s.instance_count == 1 and s.committed
     assert s.build_ms >= 0.0
+
+
+@pytest.mark.parametrize("builder", ["sah", "lbvh"])
+def test_stats_describe_the_wide_tree(builder):
+    rng = np.random.default_rng(13)
+    n = 5000
+    vertices, triangles = random_soup(rng, n, 0.02)
+    triangles = np.vstack([triangles, [[0, 0, 1]]]).astype(np.uint32)  # a degenerate one: in no leaf
+    stats = one_mesh(vertices, triangles, builder=builder).bvh_stats(0)
+    nodes, leaves = stats["nodes"], stats["leaves"]
+    assert stats["triangles"] == n  # every triangle that can be hit, in exactly one leaf
+    assert leaves >= -(-n // 8)  # a leaf is one block of at most 8 triangles
+    # Every node but the root is a used slot, and so is every leaf: the mean follows exactly.
+    assert stats["children_per_node"] == pytest.approx((nodes - 1 + leaves) / nodes, rel=1e-12)
+    assert leaves <= 7 * nodes + 1  # nodes of at most 8 children
+    assert 8 ** stats["depth"] >= leaves and stats["depth"] <= nodes
+    assert stats["sah_cost"] > 0
 
 
 def test_lbvh_builder_gives_the_same_hits_as_sah():
