@@ -1,9 +1,10 @@
-// LBVH construction after Karras 2012, "Maximizing Parallelism in the Construction of BVHs,
-// Octrees, and k-d Trees". OpenCL C 1.2, no extensions: PoCL runs it on the CPU here, and any
+// LBVH construction: the binary radix tree of Karras 2012 ("Maximizing Parallelism in the
+// Construction of BVHs, Octrees, and k-d Trees"), built bottom up with its boxes in one pass as
+// Apetrei 2014 does it ("Fast and Simple Agglomerative LBVH Construction"). OpenCL C 1.2, no extensions: PoCL runs it on the CPU here, and any
 // OpenCL 1.2 GPU runs it unchanged. The host (native/accel/lbvh_builder.cpp) runs the stages in
 // this order, one kernel each:
 //   centroid_bounds -> morton_codes -> (radix_histogram, radix_scan, radix_scatter) per digit
-//   -> emit_hierarchy -> gather_bounds -> propagate_bounds -> write_bvh_nodes
+//   -> gather_bounds -> build_hierarchy (-> write_bvh_nodes, when the flat binary tree is asked for)
 // Shared layouts are described byte by byte in native/accel/lbvh_layout.h, which static_asserts
 // them on the host side.
 
@@ -12,7 +13,7 @@
 #pragma OPENCL FP_CONTRACT OFF
 
 // 32 bytes, as LbvhNode in lbvh_layout.h. A child >= 0 is an internal node, a child < 0 is the
-// leaf ~child (the sorted primitive slot). Bounds are written by propagate_bounds.
+// leaf ~child (the sorted primitive slot). Written by build_hierarchy.
 typedef struct {
   float lo[3];  // bytes 0-11
   int left;     // bytes 12-15
@@ -66,7 +67,7 @@ __kernel void morton_codes(__global const float* centers, uint n, float lo_x, fl
 
 // Stage 3: a stable least-significant-digit radix sort of (key, value) pairs, 8 bits per pass.
 // The input is cut into blocks of `block` pairs, one work-item each, walked in order, which is
-// what keeps equal keys in index order (the tie-break emit_hierarchy relies on).
+// what keeps equal keys in index order (the tie-break build_hierarchy relies on).
 // hist is digit-major: hist[digit * blocks + b] counts `digit` in block b, so one exclusive scan
 // of it gives every (digit, block) its first output slot.
 __kernel void radix_histogram(__global const ulong* keys, uint n, uint shift, uint block, __global uint* hist) {
@@ -115,43 +116,7 @@ int common_prefix(__global const ulong* keys, long n, long i, long j) {
   return (int)clz(a ^ b);
 }
 
-// Stage 4: one work-item per internal node i in [0, n - 2] finds the range of sorted leaves it
-// covers and where that range splits (Karras 2012, section 4). Internal node 0 is the root.
-__kernel void emit_hierarchy(__global const ulong* keys, uint n_leaves, __global LbvhNode* nodes,
-                             __global int* internal_parent, __global int* leaf_parent, __global uint2* range) {
-  const long i = get_global_id(0), n = n_leaves;
-  if (i >= n - 1) return;
-  // Direction of the range: towards the neighbour sharing the longer prefix.
-  const int d = common_prefix(keys, n, i, i + 1) - common_prefix(keys, n, i, i - 1) >= 0 ? 1 : -1;
-  // Upper bound of the range's length, then its exact other end j by binary search.
-  const int min_prefix = common_prefix(keys, n, i, i - d);
-  long max_len = 2;
-  while (common_prefix(keys, n, i, i + max_len * d) > min_prefix) max_len *= 2;
-  long len = 0;
-  for (long t = max_len / 2; t >= 1; t /= 2)
-    if (common_prefix(keys, n, i, i + (len + t) * d) > min_prefix) len += t;
-  const long j = i + len * d;
-  // The split: the last position sharing more than the whole range's prefix with i.
-  const int node_prefix = common_prefix(keys, n, i, j);
-  long split = 0;
-  for (long div = 2;; div *= 2) {
-    const long t = (len + div - 1) / div;
-    if (common_prefix(keys, n, i, i + (split + t) * d) > node_prefix) split += t;
-    if (t == 1) break;
-  }
-  const long gamma = i + split * d + min(d, 0);
-  const long first = min(i, j), last = max(i, j);
-  const int left = first == gamma ? ~(int)gamma : (int)gamma;
-  const int right = last == gamma + 1 ? ~(int)(gamma + 1) : (int)(gamma + 1);
-  nodes[i].left = left;
-  nodes[i].right = right;
-  range[i] = (uint2)((uint)first, (uint)last);  // the leaves it covers, for write_bvh_nodes
-  if (left < 0) leaf_parent[~left] = (int)i; else internal_parent[left] = (int)i;
-  if (right < 0) leaf_parent[~right] = (int)i; else internal_parent[right] = (int)i;
-  if (i == 0) internal_parent[0] = -1;
-}
-
-// Stage 5a: the primitives' boxes in sorted order, so that the climb below reads its leaves'
+// Stage 4a: the primitives' boxes in sorted order, so that the climb below reads its leaves'
 // boxes from neighbouring memory rather than chasing values[] across the whole array.
 __kernel void gather_bounds(__global const float* prim_bounds, __global const uint* values, uint n,
                             __global float* sorted_bounds) {
@@ -171,71 +136,77 @@ void child_bounds(__global const float* sorted_bounds, volatile __global LbvhNod
   }
 }
 
-// Stage 5: bounds, bottom up. Every leaf's work-item climbs towards the root; at each internal
-// node the first arrival stops (atomic flag) and the second, whose sibling subtree is then
-// complete, writes the node's box and climbs on. sorted_bounds holds six floats per leaf
-// (lo.xyz, hi.xyz) in sorted order (gather_bounds).
-__kernel void propagate_bounds(__global const float* sorted_bounds, uint n_leaves,
-                               volatile __global LbvhNode* nodes, __global const int* internal_parent,
-                               __global const int* leaf_parent, volatile __global int* flags) {
-  const uint k = get_global_id(0);
-  if (k >= n_leaves) return;
-  int node = leaf_parent[k];
-  while (node >= 0) {
-    mem_fence(CLK_GLOBAL_MEM_FENCE);  // our child's box is visible before we announce arrival
-    if (atomic_inc(&flags[node]) == 0) return;
+// Stage 4b: the hierarchy and its boxes in one bottom-up pass (Apetrei 2014, "Fast and Simple
+// Agglomerative LBVH Construction"), the same binary radix tree Karras' top-down search finds,
+// without its binary searches or a second pass for the boxes. Internal node g is the one that
+// splits between sorted leaves g and g + 1. One work-item per leaf climbs: a node covering
+// leaves [l, r] is the left child of node r when keys r and r + 1 share a longer prefix than
+// keys l - 1 and l (its range grows to the right), else the right child of node l - 1. At each
+// parent the first arrival leaves the end of its range in ends[] (stored + 1: zero means empty)
+// and stops; the second, whose sibling subtree is then complete, writes the parent's box and
+// range and climbs on. The work-item that completes [0, n - 1] writes the root's index.
+__kernel void build_hierarchy(__global const ulong* keys, uint n_leaves, __global const float* sorted_bounds,
+                              volatile __global LbvhNode* nodes, __global uint2* range, volatile __global int* ends,
+                              __global int* root) {
+  const long k = get_global_id(0), n = n_leaves;
+  if (k >= n) return;
+  long l = k, r = k;
+  int current = ~(int)k;
+  float lo[3], hi[3];
+  child_bounds(sorted_bounds, nodes, current, lo, hi);
+  while (l > 0 || r < n - 1) {
+    const bool is_left = l == 0 || (r < n - 1 && common_prefix(keys, n, r, r + 1) > common_prefix(keys, n, l - 1, l));
+    const long parent = is_left ? r : l - 1;
+    if (is_left) nodes[parent].left = current; else nodes[parent].right = current;
+    mem_fence(CLK_GLOBAL_MEM_FENCE);  // our child link and box are visible before we announce arrival
+    const int other = atomic_xchg(&ends[parent], (int)(is_left ? l : r) + 1);
+    if (other == 0) return;
     mem_fence(CLK_GLOBAL_MEM_FENCE);
-    float llo[3], lhi[3], rlo[3], rhi[3];
-    child_bounds(sorted_bounds, nodes, nodes[node].left, llo, lhi);
-    child_bounds(sorted_bounds, nodes, nodes[node].right, rlo, rhi);
+    if (is_left) r = other - 1; else l = other - 1;
+    float slo[3], shi[3];
+    child_bounds(sorted_bounds, nodes, is_left ? nodes[parent].right : nodes[parent].left, slo, shi);
     for (int a = 0; a < 3; ++a) {
-      nodes[node].lo[a] = fmin(llo[a], rlo[a]);
-      nodes[node].hi[a] = fmax(lhi[a], rhi[a]);
+      lo[a] = fmin(lo[a], slo[a]);
+      hi[a] = fmax(hi[a], shi[a]);
+      nodes[parent].lo[a] = lo[a];
+      nodes[parent].hi[a] = hi[a];
     }
-    node = internal_parent[node];
+    range[parent] = (uint2)((uint)l, (uint)r);
+    current = (int)parent;
   }
+  *root = current;
 }
 
-// Where the flat BVH keeps the children of internal node p: each split position gamma (between
-// sorted leaves gamma and gamma + 1) belongs to exactly one internal node, so the pair
-// (1 + 2 gamma, 2 + 2 gamma) is a unique, adjacent home for its two children; the root is 0.
-uint child_slot(__global const LbvhNode* nodes, int p, int child) {
-  const int left = nodes[p].left;
-  const int gamma = left >= 0 ? left : ~left;
-  return 1u + 2u * (uint)gamma + (nodes[p].right == child ? 1u : 0u);
-}
-
-// Stage 6: the flat BVH (native/accel/node.h layout), written in place on the device so that
-// neither the Karras nodes nor a host-side conversion are needed. Work-items 0 .. n - 2 write the
-// internal nodes, n - 1 .. 2n - 2 the leaves (one primitive each, slot k of the sorted order).
-// Beside each node, the sorted slots under it (first, count): the host's collapse to the wide
-// layout needs them, and deriving them there took a walk of the whole tree.
-__kernel void write_bvh_nodes(__global const LbvhNode* nodes, __global const int* internal_parent,
-                              __global const int* leaf_parent, __global const float* sorted_bounds, uint n_leaves,
-                              __global BvhNode* out, __global const uint2* range, __global uint2* out_range) {
-  const uint id = get_global_id(0);
-  const uint internal = n_leaves - 1;
-  if (id >= internal + n_leaves) return;
+// Stage 5: the flat BVH (native/accel/node.h layout), written on the device for the callers that
+// want the binary tree itself (tests, benchmarks; a commit collapses the nodes above in place).
+// Internal node g's children go to slots 1 + 2g and 2 + 2g, a unique adjacent pair; the root to
+// slot 0. Beside each node, the sorted slots under it (first, count).
+void write_flat(__global const LbvhNode* nodes, __global const float* sorted_bounds, __global const uint2* range,
+                int child, uint at, __global BvhNode* out, __global uint2* out_range) {
   BvhNode node;
-  uint at;
-  if (id < internal) {
-    const int i = (int)id;
-    at = i == 0 ? 0u : child_slot(nodes, internal_parent[i], i);
+  if (child >= 0) {
     for (int a = 0; a < 3; ++a) {
-      node.bounds[a] = nodes[i].lo[a];
-      node.bounds[3 + a] = nodes[i].hi[a];
+      node.bounds[a] = nodes[child].lo[a];
+      node.bounds[3 + a] = nodes[child].hi[a];
     }
-    const int left = nodes[i].left;
-    node.first = 1u + 2u * (uint)(left >= 0 ? left : ~left);
+    node.first = 1u + 2u * (uint)child;
     node.count = 0u;
-    out_range[at] = (uint2)(range[i].x, range[i].y - range[i].x + 1u);
+    out_range[at] = (uint2)(range[child].x, range[child].y - range[child].x + 1u);
   } else {
-    const int k = (int)(id - internal);
-    at = child_slot(nodes, leaf_parent[k], ~k);
-    for (int a = 0; a < 6; ++a) node.bounds[a] = sorted_bounds[6 * k + a];
-    node.first = (uint)k;
+    for (int a = 0; a < 6; ++a) node.bounds[a] = sorted_bounds[6 * ~child + a];
+    node.first = (uint)~child;
     node.count = 1u;
-    out_range[at] = (uint2)((uint)k, 1u);
+    out_range[at] = (uint2)((uint)~child, 1u);
   }
   out[at] = node;
+}
+
+__kernel void write_bvh_nodes(__global const LbvhNode* nodes, __global const float* sorted_bounds,
+                              __global const uint2* range, uint n_leaves, int root, __global BvhNode* out,
+                              __global uint2* out_range) {
+  const int g = (int)get_global_id(0);
+  if (g >= (int)n_leaves - 1) return;
+  if (g == root) write_flat(nodes, sorted_bounds, range, g, 0u, out, out_range);
+  write_flat(nodes, sorted_bounds, range, nodes[g].left, 1u + 2u * (uint)g, out, out_range);
+  write_flat(nodes, sorted_bounds, range, nodes[g].right, 2u + 2u * (uint)g, out, out_range);
 }

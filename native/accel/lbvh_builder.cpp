@@ -98,16 +98,25 @@ LbvhHierarchy build_lbvh_hierarchy_reference(const BBox* prim_bounds, const Vec3
   h.keys.resize(count);
   for (size_t k = 0; k < count; ++k) h.keys[k] = codes[h.values[k]];
   if (count == 1) return h;
+  // Karras' top-down construction (node i has one end of its range at leaf i; root 0), then
+  // renumbered as the kernel numbers nodes, by split position. The kernel builds the tree bottom
+  // up another way (Apetrei's): equal trees are a check of both.
+  std::vector<LbvhNode> karras(count - 1);
+  for (size_t i = 0; i + 1 < count; ++i) emit_node(h.keys, int64_t(i), karras[i]);
+  // Node i's split position: its left child's index (Karras numbers a left child by it).
+  auto split_of = [&](int32_t i) {
+    return karras[size_t(i)].left >= 0 ? karras[size_t(i)].left : ~karras[size_t(i)].left;
+  };
+  auto renumbered = [&](int32_t child) { return child >= 0 ? split_of(child) : child; };
   h.nodes.resize(count - 1);
-  h.internal_parent.assign(count - 1, -1);
-  h.leaf_parent.assign(count, -1);
   for (size_t i = 0; i + 1 < count; ++i) {
-    emit_node(h.keys, int64_t(i), h.nodes[i]);
-    for (int32_t child : {h.nodes[i].left, h.nodes[i].right})
-      (child < 0 ? h.leaf_parent[size_t(~child)] : h.internal_parent[size_t(child)]) = int32_t(i);
+    LbvhNode& node = h.nodes[size_t(split_of(int32_t(i)))];
+    node.left = renumbered(karras[i].left);
+    node.right = renumbered(karras[i].right);
   }
+  h.root = split_of(0);
   // Bounds bottom up: children have no fixed index order, so recurse from the root (post-order).
-  std::vector<std::pair<int32_t, bool>> stack{{0, false}};
+  std::vector<std::pair<int32_t, bool>> stack{{h.root, false}};
   auto bounds_of = [&](int32_t child, float* lo, float* hi) {
     if (child < 0) {
       const BBox& b = prim_bounds[h.values[size_t(~child)]];
@@ -139,8 +148,8 @@ LbvhHierarchy build_lbvh_hierarchy_reference(const BBox* prim_bounds, const Vec3
 
 namespace {
 
-// What run_opencl fills, whichever is non-null: `hierarchy` (Karras nodes and parents, and the
-// keys when with_keys), `bvh` (the flat nodes written on the device), `wide` (the Karras tree
+// What run_opencl fills, whichever is non-null: `hierarchy` (the radix tree's nodes and root, and
+// the keys when with_keys), `bvh` (the flat nodes written on the device), `wide` (the radix tree
 // collapsed in place into wide nodes with leaves of up to leaf_size primitives).
 struct LbvhOutputs {
   LbvhHierarchy* hierarchy = nullptr;
@@ -254,7 +263,7 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
   }
   if (count == 1) {
     if (hierarchy) hierarchy->values = order;
-    if (bvh) *bvh = to_bvh(LbvhHierarchy{{}, order, {}, {}, {}}, prim_bounds);
+    if (bvh) *bvh = to_bvh(LbvhHierarchy{{}, order, {}, 0}, prim_bounds);
     if (out.wide) {
       out.wide->wide = WideBvh{};
       out.wide->wide.root_leaf_count = 1;
@@ -263,19 +272,6 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
     return;
   }
   const size_t internal = count - 1;
-  Buffer nodes(internal * sizeof(LbvhNode)), internal_parent(internal * sizeof(cl_int)),
-      leaf_parent(count * sizeof(cl_int)), flags(internal * sizeof(cl_int)),
-      internal_range(internal * 2 * sizeof(cl_uint));
-  Kernel(prog.program, "emit_hierarchy")
-      .arg(0, keys[in].get())
-      .arg(1, n)
-      .arg(2, nodes.get())
-      .arg(3, internal_parent.get())
-      .arg(4, leaf_parent.get())
-      .arg(5, internal_range.get())
-      .run(internal);
-  stage("hierarchy");
-
   // BBox is six packed floats (lo.xyz, hi.xyz): the layout the kernels read.
   static_assert(sizeof(BBox) == 6 * sizeof(float), "BBox must be six packed floats");
   Buffer bounds_buf(count * sizeof(BBox), CL_MEM_READ_ONLY, prim_bounds);
@@ -286,16 +282,21 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
       .arg(2, n)
       .arg(3, sorted_bounds.get())
       .run(count);
-  flags.fill_zero(internal * sizeof(cl_int));
-  Kernel(prog.program, "propagate_bounds")
-      .arg(0, sorted_bounds.get())
+  Buffer nodes(internal * sizeof(LbvhNode)), ends(internal * sizeof(cl_int)),
+      internal_range(internal * 2 * sizeof(cl_uint)), root_buf(sizeof(cl_int));
+  ends.fill_zero(internal * sizeof(cl_int));
+  Kernel(prog.program, "build_hierarchy")
+      .arg(0, keys[in].get())
       .arg(1, n)
-      .arg(2, nodes.get())
-      .arg(3, internal_parent.get())
-      .arg(4, leaf_parent.get())
-      .arg(5, flags.get())
+      .arg(2, sorted_bounds.get())
+      .arg(3, nodes.get())
+      .arg(4, internal_range.get())
+      .arg(5, ends.get())
+      .arg(6, root_buf.get())
       .run(count);
-  stage("bounds");
+  cl_int root = 0;
+  root_buf.read(&root, sizeof root);
+  stage("hierarchy and bounds");
 
   if (bvh) {
     bvh->nodes.resize(2 * count - 1);
@@ -306,14 +307,13 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
     Buffer flat_range(range_bytes, CL_MEM_WRITE_ONLY, bvh->ranges.data());
     Kernel(prog.program, "write_bvh_nodes")
         .arg(0, nodes.get())
-        .arg(1, internal_parent.get())
-        .arg(2, leaf_parent.get())
-        .arg(3, sorted_bounds.get())
-        .arg(4, n)
+        .arg(1, sorted_bounds.get())
+        .arg(2, internal_range.get())
+        .arg(3, n)
+        .arg(4, root)
         .arg(5, flat.get())
-        .arg(6, internal_range.get())
-        .arg(7, flat_range.get())
-        .run(2 * count - 1);
+        .arg(6, flat_range.get())
+        .run(internal);
     flat.sync_to_host(bytes);
     flat_range.sync_to_host(range_bytes);
     bvh->prim_ids = order;
@@ -327,6 +327,7 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
     tree.leaf_bounds = static_cast<const BBox*>(sorted_bounds.map_read(count * sizeof(BBox)));
     tree.leaf_range = static_cast<const uint32_t*>(internal_range.map_read(internal * 2 * sizeof(cl_uint)));
     tree.leaves = count;
+    tree.root = uint32_t(root);
     out.wide->wide = collapse(tree, out.leaf_size);
     nodes.unmap(tree.nodes);
     sorted_bounds.unmap(tree.leaf_bounds);
@@ -337,11 +338,8 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
   if (hierarchy) {
     hierarchy->values = std::move(order);
     hierarchy->nodes.resize(internal);
-    hierarchy->internal_parent.resize(internal);
-    hierarchy->leaf_parent.resize(count);
     nodes.read(hierarchy->nodes.data(), internal * sizeof(LbvhNode));
-    internal_parent.read(hierarchy->internal_parent.data(), internal * sizeof(cl_int));
-    leaf_parent.read(hierarchy->leaf_parent.data(), count * sizeof(cl_int));
+    hierarchy->root = root;
   }
   check(clFinish(dev.queue), "clFinish");
 }
@@ -370,26 +368,24 @@ Bvh to_bvh(const LbvhHierarchy& h, const BBox* prim_bounds) {
     bvh.nodes[0].count = 1;
     return bvh;
   }
-  // The same placement as the write_bvh_nodes kernel.
-  auto split_of = [&](int32_t p) {
-    const int32_t l = h.nodes[size_t(p)].left;
-    return uint32_t(l >= 0 ? l : ~l);
+  // The same placement as the write_bvh_nodes kernel: node g's children at 1 + 2g and 2 + 2g.
+  auto place = [&](int32_t child, size_t at) {
+    Node& node = bvh.nodes[at];
+    if (child >= 0) {
+      const LbvhNode& src = h.nodes[size_t(child)];
+      node.set_bbox({{src.lo[0], src.lo[1], src.lo[2]}, {src.hi[0], src.hi[1], src.hi[2]}});
+      node.first = 1u + 2u * uint32_t(child);
+      node.count = 0;
+    } else {
+      node.set_bbox(prim_bounds[h.values[size_t(~child)]]);
+      node.first = uint32_t(~child);
+      node.count = 1;
+    }
   };
-  auto slot = [&](int32_t p, int32_t child) {
-    return 1u + 2u * split_of(p) + (h.nodes[size_t(p)].right == child ? 1u : 0u);
-  };
-  for (size_t i = 0; i + 1 < count; ++i) {
-    const LbvhNode& src = h.nodes[i];
-    Node& node = bvh.nodes[i == 0 ? 0 : slot(h.internal_parent[i], int32_t(i))];
-    node.set_bbox({{src.lo[0], src.lo[1], src.lo[2]}, {src.hi[0], src.hi[1], src.hi[2]}});
-    node.first = 1u + 2u * split_of(int32_t(i));
-    node.count = 0;
-  }
-  for (size_t k = 0; k < count; ++k) {
-    Node& node = bvh.nodes[slot(h.leaf_parent[k], ~int32_t(k))];
-    node.set_bbox(prim_bounds[h.values[k]]);
-    node.first = uint32_t(k);
-    node.count = 1;
+  place(h.root, 0);
+  for (size_t g = 0; g + 1 < count; ++g) {
+    place(h.nodes[g].left, 1 + 2 * g);
+    place(h.nodes[g].right, 2 + 2 * g);
   }
   return bvh;
 }

@@ -1,7 +1,8 @@
-// Linear BVH (Karras 2012): primitives sorted along a Morton curve, the hierarchy read off the
-// sorted codes, boxes filled in bottom up. The OpenCL build runs kernels/lbvh.cl (on PoCL here);
-// the reference build runs the same algorithm on the CPU, with the same float operations, so the
-// two agree node for node. Both end in the same binary Bvh the SAH builder makes (leaves of one
+// Linear BVH: primitives sorted along a Morton curve, the binary radix tree of their codes (Karras
+// 2012) with its boxes. The OpenCL build runs kernels/lbvh.cl (on PoCL here), which builds the
+// tree and its boxes bottom up in one pass (Apetrei 2014); the reference build runs Karras'
+// top-down construction on the CPU with the same float operations, so the two agree node for
+// node. Both end in the same binary Bvh the SAH builder makes (leaves of one
 // primitive; collapse() gathers them into leaves of up to 8 triangles, one block, for tracing).
 #pragma once
 
@@ -28,14 +29,14 @@ struct LbvhStats {
   std::vector<std::pair<std::string, double>> stages;
 };
 
-// What the Karras construction produces before conversion: n - 1 internal nodes (root 0), and
-// the primitive order (sorted slot -> input index), with the sorted keys.
+// The radix tree before conversion: n - 1 internal nodes by split position (node g splits
+// between sorted leaves g and g + 1), the root's index, and the primitive order (sorted slot ->
+// input index), with the sorted keys.
 struct LbvhHierarchy {
   std::vector<LbvhNode> nodes;
   std::vector<uint32_t> values;
   std::vector<uint64_t> keys;
-  std::vector<int32_t> internal_parent;  // -1 at the root
-  std::vector<int32_t> leaf_parent;
+  int32_t root = 0;
 };
 
 // OpenCL build; throws opencl::OpenClError when there is no device or the kernels fail to build.
@@ -46,13 +47,13 @@ LbvhHierarchy build_lbvh_hierarchy_opencl(const BBox* prim_bounds, const Vec3* c
 LbvhHierarchy build_lbvh_hierarchy_reference(const BBox* prim_bounds, const Vec3* centers, size_t count,
                                              const LbvhConfig& config);
 // The flat Bvh of a hierarchy, laid out as the write_bvh_nodes kernel lays it out (children of
-// internal node p at 1 + 2 gamma_p; see lbvh_layout.h).
+// internal node g at 1 + 2g; see lbvh_layout.h).
 Bvh to_bvh(const LbvhHierarchy& h, const BBox* prim_bounds);
 
 // OpenCL build straight to a Bvh (the flat nodes are written on the device).
 Bvh build_lbvh(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config = {},
                LbvhStats* stats = nullptr);
-// OpenCL build straight to the traced layout: the kernels' Karras tree collapsed in place into
+// OpenCL build straight to the traced layout: the kernels' radix tree collapsed in place into
 // wide nodes with leaves of up to leaf_size primitives (the flat nodes are never written). The
 // same wide tree as collapse(build_lbvh(...), leaf_size).
 WideBuild build_lbvh_wide(const BBox* prim_bounds, const Vec3* centers, size_t count, uint32_t leaf_size,

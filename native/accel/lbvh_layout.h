@@ -1,8 +1,9 @@
 // The data the LBVH kernels (kernels/lbvh.cl) and the host share, byte by byte. The kernel file
 // declares the same struct; the asserts below keep the host side honest.
 //
-//   LbvhNode, 32 bytes, one per internal node (n - 1 of them for n primitives; node 0 is the root)
-//     bytes  0-11  float lo[3]   box minimum      (written by propagate_bounds)
+//   LbvhNode, 32 bytes, one per internal node (n - 1 of them for n primitives): node g splits
+//   between sorted leaves g and g + 1; the root is the one whose range is every leaf (`root`)
+//     bytes  0-11  float lo[3]   box minimum      (all written by build_hierarchy)
 //     bytes 12-15  int   left    child: >= 0 an internal node, < 0 the leaf ~left
 //     bytes 16-27  float hi[3]   box maximum
 //     bytes 28-31  int   right   child, encoded like left
@@ -12,12 +13,13 @@
 //     bytes  0-23  float bounds[6]  lo.xyz, hi.xyz
 //     bytes 24-27  uint  first      interior: left child index (right = first + 1); leaf: sorted slot
 //     bytes 28-31  uint  count      0 interior, 1 leaf
-//   The children of internal node p sit at 1 + 2 gamma and 2 + 2 gamma, gamma = p's split
-//   position (its left child's index, decoded); the root at 0.
+//   The children of internal node g sit at 1 + 2g and 2 + 2g; the root at 0.
 //
 //   Other buffers: centers float[3n] and prim_bounds float[6n] (lo.xyz, hi.xyz) in input order;
 //   keys ulong[n] (Morton codes, sorted in place of the input order), values uint[n];
-//   internal_parent int[n - 1] (-1 at the root), leaf_parent int[n]; flags int[n - 1] (zeroed).
+//   sorted_bounds float[6n] (prim_bounds in sorted order); range uint2[n - 1] (first and last
+//   sorted leaf under node g); ends int[n - 1] (zeroed; build_hierarchy's meeting points);
+//   root int[1].
 #pragma once
 
 #include <cstddef>
@@ -40,10 +42,11 @@ static_assert(offsetof(Node, bounds) == 0 && offsetof(Node, first) == 24 && offs
               "Node must match BvhNode in kernels/lbvh.cl");
 static_assert(sizeof(float) == 4 && sizeof(uint64_t) == 8, "OpenCL float is 4 bytes, ulong 8");
 
-// The Karras tree as the kernels leave it after propagate_bounds, which collapse()
+// The radix tree as the kernels leave it after build_hierarchy, which collapse()
 // (accel/wide_bvh.h) reads in place: no flat Bvh in between.
 struct LbvhTree {
-  const LbvhNode* nodes = nullptr;       // leaves - 1 internal nodes, root 0, boxes filled
+  const LbvhNode* nodes = nullptr;       // leaves - 1 internal nodes, by split position, boxes filled
+  uint32_t root = 0;                     // the internal node over every leaf (leaves >= 2)
   const BBox* leaf_bounds = nullptr;     // leaves boxes in sorted order (gather_bounds)
   const uint32_t* leaf_range = nullptr;  // 2 (leaves - 1): first and last sorted leaf under internal node i
   size_t leaves = 0;

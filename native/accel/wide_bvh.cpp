@@ -60,15 +60,16 @@ struct Solved {
   Counts nodes;
 };
 
-// The binary trees collapse() reads, behind one interface (node 0 is the root): interior(i),
-// left(i), right(i), box(i), range(i) (the prim_ids slots under node i), and plan_slots() (node
-// ids that can be interior, which size the plan array).
+// The binary trees collapse() reads, behind one interface: root(), interior(i), left(i),
+// right(i), box(i), range(i) (the prim_ids slots under node i), and plan_slots() (node ids that
+// can be interior, which size the plan array).
 //
 // A builder's Bvh: children adjacent at `first`, ranges given by the builder or walked.
 struct FlatTree {
   const Bvh& bvh;
   const Ranges& ranges;
 
+  uint32_t root() const { return 0; }
   bool interior(uint32_t i) const { return !bvh.nodes[i].is_leaf(); }
   uint32_t left(uint32_t i) const { return bvh.nodes[i].first; }
   uint32_t right(uint32_t i) const { return bvh.nodes[i].first + 1; }
@@ -77,13 +78,14 @@ struct FlatTree {
   size_t plan_slots() const { return bvh.nodes.size(); }
 };
 
-// The LBVH kernels' Karras tree, read where the kernels left it: internal node i has id i, sorted
-// leaf k has id (n - 1) + k.
+// The LBVH kernels' radix tree, read where the kernels left it: internal node g (the split
+// between sorted leaves g and g + 1) has id g, sorted leaf k has id (n - 1) + k.
 struct KarrasTree {
   const LbvhTree& t;
 
   uint32_t internal() const { return uint32_t(t.leaves - 1); }
   uint32_t id(int32_t child) const { return child >= 0 ? uint32_t(child) : internal() + uint32_t(~child); }
+  uint32_t root() const { return t.root; }
   bool interior(uint32_t i) const { return i < internal(); }
   uint32_t left(uint32_t i) const { return id(t.nodes[i].left); }
   uint32_t right(uint32_t i) const { return id(t.nodes[i].right); }
@@ -317,8 +319,9 @@ template <class Tree>
 WideBvh collapse_tree(const Tree& tree, uint32_t leaf_size, CollapseMethod method) {
   WideBvh wide;
   leaf_size = std::max(leaf_size, 1u);
-  if (CollapsedTree<Tree>{tree, leaf_size}.is_leaf(0)) {
-    const SlotRange r = tree.range(0);
+  const uint32_t root = tree.root();
+  if (CollapsedTree<Tree>{tree, leaf_size}.is_leaf(root)) {
+    const SlotRange r = tree.range(root);
     wide.root_leaf_first = r.first;
     wide.root_leaf_count = r.count;
     return wide;
@@ -328,12 +331,12 @@ WideBvh collapse_tree(const Tree& tree, uint32_t leaf_size, CollapseMethod metho
   std::unique_ptr<uint32_t[]> heads(new uint32_t[tree.plan_slots()]);
   if (method == CollapseMethod::Sah) {
     plans.reset(new Plan[tree.plan_slots()]);
-    Planner<Tree>{{tree, leaf_size}, plans.get(), heads.get()}.solve(0);
+    Planner<Tree>{{tree, leaf_size}, plans.get(), heads.get()}.solve(root);
   }
   const Collapser<Tree> c{{tree, leaf_size}, plans.get(), heads.get()};
-  if (!plans) c.count(0, heads.get());
-  wide.nodes.resize(heads[0]);  // not zeroed (HugePageAllocator): place() writes every node
-  c.place(0, 0, 1, wide.nodes.data());
+  if (!plans) c.count(root, heads.get());
+  wide.nodes.resize(heads[root]);  // not zeroed (HugePageAllocator): place() writes every node
+  c.place(root, 0, 1, wide.nodes.data());
   return wide;
 }
 }  // namespace

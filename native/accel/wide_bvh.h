@@ -85,7 +85,7 @@ inline constexpr double kChainVisitWeight = 2.0;
 // one leaf (a subtree's primitives are contiguous in prim_ids, since builders partition
 // top-down), so small leaves do not leave wide nodes half empty.
 WideBvh collapse(const Bvh& bvh, uint32_t leaf_size = 1, CollapseMethod method = CollapseMethod::Sah);
-// The same from the LBVH kernels' Karras tree (sorted leaf k = prim_ids slot k): the same wide
+// The same from the LBVH kernels' radix tree (sorted leaf k = prim_ids slot k): the same wide
 // tree as collapsing that tree's flat Bvh (to_bvh), without writing the 2n - 1 flat nodes.
 WideBvh collapse(const LbvhTree& tree, uint32_t leaf_size = 1, CollapseMethod method = CollapseMethod::Sah);
 
