@@ -34,38 +34,38 @@ UninitializedArray<Vec3> centers_of(const BBox* bounds, size_t count) {
   return made;
 }
 
-const char* const kLbvhFallback = "LBVH builder unavailable, using the SAH builder instead: ";
-
-// An LBVH build that cannot run (no OpenCL device, kernel build failure) falls back to SAH.
-Bvh build_linear(const BBox* bounds, const Vec3* centers, size_t count, const BuildConfig& config, BuildStats& st) {
+// Runs an LBVH build, lbvh(centres, stats), making the centres when the caller left them out. One
+// that cannot run (no OpenCL device, kernel build failure) says why in st.warning and falls back
+// to sah(), which is handed the caller's own centres (those made here die with the attempt).
+template <class Lbvh, class Sah>
+auto lbvh_or_sah(const BBox* bounds, const Vec3* centers, size_t count, BuildStats& st, Lbvh&& lbvh, Sah&& sah) {
   try {
     UninitializedArray<Vec3> made;
-    if (!centers) centers = (made = centers_of(bounds, count)).data();
+    const Vec3* lbvh_centers = centers ? centers : (made = centers_of(bounds, count)).data();
     LbvhStats lbvh_stats;
-    Bvh bvh = build_lbvh(bounds, centers, count, config.lbvh, &lbvh_stats);
-    st.used = BuilderKind::Lbvh;
-    st.lbvh_compile_ms = lbvh_stats.compile_ms;
-    return bvh;
-  } catch (const opencl::OpenClError& e) {
-    st.warning = std::string(kLbvhFallback) + e.what();
-  }
-  return build_sah(bounds, centers, count, config, st);
-}
-
-WideBuild build_linear_wide(const BBox* bounds, const Vec3* centers, size_t count, uint32_t leaf_size,
-                            const BuildConfig& config, BuildStats& st) {
-  try {
-    UninitializedArray<Vec3> made;
-    if (!centers) centers = (made = centers_of(bounds, count)).data();
-    LbvhStats lbvh_stats;
-    WideBuild built = build_lbvh_wide(bounds, centers, count, leaf_size, config.lbvh, &lbvh_stats);
+    auto built = lbvh(lbvh_centers, &lbvh_stats);
     st.used = BuilderKind::Lbvh;
     st.lbvh_compile_ms = lbvh_stats.compile_ms;
     return built;
   } catch (const opencl::OpenClError& e) {
-    st.warning = std::string(kLbvhFallback) + e.what();
+    st.warning = std::string("LBVH builder unavailable, using the SAH builder instead: ") + e.what();
   }
-  return build_sah_wide(bounds, centers, count, leaf_size, config, st);
+  return sah();
+}
+
+Bvh build_linear(const BBox* bounds, const Vec3* centers, size_t count, const BuildConfig& config, BuildStats& st) {
+  return lbvh_or_sah(
+      bounds, centers, count, st,
+      [&](const Vec3* c, LbvhStats* stats) { return build_lbvh(bounds, c, count, config.lbvh, stats); },
+      [&] { return build_sah(bounds, centers, count, config, st); });
+}
+
+WideBuild build_linear_wide(const BBox* bounds, const Vec3* centers, size_t count, uint32_t leaf_size,
+                            const BuildConfig& config, BuildStats& st) {
+  return lbvh_or_sah(
+      bounds, centers, count, st,
+      [&](const Vec3* c, LbvhStats* stats) { return build_lbvh_wide(bounds, c, count, leaf_size, config.lbvh, stats); },
+      [&] { return build_sah_wide(bounds, centers, count, leaf_size, config, st); });
 }
 
 struct BuilderEntry {

@@ -296,25 +296,24 @@ struct Collapser : CollapsedTree<Tree> {
       }
     out[index] = node;
     size_t next = first + size_t(m);
-    int large[kWidth], large_count = 0;
-    bool in_parallel[kWidth] = {};
+    bool large[kWidth];
+    int large_count = 0;
     for (int j = 0; j < m; ++j) {
       start[j] = next;
       next += heads[interior[j]] - 1u;
-      if (tree.range(interior[j]).count > kParallelPrimitives) large[large_count++] = j;
+      large_count += large[j] = tree.range(interior[j]).count > kParallelPrimitives;
     }
     auto child = [&](int j) { place(interior[j], first + size_t(j), start[j], out); };
-    if (large_count > 1) {
-      for (int k = 0; k < large_count; ++k) in_parallel[large[k]] = true;
-      tbb::parallel_for(0, large_count, [&](int k) { child(large[k]); });
-    }
+    const bool parallel = large_count > 1;
+    if (parallel)
+      tbb::parallel_for(0, m, [&](int j) {
+        if (large[j]) child(j);
+      });
     for (int j = 0; j < m; ++j)
-      if (!in_parallel[j]) child(j);
+      if (!(parallel && large[j])) child(j);
   }
 };
-}  // namespace
 
-namespace {
 template <class Tree>
 WideBvh collapse_tree(const Tree& tree, uint32_t leaf_size, CollapseMethod method) {
   WideBvh wide;
