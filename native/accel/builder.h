@@ -1,9 +1,10 @@
-// The one entry point to every BVH builder: a mesh, the top level, tests and benchmarks call
-// build_bvh() with a BuilderKind, and nothing else names a builder's own function to build a
-// scene. Adding a builder = its own accel/<x>_builder.{h,cpp} (as binned_sah_builder and
-// lbvh_builder) + its entry in this pair: a BuilderKind value and its settings in BuilderSettings
-// here, one row of the table in builder.cpp (name, kind, build function). The scene's
-// CommitOptions inherit BuilderSettings, so the scene needs no edit.
+// The one entry point to every BVH builder: the top level, tests and benchmarks call build_bvh()
+// with a BuilderKind, a mesh calls build_wide_bvh() (the same builders, ending in the traced
+// layout), and nothing else names a builder's own function to build a scene. Adding a builder =
+// its own accel/<x>_builder.{h,cpp} (as binned_sah_builder and lbvh_builder) + its entry in this
+// pair: a BuilderKind value and its settings in BuilderSettings here, one row of the table in
+// builder.cpp (name, kind, binary and wide build functions). The scene's CommitOptions inherit
+// BuilderSettings, so the scene needs no edit.
 //
 // "auto" picks, per build, the builder whose build plus the tracing to come costs least ("model
 // no more than a scene needs"). The SAH tree traces faster; the LBVH builds faster. With n

@@ -96,7 +96,7 @@ Mesh::Prepared Mesh::prepare() {
 void Mesh::build(BuilderKind kind, const BuildConfig& config, BuildStats* stats) {
   Prepared prepared = prepare();
   BuildConfig mine = config;
-  mine.sah.leaf_without_search = kBlockWidth;  // finish() collapses with leaves of one block
+  mine.sah.leaf_without_search = kBlockWidth;  // the collapse makes leaves of one block
   WideBuild built = build_wide_bvh(kind, prepared.boxes.data(), nullptr, prepared.count, kBlockWidth, mine, stats);
   // The boxes are freed only after finish(): freeing them before it (24 MB less at the peak at 1M)
   // made the 4M commit on two threads 845 -> 1600 ms in bench_trace, its collapse and blocks

@@ -20,8 +20,8 @@ class Mesh {
   // a triangle of zero area.
   Mesh(std::vector<Vec3> vertices, std::vector<Triangle> triangles);
 
-  // Builds (or rebuilds) the BVH over the triangles that can be hit with build_bvh() (the one
-  // builder entry point: Auto, the LBVH fallback and the cancel flag behave as there); runs on
+  // Builds (or rebuilds) the BVH over the triangles that can be hit with build_wide_bvh()
+  // (accel/builder.h: Auto, the LBVH fallback and the cancel flag behave as there); runs on
   // the caller's TBB arena. A cancelled build throws BuildCancelled and leaves the mesh unbuilt.
   void build(BuilderKind kind = BuilderKind::Sah, const BuildConfig& config = {}, BuildStats* stats = nullptr);
   bool built() const { return built_; }
