@@ -94,10 +94,9 @@ int main(int argc, char** argv) {
     };
     for (BuilderKind kind : {BuilderKind::Sah, BuilderKind::Lbvh}) {
       Bvh tree;
-      const double build =
-          kind == BuilderKind::Sah
-              ? best_ms(args->runs, [&] { tree = build_binned_sah(prims.boxes.data(), prims.centers.data(), n); })
-              : best_ms(args->runs, [&] { tree = build_lbvh(prims.boxes.data(), prims.centers.data(), n, {}); });
+      const double build = kind == BuilderKind::Sah
+                               ? best_ms(args->runs, [&] { tree = build_binned_sah(prims.boxes.data(), n); })
+                               : best_ms(args->runs, [&] { tree = build_lbvh(prims.boxes.data(), n, {}); });
       const auto s = scene_of(m, kind);
       auto hit = [&](const Ray& ray) { s->intersect(ray); };
       auto occ = [&](const Ray& ray) { s->occluded(ray); };

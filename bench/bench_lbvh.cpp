@@ -83,17 +83,15 @@ int main(int argc, char** argv) {
     row.triangles = m.triangles.size();
     const PrimitiveBounds prims = triangle_bounds(m);
     const std::vector<BBox>& boxes = prims.boxes;
-    const std::vector<Vec3>& centers = prims.centers;
     // Builder alone (what differs between them); the collapse to the wide traversal layout that
     // both then share is not included.
     Bvh sah, lbvh, lbvh63;
-    row.sah_ms = best_ms(args->runs, [&] { sah = build_binned_sah(boxes.data(), centers.data(), boxes.size()); });
+    row.sah_ms = best_ms(args->runs, [&] { sah = build_binned_sah(boxes.data(), boxes.size()); });
     LbvhStats st;
-    row.lbvh_ms = best_ms(args->runs, [&] { lbvh = build_lbvh(boxes.data(), centers.data(), boxes.size(), {}, &st); });
+    row.lbvh_ms = best_ms(args->runs, [&] { lbvh = build_lbvh(boxes.data(), boxes.size(), {}, &st); });
     stages.push_back(st.stages);
-    row.lbvh63_ms = best_ms(args->runs, [&] {
-      lbvh63 = build_lbvh(boxes.data(), centers.data(), boxes.size(), LbvhConfig{MortonBits::k63});
-    });
+    row.lbvh63_ms =
+        best_ms(args->runs, [&] { lbvh63 = build_lbvh(boxes.data(), boxes.size(), LbvhConfig{MortonBits::k63}); });
     row.embree_ms = best_ms(args->runs, [&] { EmbreeScene e(m.vertices, m.triangles); });
     row.sah_cost = sah.sah_cost();
     row.lbvh_cost = lbvh.sah_cost();

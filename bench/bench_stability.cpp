@@ -308,10 +308,9 @@ int main(int argc, char** argv) {
       room.triangles.push_back(Triangle(b + f[0], b + f[2], b + f[3]));
     }
     const PrimitiveBounds prims = triangle_bounds(room);
-    const Bvh sah = build_binned_sah(prims.boxes.data(), prims.centers.data(), prims.boxes.size());
-    const Bvh l30 = build_lbvh(prims.boxes.data(), prims.centers.data(), prims.boxes.size(), {});
-    const Bvh l63 =
-        build_lbvh(prims.boxes.data(), prims.centers.data(), prims.boxes.size(), LbvhConfig{MortonBits::k63});
+    const Bvh sah = build_binned_sah(prims.boxes.data(), prims.boxes.size());
+    const Bvh l30 = build_lbvh(prims.boxes.data(), prims.boxes.size(), {});
+    const Bvh l63 = build_lbvh(prims.boxes.data(), prims.boxes.size(), LbvhConfig{MortonBits::k63});
     // Rays at the object (camera outside its box, inside the room), then diffuse bounces from the hits.
     MeshData object_only;
     object_only.vertices.assign(room.vertices.begin(), room.vertices.begin() + b);

@@ -1,16 +1,23 @@
 // LBVH construction: the binary radix tree of Karras 2012 ("Maximizing Parallelism in the
 // Construction of BVHs, Octrees, and k-d Trees"), built bottom up with its boxes in one pass as
-// Apetrei 2014 does it ("Fast and Simple Agglomerative LBVH Construction"). OpenCL C 1.2, no extensions: PoCL runs it on the CPU here, and any
-// OpenCL 1.2 GPU runs it unchanged. The host (native/accel/lbvh_builder.cpp) runs the stages in
-// this order, one kernel each:
+// Apetrei 2014 does it ("Fast and Simple Agglomerative LBVH Construction"). OpenCL C 1.2, no extensions: PoCL runs it
+// on the CPU here, and any OpenCL 1.2 GPU runs it unchanged. The host (native/accel/lbvh_builder.cpp) runs the stages
+// in this order, one kernel each:
 //   centroid_bounds -> morton_codes -> (radix_histogram, radix_scan, radix_scatter) per digit
-//   -> gather_bounds -> build_hierarchy (-> write_bvh_nodes, when the flat binary tree is asked for)
+//   -> build_hierarchy (-> write_bvh_nodes, when the flat binary tree is asked for)
 // Shared layouts are described byte by byte in native/accel/lbvh_layout.h, which static_asserts
 // them on the host side.
 
 // The host computes the same Morton codes for its reference builder: no contraction of a * b + c
 // into a fused multiply-add, so both sides round identically.
 #pragma OPENCL FP_CONTRACT OFF
+
+// The key type, set by the host at compilation: uint for 30-bit codes (half the bytes to sort and
+// to read in the climb), ulong for 63-bit codes. KEY_BITS is its width.
+#ifndef KEY
+#define KEY ulong
+#define KEY_BITS 64
+#endif
 
 // 32 bytes, as LbvhNode in lbvh_layout.h. A child >= 0 is an internal node, a child < 0 is the
 // leaf ~child (the sorted primitive slot). Written by build_hierarchy.
@@ -28,40 +35,61 @@ typedef struct {
   uint count;       // bytes 28-31: 0 for an interior node, else the leaf's primitive count
 } BvhNode;
 
+// A primitive's centre, as BBox::center computes it (0.5 lo + 0.5 hi, no contraction): the
+// kernels read the boxes, so no array of centres is made for them.
+float3 box_center(__global const float* bounds, uint i) {
+  __global const float* b = bounds + 6 * i;
+  return (float3)(0.5f * b[0] + 0.5f * b[3], 0.5f * b[1] + 0.5f * b[4], 0.5f * b[2] + 0.5f * b[5]);
+}
+
 // Stage 1: centroid bounds. Work-item g reduces centres g, g + G, g + 2G, ... into six floats
 // partial[6g .. 6g + 5] = (lo.x, lo.y, lo.z, hi.x, hi.y, hi.z); the host reduces the G partials.
-__kernel void centroid_bounds(__global const float* centers, uint n, __global float* partial) {
+__kernel void centroid_bounds(__global const float* prim_bounds, uint n, __global float* partial) {
   const uint g = get_global_id(0), stride = get_global_size(0);
   float lx = INFINITY, ly = INFINITY, lz = INFINITY, hx = -INFINITY, hy = -INFINITY, hz = -INFINITY;
   for (uint i = g; i < n; i += stride) {
-    const float x = centers[3 * i], y = centers[3 * i + 1], z = centers[3 * i + 2];
-    lx = fmin(lx, x); ly = fmin(ly, y); lz = fmin(lz, z);
-    hx = fmax(hx, x); hy = fmax(hy, y); hz = fmax(hz, z);
+    const float3 c = box_center(prim_bounds, i);
+    lx = fmin(lx, c.x);
+    ly = fmin(ly, c.y);
+    lz = fmin(lz, c.z);
+    hx = fmax(hx, c.x);
+    hy = fmax(hy, c.y);
+    hz = fmax(hz, c.z);
   }
-  partial[6 * g] = lx; partial[6 * g + 1] = ly; partial[6 * g + 2] = lz;
-  partial[6 * g + 3] = hx; partial[6 * g + 4] = hy; partial[6 * g + 5] = hz;
+  partial[6 * g] = lx;
+  partial[6 * g + 1] = ly;
+  partial[6 * g + 2] = lz;
+  partial[6 * g + 3] = hx;
+  partial[6 * g + 4] = hy;
+  partial[6 * g + 5] = hz;
 }
 
-// Spreads the low `bits` bits of v so that two zero bits separate each (bit k moves to 3k).
-ulong spread_bits(ulong v, uint bits) {
-  ulong out = 0;
-  for (uint k = 0; k < bits; ++k) out |= ((v >> k) & 1UL) << (3 * k);
-  return out;
+// Spreads the low 21 bits of v so that two zero bits separate each (bit k moves to 3k): five
+// shift-or-mask steps, each moving groups half as wide as the step before, instead of a loop over
+// the bits (which made this kernel cost as much as a radix pass). The same codes as a loop gives.
+ulong spread_bits(ulong v) {
+  v &= 0x1FFFFFUL;
+  v = (v | v << 32) & 0x1F00000000FFFFUL;
+  v = (v | v << 16) & 0x1F0000FF0000FFUL;
+  v = (v | v << 8) & 0x100F00F00F00F00FUL;
+  v = (v | v << 4) & 0x10C30C30C30C30C3UL;
+  v = (v | v << 2) & 0x1249249249249249UL;
+  return v;
 }
 
 // Stage 2: Morton codes of the centres, quantised to 2^bits_per_axis cells per axis of the
 // centroid box. `scale` is cells / extent per axis, computed once by the host (0 for a flat axis).
-__kernel void morton_codes(__global const float* centers, uint n, float lo_x, float lo_y, float lo_z,
-                           float scale_x, float scale_y, float scale_z, uint bits_per_axis,
-                           __global ulong* keys, __global uint* values) {
+__kernel void morton_codes(__global const float* prim_bounds, uint n, float lo_x, float lo_y, float lo_z, float scale_x,
+                           float scale_y, float scale_z, uint bits_per_axis, __global KEY* keys,
+                           __global uint* values) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   const float cells = (float)((1u << bits_per_axis) - 1u);
-  const float qx = fmin(fmax((centers[3 * i] - lo_x) * scale_x, 0.0f), cells);
-  const float qy = fmin(fmax((centers[3 * i + 1] - lo_y) * scale_y, 0.0f), cells);
-  const float qz = fmin(fmax((centers[3 * i + 2] - lo_z) * scale_z, 0.0f), cells);
-  keys[i] = (spread_bits((ulong)qx, bits_per_axis) << 2) | (spread_bits((ulong)qy, bits_per_axis) << 1) |
-            spread_bits((ulong)qz, bits_per_axis);
+  const float3 c = box_center(prim_bounds, i);
+  const float qx = fmin(fmax((c.x - lo_x) * scale_x, 0.0f), cells);
+  const float qy = fmin(fmax((c.y - lo_y) * scale_y, 0.0f), cells);
+  const float qz = fmin(fmax((c.z - lo_z) * scale_z, 0.0f), cells);
+  keys[i] = (KEY)((spread_bits((ulong)qx) << 2) | (spread_bits((ulong)qy) << 1) | spread_bits((ulong)qz));
   values[i] = i;
 }
 
@@ -70,12 +98,12 @@ __kernel void morton_codes(__global const float* centers, uint n, float lo_x, fl
 // what keeps equal keys in index order (the tie-break build_hierarchy relies on).
 // hist is digit-major: hist[digit * blocks + b] counts `digit` in block b, so one exclusive scan
 // of it gives every (digit, block) its first output slot.
-__kernel void radix_histogram(__global const ulong* keys, uint n, uint shift, uint block, __global uint* hist) {
+__kernel void radix_histogram(__global const KEY* keys, uint n, uint shift, uint block, __global uint* hist) {
   const uint b = get_global_id(0), blocks = get_global_size(0);
   uint count[256];
   for (uint d = 0; d < 256; ++d) count[d] = 0;
   const uint end = min(n, (b + 1) * block);
-  for (uint i = b * block; i < end; ++i) ++count[(keys[i] >> shift) & 255UL];
+  for (uint i = b * block; i < end; ++i) ++count[(keys[i] >> shift) & 255u];
   for (uint d = 0; d < 256; ++d) hist[d * blocks + b] = count[d];
 }
 
@@ -91,16 +119,15 @@ __kernel void radix_scan(__global uint* hist, uint count) {
   }
 }
 
-__kernel void radix_scatter(__global const ulong* keys_in, __global const uint* values_in, uint n, uint shift,
-                            uint block, __global const uint* offsets, __global ulong* keys_out,
-                            __global uint* values_out) {
+__kernel void radix_scatter(__global const KEY* keys_in, __global const uint* values_in, uint n, uint shift, uint block,
+                            __global const uint* offsets, __global KEY* keys_out, __global uint* values_out) {
   const uint b = get_global_id(0), blocks = get_global_size(0);
   uint next[256];
   for (uint d = 0; d < 256; ++d) next[d] = offsets[d * blocks + b];
   const uint end = min(n, (b + 1) * block);
   for (uint i = b * block; i < end; ++i) {
-    const ulong k = keys_in[i];
-    const uint slot = next[(k >> shift) & 255UL]++;
+    const KEY k = keys_in[i];
+    const uint slot = next[(k >> shift) & 255u]++;
     keys_out[slot] = k;
     values_out[slot] = values_in[i];
   }
@@ -109,30 +136,30 @@ __kernel void radix_scatter(__global const ulong* keys_in, __global const uint* 
 // Length of the common prefix of sorted keys i and j; -1 outside [0, n). Equal keys (duplicate
 // Morton codes) are told apart by their indices, as if each key were followed by its index:
 // Karras' tie-break, which keeps the hierarchy a valid binary tree when centroids coincide.
-int common_prefix(__global const ulong* keys, long n, long i, long j) {
+int common_prefix(__global const KEY* keys, long n, long i, long j) {
   if (j < 0 || j >= n) return -1;
-  const ulong a = keys[i], b = keys[j];
-  if (a == b) return 64 + (int)clz((uint)(i ^ j));
+  const KEY a = keys[i], b = keys[j];
+  if (a == b) return KEY_BITS + (int)clz((uint)(i ^ j));
   return (int)clz(a ^ b);
 }
 
-// Stage 4a: the primitives' boxes in sorted order, so that the climb below reads its leaves'
-// boxes from neighbouring memory rather than chasing values[] across the whole array.
-__kernel void gather_bounds(__global const float* prim_bounds, __global const uint* values, uint n,
-                            __global float* sorted_bounds) {
-  const uint k = get_global_id(0);
-  if (k >= n) return;
-  __global const float* b = prim_bounds + 6 * values[k];
-  for (int a = 0; a < 6; ++a) sorted_bounds[6 * k + a] = b[a];
-}
-
-void child_bounds(__global const float* sorted_bounds, volatile __global LbvhNode* nodes, int child, float* lo,
-                  float* hi) {
+// A child's box: an internal node's from the climb below, a leaf's from the input boxes through
+// the sort's permutation. Reading them in place (rather than first gathering the leaves' boxes into
+// sorted order) spares a pass and 24 bytes a primitive of fresh memory: Morton order keeps the
+// reads near one another on meshes, whose triangles are mostly stored near their neighbours.
+void child_bounds(__global const float* prim_bounds, __global const uint* values, volatile __global LbvhNode* nodes,
+                  int child, float* lo, float* hi) {
   if (child < 0) {
-    __global const float* b = sorted_bounds + 6 * ~child;
-    for (int a = 0; a < 3; ++a) { lo[a] = b[a]; hi[a] = b[3 + a]; }
+    __global const float* b = prim_bounds + 6 * values[~child];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = b[a];
+      hi[a] = b[3 + a];
+    }
   } else {
-    for (int a = 0; a < 3; ++a) { lo[a] = nodes[child].lo[a]; hi[a] = nodes[child].hi[a]; }
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = nodes[child].lo[a];
+      hi[a] = nodes[child].hi[a];
+    }
   }
 }
 
@@ -145,33 +172,39 @@ void child_bounds(__global const float* sorted_bounds, volatile __global LbvhNod
 // parent the first arrival leaves the end of its range in ends[] (stored + 1: zero means empty)
 // and stops; the second, whose sibling subtree is then complete, writes the parent's box and
 // range and climbs on. The work-item that completes [0, n - 1] writes the root's index.
-__kernel void build_hierarchy(__global const ulong* keys, uint n_leaves, __global const float* sorted_bounds,
-                              volatile __global LbvhNode* nodes, __global uint2* range, volatile __global int* ends,
-                              __global int* root) {
+__kernel void build_hierarchy(__global const KEY* keys, uint n_leaves, __global const float* prim_bounds,
+                              __global const uint* values, volatile __global LbvhNode* nodes, __global uint2* range,
+                              volatile __global int* ends, __global int* root) {
   const long k = get_global_id(0), n = n_leaves;
   if (k >= n) return;
   long l = k, r = k;
   int current = ~(int)k;
   float lo[3], hi[3];
-  child_bounds(sorted_bounds, nodes, current, lo, hi);
+  child_bounds(prim_bounds, values, nodes, current, lo, hi);
   while (l > 0 || r < n - 1) {
     const bool is_left = l == 0 || (r < n - 1 && common_prefix(keys, n, r, r + 1) > common_prefix(keys, n, l - 1, l));
     const long parent = is_left ? r : l - 1;
-    if (is_left) nodes[parent].left = current; else nodes[parent].right = current;
+    if (is_left)
+      nodes[parent].left = current;
+    else
+      nodes[parent].right = current;
     mem_fence(CLK_GLOBAL_MEM_FENCE);  // our child link and box are visible before we announce arrival
     const int other = atomic_xchg(&ends[parent], (int)(is_left ? l : r) + 1);
     if (other == 0) return;
     mem_fence(CLK_GLOBAL_MEM_FENCE);
-    if (is_left) r = other - 1; else l = other - 1;
+    if (is_left)
+      r = other - 1;
+    else
+      l = other - 1;
     float slo[3], shi[3];
-    child_bounds(sorted_bounds, nodes, is_left ? nodes[parent].right : nodes[parent].left, slo, shi);
+    child_bounds(prim_bounds, values, nodes, is_left ? nodes[parent].right : nodes[parent].left, slo, shi);
     for (int a = 0; a < 3; ++a) {
       lo[a] = fmin(lo[a], slo[a]);
       hi[a] = fmax(hi[a], shi[a]);
       nodes[parent].lo[a] = lo[a];
       nodes[parent].hi[a] = hi[a];
     }
-    range[parent] = (uint2)((uint)l, (uint)r);
+    if (range) range[parent] = (uint2)((uint)l, (uint)r);  // null when only the collapse reads the tree
     current = (int)parent;
   }
   *root = current;
@@ -181,8 +214,8 @@ __kernel void build_hierarchy(__global const ulong* keys, uint n_leaves, __globa
 // want the binary tree itself (tests, benchmarks; a commit collapses the nodes above in place).
 // Internal node g's children go to slots 1 + 2g and 2 + 2g, a unique adjacent pair; the root to
 // slot 0. Beside each node, the sorted slots under it (first, count).
-void write_flat(__global const LbvhNode* nodes, __global const float* sorted_bounds, __global const uint2* range,
-                int child, uint at, __global BvhNode* out, __global uint2* out_range) {
+void write_flat(__global const LbvhNode* nodes, __global const float* prim_bounds, __global const uint* values,
+                __global const uint2* range, int child, uint at, __global BvhNode* out, __global uint2* out_range) {
   BvhNode node;
   if (child >= 0) {
     for (int a = 0; a < 3; ++a) {
@@ -193,7 +226,7 @@ void write_flat(__global const LbvhNode* nodes, __global const float* sorted_bou
     node.count = 0u;
     out_range[at] = (uint2)(range[child].x, range[child].y - range[child].x + 1u);
   } else {
-    for (int a = 0; a < 6; ++a) node.bounds[a] = sorted_bounds[6 * ~child + a];
+    for (int a = 0; a < 6; ++a) node.bounds[a] = prim_bounds[6 * values[~child] + a];
     node.first = (uint)~child;
     node.count = 1u;
     out_range[at] = (uint2)((uint)~child, 1u);
@@ -201,12 +234,12 @@ void write_flat(__global const LbvhNode* nodes, __global const float* sorted_bou
   out[at] = node;
 }
 
-__kernel void write_bvh_nodes(__global const LbvhNode* nodes, __global const float* sorted_bounds,
-                              __global const uint2* range, uint n_leaves, int root, __global BvhNode* out,
-                              __global uint2* out_range) {
+__kernel void write_bvh_nodes(__global const LbvhNode* nodes, __global const float* prim_bounds,
+                              __global const uint* values, __global const uint2* range, uint n_leaves, int root,
+                              __global BvhNode* out, __global uint2* out_range) {
   const int g = (int)get_global_id(0);
   if (g >= (int)n_leaves - 1) return;
-  if (g == root) write_flat(nodes, sorted_bounds, range, g, 0u, out, out_range);
-  write_flat(nodes, sorted_bounds, range, nodes[g].left, 1u + 2u * (uint)g, out, out_range);
-  write_flat(nodes, sorted_bounds, range, nodes[g].right, 2u + 2u * (uint)g, out, out_range);
+  if (g == root) write_flat(nodes, prim_bounds, values, range, g, 0u, out, out_range);
+  write_flat(nodes, prim_bounds, values, range, nodes[g].left, 1u + 2u * (uint)g, out, out_range);
+  write_flat(nodes, prim_bounds, values, range, nodes[g].right, 2u + 2u * (uint)g, out, out_range);
 }

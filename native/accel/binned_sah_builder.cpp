@@ -399,9 +399,8 @@ class Builder {
 
 }  // namespace
 
-Bvh build_binned_sah(const BBox* prim_bounds, const Vec3* prim_centers, size_t count, const BinnedSahConfig& config) {
+Bvh build_binned_sah(const BBox* prim_bounds, size_t count, const BinnedSahConfig& config) {
   if (count == 0) return {};
-  (void)prim_centers;  // the boxes' own centres: recomputed from the boxes (PrimRef::center)
   return Builder(prim_bounds, count, config).run();
 }
 

@@ -35,9 +35,7 @@ struct BuildCancelled : std::runtime_error {
 
 // Builds over `count` primitives. Runs on the calling thread's TBB arena, so the caller chooses
 // the thread count. The result does not depend on the thread count: nodes are laid out in
-// depth-first order after the build. The centres must be the boxes' own (BBox::center), as every
-// caller's are: the builder recomputes them from the boxes rather than read a second array.
-Bvh build_binned_sah(const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
-                     const BinnedSahConfig& config = {});
+// depth-first order after the build. A primitive's centre is its box's (BBox::center).
+Bvh build_binned_sah(const BBox* prim_bounds, size_t count, const BinnedSahConfig& config = {});
 
 }  // namespace toyrt

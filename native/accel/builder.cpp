@@ -1,10 +1,6 @@
 #include "accel/builder.h"
 
-#include "core/uninitialized_array.h"
 #include "opencl/device.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <iterator>
 #include <stdexcept>
@@ -13,37 +9,25 @@ namespace toyrt {
 
 namespace {
 
-Bvh build_sah(const BBox* bounds, const Vec3* centers, size_t count, const BuildConfig& config, BuildStats& st) {
+Bvh build_sah(const BBox* bounds, size_t count, const BuildConfig& config, BuildStats& st) {
   st.used = BuilderKind::Sah;
-  return build_binned_sah(bounds, centers, count, config.sah);
+  return build_binned_sah(bounds, count, config.sah);
 }
 
-WideBuild build_sah_wide(const BBox* bounds, const Vec3* centers, size_t count, uint32_t leaf_size,
-                         const BuildConfig& config, BuildStats& st) {
-  Bvh bvh = build_sah(bounds, centers, count, config, st);
+WideBuild build_sah_wide(const BBox* bounds, size_t count, uint32_t leaf_size, const BuildConfig& config,
+                         BuildStats& st) {
+  Bvh bvh = build_sah(bounds, count, config, st);
   WideBuild built{collapse(bvh, leaf_size), std::move(bvh.prim_ids)};
   return built;
 }
 
-// The boxes' centres, when the caller left them out (the LBVH's Morton codes read them).
-UninitializedArray<Vec3> centers_of(const BBox* bounds, size_t count) {
-  UninitializedArray<Vec3> made(count);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 16384), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i != r.end(); ++i) made.emplace(i, bounds[i].center());
-  });
-  return made;
-}
-
-// Runs an LBVH build, lbvh(centres, stats), making the centres when the caller left them out. One
-// that cannot run (no OpenCL device, kernel build failure) says why in st.warning and falls back
-// to sah(), which is handed the caller's own centres (those made here die with the attempt).
+// Runs an LBVH build, lbvh(stats). One that cannot run (no OpenCL device, kernel build failure)
+// says why in st.warning and falls back to sah().
 template <class Lbvh, class Sah>
-auto lbvh_or_sah(const BBox* bounds, const Vec3* centers, size_t count, BuildStats& st, Lbvh&& lbvh, Sah&& sah) {
+auto lbvh_or_sah(BuildStats& st, Lbvh&& lbvh, Sah&& sah) {
   try {
-    UninitializedArray<Vec3> made;
-    const Vec3* lbvh_centers = centers ? centers : (made = centers_of(bounds, count)).data();
     LbvhStats lbvh_stats;
-    auto built = lbvh(lbvh_centers, &lbvh_stats);
+    auto built = lbvh(&lbvh_stats);
     st.used = BuilderKind::Lbvh;
     st.lbvh_compile_ms = lbvh_stats.compile_ms;
     return built;
@@ -53,19 +37,17 @@ auto lbvh_or_sah(const BBox* bounds, const Vec3* centers, size_t count, BuildSta
   return sah();
 }
 
-Bvh build_linear(const BBox* bounds, const Vec3* centers, size_t count, const BuildConfig& config, BuildStats& st) {
+Bvh build_linear(const BBox* bounds, size_t count, const BuildConfig& config, BuildStats& st) {
   return lbvh_or_sah(
-      bounds, centers, count, st,
-      [&](const Vec3* c, LbvhStats* stats) { return build_lbvh(bounds, c, count, config.lbvh, stats); },
-      [&] { return build_sah(bounds, centers, count, config, st); });
+      st, [&](LbvhStats* stats) { return build_lbvh(bounds, count, config.lbvh, stats); },
+      [&] { return build_sah(bounds, count, config, st); });
 }
 
-WideBuild build_linear_wide(const BBox* bounds, const Vec3* centers, size_t count, uint32_t leaf_size,
-                            const BuildConfig& config, BuildStats& st) {
+WideBuild build_linear_wide(const BBox* bounds, size_t count, uint32_t leaf_size, const BuildConfig& config,
+                            BuildStats& st) {
   return lbvh_or_sah(
-      bounds, centers, count, st,
-      [&](const Vec3* c, LbvhStats* stats) { return build_lbvh_wide(bounds, c, count, leaf_size, config.lbvh, stats); },
-      [&] { return build_sah_wide(bounds, centers, count, leaf_size, config, st); });
+      st, [&](LbvhStats* stats) { return build_lbvh_wide(bounds, count, leaf_size, config.lbvh, stats); },
+      [&] { return build_sah_wide(bounds, count, leaf_size, config, st); });
 }
 
 struct BuilderEntry {
@@ -74,9 +56,9 @@ struct BuilderEntry {
   // Null for Auto, which build_bvh resolves to another entry first. `build` makes the binary
   // tree; `build_wide` the traced layout, by collapsing it or (the LBVH) straight from the
   // builder's own tree.
-  Bvh (*build)(const BBox* bounds, const Vec3* centers, size_t count, const BuildConfig& config, BuildStats& st);
-  WideBuild (*build_wide)(const BBox* bounds, const Vec3* centers, size_t count, uint32_t leaf_size,
-                          const BuildConfig& config, BuildStats& st);
+  Bvh (*build)(const BBox* bounds, size_t count, const BuildConfig& config, BuildStats& st);
+  WideBuild (*build_wide)(const BBox* bounds, size_t count, uint32_t leaf_size, const BuildConfig& config,
+                          BuildStats& st);
 };
 // The one table of builders: a new builder adds its row here.
 constexpr BuilderEntry kBuilders[] = {{"auto", BuilderKind::Auto, nullptr, nullptr},
@@ -112,18 +94,17 @@ const BuilderEntry& entry_for(BuilderKind kind, size_t count, const BuildConfig&
 }
 }  // namespace
 
-Bvh build_bvh(BuilderKind kind, const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
-              const BuildConfig& config, BuildStats* stats) {
+Bvh build_bvh(BuilderKind kind, const BBox* prim_bounds, size_t count, const BuildConfig& config, BuildStats* stats) {
   BuildStats local;
   BuildStats& st = stats ? *stats : local;
-  return entry_for(kind, count, config, st).build(prim_bounds, prim_centers, count, config, st);
+  return entry_for(kind, count, config, st).build(prim_bounds, count, config, st);
 }
 
-WideBuild build_wide_bvh(BuilderKind kind, const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
-                         uint32_t leaf_size, const BuildConfig& config, BuildStats* stats) {
+WideBuild build_wide_bvh(BuilderKind kind, const BBox* prim_bounds, size_t count, uint32_t leaf_size,
+                         const BuildConfig& config, BuildStats* stats) {
   BuildStats local;
   BuildStats& st = stats ? *stats : local;
-  return entry_for(kind, count, config, st).build_wide(prim_bounds, prim_centers, count, leaf_size, config, st);
+  return entry_for(kind, count, config, st).build_wide(prim_bounds, count, leaf_size, config, st);
 }
 
 }  // namespace toyrt

@@ -68,18 +68,17 @@ struct BuildStats {
   std::string warning;
 };
 
-// Builds over `count` primitives given their boxes and centres, on the calling thread's TBB
-// arena. The centres must be the boxes' own (BBox::center); null: the builders that read them
-// (the LBVH) make them from the boxes, and the SAH builder never does, so a mesh's SAH commit
-// does not write 12 bytes a triangle it would not read. Auto resolves with config.cost_model for `count` primitives; an
-// LBVH build that cannot run falls back to SAH and says so in stats->warning. SAH builds throw BuildCancelled when
-// config.sah.cancel is set.
-Bvh build_bvh(BuilderKind kind, const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
-              const BuildConfig& config = {}, BuildStats* stats = nullptr);
+// Builds over `count` primitives given their boxes, on the calling thread's TBB arena. Builders
+// take a primitive's centre to be its box's (BBox::center) and compute it where they need it,
+// so no caller writes an array of centres. Auto resolves with config.cost_model for `count`
+// primitives; an LBVH build that cannot run falls back to SAH and says so in stats->warning. SAH
+// builds throw BuildCancelled when config.sah.cancel is set.
+Bvh build_bvh(BuilderKind kind, const BBox* prim_bounds, size_t count, const BuildConfig& config = {},
+              BuildStats* stats = nullptr);
 // The same build, ending in the traced layout: wide nodes whose leaves hold subtrees of up to
 // leaf_size primitives (collapse() of the binary tree; the LBVH collapses its kernels' tree in
 // place and never writes a binary Bvh). What a mesh commits.
-WideBuild build_wide_bvh(BuilderKind kind, const BBox* prim_bounds, const Vec3* prim_centers, size_t count,
-                         uint32_t leaf_size, const BuildConfig& config = {}, BuildStats* stats = nullptr);
+WideBuild build_wide_bvh(BuilderKind kind, const BBox* prim_bounds, size_t count, uint32_t leaf_size,
+                         const BuildConfig& config = {}, BuildStats* stats = nullptr);
 
 }  // namespace toyrt

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <optional>
 
 namespace toyrt {
 namespace {
@@ -76,21 +77,20 @@ void emit_node(const std::vector<uint64_t>& keys, int64_t i, LbvhNode& node) {
   node.right = std::max(i, j) == gamma + 1 ? ~int32_t(gamma + 1) : int32_t(gamma + 1);
 }
 
-BBox centroid_bounds_of(const Vec3* centers, size_t count) {
+BBox centroid_bounds_of(const BBox* prim_bounds, size_t count) {
   BBox b;
-  for (size_t i = 0; i < count; ++i) b.extend(centers[i]);
+  for (size_t i = 0; i < count; ++i) b.extend(prim_bounds[i].center());
   return b;
 }
 
 }  // namespace
 
-LbvhHierarchy build_lbvh_hierarchy_reference(const BBox* prim_bounds, const Vec3* centers, size_t count,
-                                             const LbvhConfig& config) {
+LbvhHierarchy build_lbvh_hierarchy_reference(const BBox* prim_bounds, size_t count, const LbvhConfig& config) {
   LbvhHierarchy h;
   if (count == 0) return h;
-  const MortonFrame frame = morton_frame(centroid_bounds_of(centers, count), config.bits);
+  const MortonFrame frame = morton_frame(centroid_bounds_of(prim_bounds, count), config.bits);
   std::vector<uint64_t> codes(count);
-  for (size_t i = 0; i < count; ++i) codes[i] = morton_code(centers[i], frame);
+  for (size_t i = 0; i < count; ++i) codes[i] = morton_code(prim_bounds[i].center(), frame);
   h.values.resize(count);
   std::iota(h.values.begin(), h.values.end(), 0u);
   // Stable, as the kernels' radix sort: equal codes keep input order.
@@ -160,27 +160,31 @@ struct LbvhOutputs {
 };
 
 // Runs the kernels and fills `out`.
-void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config, LbvhStats* stats,
+void run_opencl(const BBox* prim_bounds, size_t count, const LbvhConfig& config, LbvhStats* stats,
                 const LbvhOutputs& out) {
   LbvhHierarchy* hierarchy = out.hierarchy;
   Bvh* bvh = out.bvh;
   using namespace opencl;
   if (count >= size_t(INT32_MAX) / 2) throw OpenClError("LBVH: more than 2^30 primitives");
   const Device& dev = device();
-  static std::atomic<bool> compiled{false};
-  const bool compiling_now = !compiled.exchange(true);
-  const Program& prog = program("lbvh", kLbvhKernelSource, "-cl-std=CL1.2");
+  // 30-bit codes sort as 32-bit keys: half the bytes of 64-bit ones in every radix pass and in
+  // the climb's prefix comparisons. One program per key width.
+  const bool narrow = 3 * uint32_t(config.bits) <= 32;
+  static std::atomic<bool> compiled[2] = {false, false};
+  const bool compiling_now = !compiled[narrow].exchange(true);
+  const Program& prog = narrow ? program("lbvh32", kLbvhKernelSource, "-cl-std=CL1.2 -DKEY=uint -DKEY_BITS=32")
+                               : program("lbvh64", kLbvhKernelSource, "-cl-std=CL1.2 -DKEY=ulong -DKEY_BITS=64");
+  const size_t key_size = narrow ? sizeof(uint32_t) : sizeof(uint64_t);
   double compile_ms = prog.compile_ms;
   if (compiling_now) {
     // Drivers finish compiling at a kernel's first launch (PoCL does): run every stage once on
     // three boxes so that this cost lands in compile_ms, not in the first build's time.
     const auto warm = std::chrono::steady_clock::now();
     const BBox tiny[3] = {{Vec3(0.0f), Vec3(1.0f)}, {Vec3(1.0f), Vec3(2.0f)}, {Vec3(2.0f), Vec3(3.0f)}};
-    const Vec3 tiny_centers[3] = {Vec3(0.5f), Vec3(1.5f), Vec3(2.5f)};
     Bvh unused;
     LbvhOutputs warm_out;
     warm_out.bvh = &unused;  // write_bvh_nodes too: tests and benchmarks still build flat trees
-    run_opencl(tiny, tiny_centers, 3, config, nullptr, warm_out);
+    run_opencl(tiny, 3, config, nullptr, warm_out);
     compile_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - warm).count();
   }
   if (stats) {
@@ -200,11 +204,13 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
   if (count == 0) return;
   const cl_uint n = cl_uint(count);
 
-  Buffer centers_buf(count * sizeof(Vec3), CL_MEM_READ_ONLY, centers);
+  // BBox is six packed floats (lo.xyz, hi.xyz): the layout the kernels read.
+  static_assert(sizeof(BBox) == 6 * sizeof(float), "BBox must be six packed floats");
+  Buffer bounds_buf(count * sizeof(BBox), CL_MEM_READ_ONLY, prim_bounds);
   // Centroid bounds: partial boxes on the device, the last few merged here.
   const size_t partials = std::min<size_t>(count, 1024);
   Buffer partial_buf(partials * 6 * sizeof(float));
-  Kernel(prog.program, "centroid_bounds").arg(0, centers_buf.get()).arg(1, n).arg(2, partial_buf.get()).run(partials);
+  Kernel(prog.program, "centroid_bounds").arg(0, bounds_buf.get()).arg(1, n).arg(2, partial_buf.get()).run(partials);
   std::vector<float> partial(partials * 6);
   partial_buf.read(partial.data(), partial.size() * sizeof(float));
   BBox cb;
@@ -215,10 +221,10 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
   const MortonFrame frame = morton_frame(cb, config.bits);
   stage("centroid bounds");
 
-  Buffer keys[2] = {Buffer(count * sizeof(uint64_t)), Buffer(count * sizeof(uint64_t))};
+  Buffer keys[2] = {Buffer(count * key_size), Buffer(count * key_size)};
   Buffer values[2] = {Buffer(count * sizeof(uint32_t)), Buffer(count * sizeof(uint32_t))};
   Kernel(prog.program, "morton_codes")
-      .arg(0, centers_buf.get())
+      .arg(0, bounds_buf.get())
       .arg(1, n)
       .arg(2, frame.lo.x)
       .arg(3, frame.lo.y)
@@ -259,7 +265,13 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
   values[in].read(order.data(), count * sizeof(uint32_t));
   if (hierarchy && out.with_keys) {
     hierarchy->keys.resize(count);
-    keys[in].read(hierarchy->keys.data(), count * sizeof(uint64_t));
+    if (narrow) {
+      std::vector<uint32_t> narrow_keys(count);
+      keys[in].read(narrow_keys.data(), count * sizeof(uint32_t));
+      std::copy(narrow_keys.begin(), narrow_keys.end(), hierarchy->keys.begin());
+    } else {
+      keys[in].read(hierarchy->keys.data(), count * sizeof(uint64_t));
+    }
   }
   if (count == 1) {
     if (hierarchy) hierarchy->values = order;
@@ -272,27 +284,21 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
     return;
   }
   const size_t internal = count - 1;
-  // BBox is six packed floats (lo.xyz, hi.xyz): the layout the kernels read.
-  static_assert(sizeof(BBox) == 6 * sizeof(float), "BBox must be six packed floats");
-  Buffer bounds_buf(count * sizeof(BBox), CL_MEM_READ_ONLY, prim_bounds);
-  Buffer sorted_bounds(count * sizeof(BBox));
-  Kernel(prog.program, "gather_bounds")
-      .arg(0, bounds_buf.get())
-      .arg(1, values[in].get())
-      .arg(2, n)
-      .arg(3, sorted_bounds.get())
-      .run(count);
-  Buffer nodes(internal * sizeof(LbvhNode)), ends(internal * sizeof(cl_int)),
-      internal_range(internal * 2 * sizeof(cl_uint)), root_buf(sizeof(cl_int));
+  Buffer nodes(internal * sizeof(LbvhNode)), ends(internal * sizeof(cl_int)), root_buf(sizeof(cl_int));
+  // Each node's range of sorted leaves, for the flat nodes only: the collapse derives the ranges
+  // from the split positions, so the wide build leaves the kernel's pointer null.
+  std::optional<Buffer> internal_range;
+  if (bvh) internal_range.emplace(internal * 2 * sizeof(cl_uint));
   ends.fill_zero(internal * sizeof(cl_int));
   Kernel(prog.program, "build_hierarchy")
       .arg(0, keys[in].get())
       .arg(1, n)
-      .arg(2, sorted_bounds.get())
-      .arg(3, nodes.get())
-      .arg(4, internal_range.get())
-      .arg(5, ends.get())
-      .arg(6, root_buf.get())
+      .arg(2, bounds_buf.get())
+      .arg(3, values[in].get())
+      .arg(4, nodes.get())
+      .arg(5, internal_range ? internal_range->get() : cl_mem(nullptr))
+      .arg(6, ends.get())
+      .arg(7, root_buf.get())
       .run(count);
   cl_int root = 0;
   root_buf.read(&root, sizeof root);
@@ -307,12 +313,13 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
     Buffer flat_range(range_bytes, CL_MEM_WRITE_ONLY, bvh->ranges.data());
     Kernel(prog.program, "write_bvh_nodes")
         .arg(0, nodes.get())
-        .arg(1, sorted_bounds.get())
-        .arg(2, internal_range.get())
-        .arg(3, n)
-        .arg(4, root)
-        .arg(5, flat.get())
-        .arg(6, flat_range.get())
+        .arg(1, bounds_buf.get())
+        .arg(2, values[in].get())
+        .arg(3, internal_range->get())
+        .arg(4, n)
+        .arg(5, root)
+        .arg(6, flat.get())
+        .arg(7, flat_range.get())
         .run(internal);
     flat.sync_to_host(bytes);
     flat_range.sync_to_host(range_bytes);
@@ -324,14 +331,12 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
     // 1M triangles they were 80 MB of fresh pages and a third of the commit (docs/lbvh.md).
     LbvhTree tree;
     tree.nodes = static_cast<const LbvhNode*>(nodes.map_read(internal * sizeof(LbvhNode)));
-    tree.leaf_bounds = static_cast<const BBox*>(sorted_bounds.map_read(count * sizeof(BBox)));
-    tree.leaf_range = static_cast<const uint32_t*>(internal_range.map_read(internal * 2 * sizeof(cl_uint)));
+    tree.prim_bounds = prim_bounds;
+    tree.order = order.data();
     tree.leaves = count;
     tree.root = uint32_t(root);
     out.wide->wide = collapse(tree, out.leaf_size);
     nodes.unmap(tree.nodes);
-    sorted_bounds.unmap(tree.leaf_bounds);
-    internal_range.unmap(tree.leaf_range);
     out.wide->prim_ids = hierarchy ? order : std::move(order);
     stage("collapse");
   }
@@ -346,13 +351,13 @@ void run_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count, cons
 
 }  // namespace
 
-LbvhHierarchy build_lbvh_hierarchy_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count,
-                                          const LbvhConfig& config, LbvhStats* stats, bool with_keys) {
+LbvhHierarchy build_lbvh_hierarchy_opencl(const BBox* prim_bounds, size_t count, const LbvhConfig& config,
+                                          LbvhStats* stats, bool with_keys) {
   LbvhHierarchy h;
   LbvhOutputs out;
   out.hierarchy = &h;
   out.with_keys = with_keys;
-  run_opencl(prim_bounds, centers, count, config, stats, out);
+  run_opencl(prim_bounds, count, config, stats, out);
   return h;
 }
 
@@ -390,32 +395,32 @@ Bvh to_bvh(const LbvhHierarchy& h, const BBox* prim_bounds) {
   return bvh;
 }
 
-Bvh build_lbvh(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config, LbvhStats* stats) {
+Bvh build_lbvh(const BBox* prim_bounds, size_t count, const LbvhConfig& config, LbvhStats* stats) {
   const auto start = std::chrono::steady_clock::now();
   Bvh bvh;
   LbvhOutputs out;
   out.bvh = &bvh;
-  run_opencl(prim_bounds, centers, count, config, stats, out);
+  run_opencl(prim_bounds, count, config, stats, out);
   if (stats)
     stats->build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return bvh;
 }
 
-WideBuild build_lbvh_wide(const BBox* prim_bounds, const Vec3* centers, size_t count, uint32_t leaf_size,
-                          const LbvhConfig& config, LbvhStats* stats) {
+WideBuild build_lbvh_wide(const BBox* prim_bounds, size_t count, uint32_t leaf_size, const LbvhConfig& config,
+                          LbvhStats* stats) {
   const auto start = std::chrono::steady_clock::now();
   WideBuild built;
   LbvhOutputs out;
   out.wide = &built;
   out.leaf_size = leaf_size;
-  run_opencl(prim_bounds, centers, count, config, stats, out);
+  run_opencl(prim_bounds, count, config, stats, out);
   if (stats)
     stats->build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return built;
 }
 
-Bvh build_lbvh_reference(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config) {
-  return to_bvh(build_lbvh_hierarchy_reference(prim_bounds, centers, count, config), prim_bounds);
+Bvh build_lbvh_reference(const BBox* prim_bounds, size_t count, const LbvhConfig& config) {
+  return to_bvh(build_lbvh_hierarchy_reference(prim_bounds, count, config), prim_bounds);
 }
 
 }  // namespace toyrt

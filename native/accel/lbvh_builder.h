@@ -41,24 +41,22 @@ struct LbvhHierarchy {
 
 // OpenCL build; throws opencl::OpenClError when there is no device or the kernels fail to build.
 // The sorted keys are read back only when with_keys (tests compare them with the reference).
-LbvhHierarchy build_lbvh_hierarchy_opencl(const BBox* prim_bounds, const Vec3* centers, size_t count,
-                                          const LbvhConfig& config, LbvhStats* stats = nullptr, bool with_keys = false);
+LbvhHierarchy build_lbvh_hierarchy_opencl(const BBox* prim_bounds, size_t count, const LbvhConfig& config,
+                                          LbvhStats* stats = nullptr, bool with_keys = false);
 // The same construction on the CPU, single-threaded: the reference the kernels are checked by.
-LbvhHierarchy build_lbvh_hierarchy_reference(const BBox* prim_bounds, const Vec3* centers, size_t count,
-                                             const LbvhConfig& config);
+LbvhHierarchy build_lbvh_hierarchy_reference(const BBox* prim_bounds, size_t count, const LbvhConfig& config);
 // The flat Bvh of a hierarchy, laid out as the write_bvh_nodes kernel lays it out (children of
 // internal node g at 1 + 2g; see lbvh_layout.h).
 Bvh to_bvh(const LbvhHierarchy& h, const BBox* prim_bounds);
 
 // OpenCL build straight to a Bvh (the flat nodes are written on the device).
-Bvh build_lbvh(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config = {},
-               LbvhStats* stats = nullptr);
+Bvh build_lbvh(const BBox* prim_bounds, size_t count, const LbvhConfig& config = {}, LbvhStats* stats = nullptr);
 // OpenCL build straight to the traced layout: the kernels' radix tree collapsed in place into
 // wide nodes with leaves of up to leaf_size primitives (the flat nodes are never written). The
 // same wide tree as collapse(build_lbvh(...), leaf_size).
-WideBuild build_lbvh_wide(const BBox* prim_bounds, const Vec3* centers, size_t count, uint32_t leaf_size,
-                          const LbvhConfig& config = {}, LbvhStats* stats = nullptr);
+WideBuild build_lbvh_wide(const BBox* prim_bounds, size_t count, uint32_t leaf_size, const LbvhConfig& config = {},
+                          LbvhStats* stats = nullptr);
 // The reference build straight to a Bvh.
-Bvh build_lbvh_reference(const BBox* prim_bounds, const Vec3* centers, size_t count, const LbvhConfig& config = {});
+Bvh build_lbvh_reference(const BBox* prim_bounds, size_t count, const LbvhConfig& config = {});
 
 }  // namespace toyrt

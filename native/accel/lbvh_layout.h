@@ -15,10 +15,11 @@
 //     bytes 28-31  uint  count      0 interior, 1 leaf
 //   The children of internal node g sit at 1 + 2g and 2 + 2g; the root at 0.
 //
-//   Other buffers: centers float[3n] and prim_bounds float[6n] (lo.xyz, hi.xyz) in input order;
-//   keys ulong[n] (Morton codes, sorted in place of the input order), values uint[n];
-//   sorted_bounds float[6n] (prim_bounds in sorted order); range uint2[n - 1] (first and last
-//   sorted leaf under node g); ends int[n - 1] (zeroed; build_hierarchy's meeting points);
+//   Other buffers: prim_bounds float[6n] (lo.xyz, hi.xyz) in input order;
+//   keys uint[n] for 30-bit codes, ulong[n] for 63-bit ones (Morton codes, sorted in place of the
+//   input order), values uint[n] (sorted slot -> input index); range uint2[n - 1] (first and last
+//   sorted leaf under node g; written only for the flat nodes); ends int[n - 1] (zeroed;
+//   build_hierarchy's meeting points);
 //   root int[1].
 #pragma once
 
@@ -45,10 +46,10 @@ static_assert(sizeof(float) == 4 && sizeof(uint64_t) == 8, "OpenCL float is 4 by
 // The radix tree as the kernels leave it after build_hierarchy, which collapse()
 // (accel/wide_bvh.h) reads in place: no flat Bvh in between.
 struct LbvhTree {
-  const LbvhNode* nodes = nullptr;       // leaves - 1 internal nodes, by split position, boxes filled
-  uint32_t root = 0;                     // the internal node over every leaf (leaves >= 2)
-  const BBox* leaf_bounds = nullptr;     // leaves boxes in sorted order (gather_bounds)
-  const uint32_t* leaf_range = nullptr;  // 2 (leaves - 1): first and last sorted leaf under internal node i
+  const LbvhNode* nodes = nullptr;    // leaves - 1 internal nodes, by split position, boxes filled
+  uint32_t root = 0;                  // the internal node over every leaf (leaves >= 2)
+  const BBox* prim_bounds = nullptr;  // the primitives' boxes in input order (leaf k's: prim_bounds[order[k]])
+  const uint32_t* order = nullptr;    // sorted leaf -> input index (the sort's values)
   size_t leaves = 0;
 };
 

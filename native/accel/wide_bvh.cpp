@@ -60,45 +60,62 @@ struct Solved {
   Counts nodes;
 };
 
-// The binary trees collapse() reads, behind one interface: root(), interior(i), left(i),
-// right(i), box(i), range(i) (the prim_ids slots under node i), and plan_slots() (node ids that
-// can be interior, which size the plan array).
+// A binary node and the prim_ids slots under it. The collapse hands each node's range down from its
+// parent instead of looking it up: the LBVH's follow from the split position alone, so its
+// collapse reads no range array at all (a cache miss a node when it did).
+struct Ref {
+  uint32_t node;
+  SlotRange range;
+};
+
+// The binary trees collapse() reads, behind one interface: root() (with its range), interior(i),
+// children(parent) (with their ranges), box(i), and plan_slots() (node ids that can be interior,
+// which size the plan array).
 //
 // A builder's Bvh: children adjacent at `first`, ranges given by the builder or walked.
 struct FlatTree {
   const Bvh& bvh;
   const Ranges& ranges;
 
-  uint32_t root() const { return 0; }
+  Ref root() const { return {0, ranges[0]}; }
   bool interior(uint32_t i) const { return !bvh.nodes[i].is_leaf(); }
-  uint32_t left(uint32_t i) const { return bvh.nodes[i].first; }
-  uint32_t right(uint32_t i) const { return bvh.nodes[i].first + 1; }
+  std::pair<Ref, Ref> children(const Ref& parent) const {
+    const uint32_t l = bvh.nodes[parent.node].first;
+    return {{l, ranges[l]}, {l + 1, ranges[l + 1]}};
+  }
   BBox box(uint32_t i) const { return bvh.nodes[i].bbox(); }
-  SlotRange range(uint32_t i) const { return ranges[i]; }
   size_t plan_slots() const { return bvh.nodes.size(); }
+  void prefetch(uint32_t i) const { __builtin_prefetch(&bvh.nodes[i]); }
 };
 
 // The LBVH kernels' radix tree, read where the kernels left it: internal node g (the split
-// between sorted leaves g and g + 1) has id g, sorted leaf k has id (n - 1) + k.
+// between sorted leaves g and g + 1) has id g, sorted leaf k has id (n - 1) + k. A node over
+// sorted leaves [l, r] split at g has children over [l, g] and [g + 1, r].
 struct KarrasTree {
   const LbvhTree& t;
 
   uint32_t internal() const { return uint32_t(t.leaves - 1); }
   uint32_t id(int32_t child) const { return child >= 0 ? uint32_t(child) : internal() + uint32_t(~child); }
-  uint32_t root() const { return t.root; }
+  Ref root() const { return {t.root, {0u, uint32_t(t.leaves)}}; }
   bool interior(uint32_t i) const { return i < internal(); }
-  uint32_t left(uint32_t i) const { return id(t.nodes[i].left); }
-  uint32_t right(uint32_t i) const { return id(t.nodes[i].right); }
+  std::pair<Ref, Ref> children(const Ref& parent) const {
+    const uint32_t g = parent.node, first = parent.range.first;
+    const LbvhNode& n = t.nodes[g];
+    return {{id(n.left), {first, g + 1u - first}}, {id(n.right), {g + 1u, first + parent.range.count - 1u - g}}};
+  }
   BBox box(uint32_t i) const {
-    if (!interior(i)) return t.leaf_bounds[i - internal()];
+    if (!interior(i)) return t.prim_bounds[t.order[i - internal()]];
     const LbvhNode& n = t.nodes[i];
     return {{n.lo[0], n.lo[1], n.lo[2]}, {n.hi[0], n.hi[1], n.hi[2]}};
   }
-  SlotRange range(uint32_t i) const {
-    if (!interior(i)) return {i - internal(), 1u};
-    return {t.leaf_range[2 * size_t(i)], t.leaf_range[2 * size_t(i) + 1] - t.leaf_range[2 * size_t(i)] + 1u};
-  }
   size_t plan_slots() const { return t.leaves - 1; }
+  // Starts loading what box() will read.
+  void prefetch(uint32_t i) const {
+    if (interior(i))
+      __builtin_prefetch(&t.nodes[i]);
+    else
+      __builtin_prefetch(&t.prim_bounds[t.order[i - internal()]]);
+  }
 };
 
 // The tree as collapse() sees it: a subtree of at most leaf_size primitives is one leaf.
@@ -107,7 +124,7 @@ struct CollapsedTree {
   const Tree& tree;
   uint32_t leaf_size;
 
-  bool is_leaf(uint32_t i) const { return !tree.interior(i) || tree.range(i).count <= leaf_size; }
+  bool is_leaf(const Ref& r) const { return !tree.interior(r.node) || r.range.count <= leaf_size; }
 };
 
 template <class Tree>
@@ -121,30 +138,34 @@ struct Planner : CollapsedTree<Tree> {
   // Bottom up: the costs of binary node i in at most 1..kWidth slots (parent_area: its parent's
   // box's half area), and the wide nodes each answer makes. Each node's plan depends on its
   // subtree alone, so the parallel split (by a fixed primitive count) gives the serial plans.
-  Solved solve(uint32_t i, float parent_area = kInfinity) const {
+  Solved solve(const Ref& i, float parent_area = kInfinity) const {
     Solved solved;
     Costs& out = solved.cost;
     if (is_leaf(i)) {  // the same in any budget: one collapsed leaf
-      const uint32_t blocks = (tree.range(i).count + leaf_size - 1) / leaf_size;
-      out.fill(float(kBlockCost) * tree.box(i).half_area() * float(blocks));
+      const uint32_t blocks = (i.range.count + leaf_size - 1) / leaf_size;
+      out.fill(float(kBlockCost) * tree.box(i.node).half_area() * float(blocks));
       solved.nodes.fill(0);
       return solved;
     }
-    const uint32_t l = tree.left(i), r = tree.right(i);
-    const float area_i = tree.box(i).half_area();
+    const auto [l, r] = tree.children(i);
+    // The walk is depth first over a tree larger than the caches: the right child's box (read
+    // after the whole left subtree) and the left child's are fetched while this node is solved.
+    tree.prefetch(l.node);
+    tree.prefetch(r.node);
+    const float area_i = tree.box(i.node).half_area();
     // A node whose box is its parent's (a link of a chain: see kChainVisitWeight) weighs more as
     // a wide node of its own, so the programme prefers to open it into its parent's slots.
     const float visit =
         float(kWideNodeCost) * area_i * (area_i >= 0.999f * parent_area ? float(kChainVisitWeight) : 1.0f);
     Solved left, right;
-    if (tree.range(i).count > kParallelPrimitives) {
-      tbb::parallel_invoke([&] { left = solve(l, area_i); }, [&] { right = solve(r, area_i); });
+    if (i.range.count > kParallelPrimitives) {
+      tbb::parallel_invoke([&, l = l] { left = solve(l, area_i); }, [&, r = r] { right = solve(r, area_i); });
     } else {
       left = solve(l, area_i);
       right = solve(r, area_i);
     }
     const Costs &left_cost = left.cost, &right_cost = right.cost;
-    Plan& p = plan[i];
+    Plan& p = plan[i.node];
     // Distributing b slots between the children, k to the left: the best k for every b.
     float spread[kWidth + 1];
     uint8_t spread_left[kWidth + 1];
@@ -163,8 +184,8 @@ struct Planner : CollapsedTree<Tree> {
     p.open_left = spread_left[kWidth];
     out[0] = visit + spread[kWidth];
     p.split[0] = 0;
-    heads[i] = 1u + left.nodes[size_t(p.open_left - 1)] + right.nodes[size_t(kWidth - p.open_left - 1)];
-    solved.nodes[0] = heads[i];
+    heads[i.node] = 1u + left.nodes[size_t(p.open_left - 1)] + right.nodes[size_t(kWidth - p.open_left - 1)];
+    solved.nodes[0] = heads[i.node];
     // More slots: the node opened into its parent (its children take the slots), or the
     // answer for one slot fewer, whichever is cheaper.
     for (int b = 2; b <= kWidth; ++b) {
@@ -191,25 +212,26 @@ struct Collapser : CollapsedTree<Tree> {
   const uint32_t* heads;  // as Planner::heads (the greedy collapse's from count())
 
   // The slots binary node i takes with `budget` of them, by its plan.
-  void read_out(uint32_t i, int budget, uint32_t kids[kWidth], int& n) const {
-    if (is_leaf(i) || plan[i].split[budget - 1] == 0) {
+  void read_out(const Ref& i, int budget, Ref kids[kWidth], int& n) const {
+    if (is_leaf(i) || plan[i.node].split[budget - 1] == 0) {
       kids[n++] = i;
       return;
     }
-    read_out(tree.left(i), plan[i].split[budget - 1] & 15, kids, n);
-    read_out(tree.right(i), plan[i].split[budget - 1] >> 4, kids, n);
+    const auto [l, r] = tree.children(i);
+    read_out(l, plan[i.node].split[budget - 1] & 15, kids, n);
+    read_out(r, plan[i.node].split[budget - 1] >> 4, kids, n);
   }
 
   // The wide node for binary interior node `binary`: the slots of its plan, or (greedy) the
   // binary node's two children, then the largest (by surface area) interior one opened until
   // kWidth are held. Leaf slots are final; an interior slot's child field holds its binary node
   // until the caller places it.
-  int gather(uint32_t binary, WideNode& node, uint32_t kids[kWidth]) const {
-    const uint32_t left = tree.left(binary), right = tree.right(binary);
+  int gather(const Ref& binary, WideNode& node, Ref kids[kWidth]) const {
+    const auto [left, right] = tree.children(binary);
     int n = 0;
     if (plan) {
-      read_out(left, plan[binary].open_left, kids, n);
-      read_out(right, kWidth - plan[binary].open_left, kids, n);
+      read_out(left, plan[binary.node].open_left, kids, n);
+      read_out(right, kWidth - plan[binary.node].open_left, kids, n);
     } else {
       kids[n++] = left;
       kids[n++] = right;
@@ -217,16 +239,16 @@ struct Collapser : CollapsedTree<Tree> {
         int best = -1;
         float best_area = -1.0f;
         for (int i = 0; i < n; ++i) {
-          const float area = tree.box(kids[i]).half_area();
+          const float area = tree.box(kids[i].node).half_area();
           if (!is_leaf(kids[i]) && area > best_area) {
             best = i;
             best_area = area;
           }
         }
         if (best < 0) break;
-        const uint32_t opened = kids[best];
-        kids[best] = tree.left(opened);
-        kids[n++] = tree.right(opened);
+        const auto [l, r] = tree.children(kids[best]);
+        kids[best] = l;
+        kids[n++] = r;
       }
     }
     // Children by decreasing surface area: the order an any-hit walk visits them in. A large box
@@ -234,9 +256,9 @@ struct Collapser : CollapsedTree<Tree> {
     // of after the model's subtrees); the closest-hit walk sorts by distance and ignores it.
     // An insertion sort: stable, and no allocation.
     BBox boxes[kWidth];
-    for (int i = 0; i < n; ++i) boxes[i] = tree.box(kids[i]);
+    for (int i = 0; i < n; ++i) boxes[i] = tree.box(kids[i].node);
     for (int i = 1; i < n; ++i) {
-      const uint32_t kid = kids[i];
+      const Ref kid = kids[i];
       const BBox box = boxes[i];
       const float area = box.half_area();
       int k = i;
@@ -259,23 +281,22 @@ struct Collapser : CollapsedTree<Tree> {
         node.bounds[a + 3][i] = boxes[i].hi[a];
       }
       if (is_leaf(kids[i])) {
-        const SlotRange r = tree.range(kids[i]);
-        node.child[i] = r.first;
-        node.count[i] = r.count;
+        node.child[i] = kids[i].range.first;
+        node.count[i] = kids[i].range.count;
       }
     }
     return n;
   }
 
   // The greedy collapse's heads[]: the wide nodes under each node that heads one, by a dry run.
-  uint32_t count(uint32_t binary, uint32_t* heads_out) const {
+  uint32_t count(const Ref& binary, uint32_t* heads_out) const {
     WideNode node;
-    uint32_t kids[kWidth];
+    Ref kids[kWidth];
     const int n = gather(binary, node, kids);
     uint32_t total = 1;
     for (int i = 0; i < n; ++i)
       if (!is_leaf(kids[i])) total += count(kids[i], heads_out);
-    return heads_out[binary] = total;
+    return heads_out[binary.node] = total;
   }
 
   // Writes the wide node headed by binary node `binary` at out[index], its interior children's
@@ -283,9 +304,9 @@ struct Collapser : CollapsedTree<Tree> {
   // subtree after them, in slot order: a depth-first layout. heads[] sizes every subtree
   // beforehand, so each lands straight in its place, and large children's subtrees are written in
   // parallel with the layout of a serial walk (no per-task arrays, copies or regrowth).
-  void place(uint32_t binary, size_t index, size_t first, WideNode* out) const {
+  void place(const Ref& binary, size_t index, size_t first, WideNode* out) const {
     WideNode node;
-    uint32_t kids[kWidth], interior[kWidth];
+    Ref kids[kWidth], interior[kWidth];
     size_t start[kWidth];
     const int n = gather(binary, node, kids);
     int m = 0;
@@ -300,8 +321,8 @@ struct Collapser : CollapsedTree<Tree> {
     int large_count = 0;
     for (int j = 0; j < m; ++j) {
       start[j] = next;
-      next += heads[interior[j]] - 1u;
-      large_count += large[j] = tree.range(interior[j]).count > kParallelPrimitives;
+      next += heads[interior[j].node] - 1u;
+      large_count += large[j] = interior[j].range.count > kParallelPrimitives;
     }
     auto child = [&](int j) { place(interior[j], first + size_t(j), start[j], out); };
     const bool parallel = large_count > 1;
@@ -318,11 +339,10 @@ template <class Tree>
 WideBvh collapse_tree(const Tree& tree, uint32_t leaf_size, CollapseMethod method) {
   WideBvh wide;
   leaf_size = std::max(leaf_size, 1u);
-  const uint32_t root = tree.root();
+  const Ref root = tree.root();
   if (CollapsedTree<Tree>{tree, leaf_size}.is_leaf(root)) {
-    const SlotRange r = tree.range(root);
-    wide.root_leaf_first = r.first;
-    wide.root_leaf_count = r.count;
+    wide.root_leaf_first = root.range.first;
+    wide.root_leaf_count = root.range.count;
     return wide;
   }
   // Not zeroed: only the entries of interior nodes are written, and only they are read.
@@ -334,7 +354,7 @@ WideBvh collapse_tree(const Tree& tree, uint32_t leaf_size, CollapseMethod metho
   }
   const Collapser<Tree> c{{tree, leaf_size}, plans.get(), heads.get()};
   if (!plans) c.count(root, heads.get());
-  wide.nodes.resize(heads[root]);  // not zeroed (HugePageAllocator): place() writes every node
+  wide.nodes.resize(heads[root.node]);  // not zeroed (HugePageAllocator): place() writes every node
   c.place(root, 0, 1, wide.nodes.data());
   return wide;
 }

@@ -97,7 +97,7 @@ void Mesh::build(BuilderKind kind, const BuildConfig& config, BuildStats* stats)
   Prepared prepared = prepare();
   BuildConfig mine = config;
   mine.sah.leaf_without_search = kBlockWidth;  // the collapse makes leaves of one block
-  WideBuild built = build_wide_bvh(kind, prepared.boxes.data(), nullptr, prepared.count, kBlockWidth, mine, stats);
+  WideBuild built = build_wide_bvh(kind, prepared.boxes.data(), prepared.count, kBlockWidth, mine, stats);
   // The boxes are freed only after finish(): freeing them before it (24 MB less at the peak at 1M)
   // made the 4M commit on two threads 845 -> 1600 ms in bench_trace, its collapse and blocks
   // stalling up to 0.5 s on fresh pages (docs/trace-speed.md, twenty-second session).

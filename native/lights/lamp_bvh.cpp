@@ -7,7 +7,6 @@ namespace toyrt {
 LampBvh build_lamp_bvh(const std::vector<Light>& lights) {
   LampBvh lamps;
   std::vector<BBox> boxes;
-  std::vector<Vec3> centers;
   std::vector<uint32_t> boxed;
   for (size_t j = 0; j < lights.size(); ++j) {
     BBox box = light_bounds(lights[j]).box;
@@ -21,13 +20,12 @@ LampBvh build_lamp_bvh(const std::vector<Light>& lights) {
     box.lo -= pad;
     box.hi += pad;
     boxes.push_back(box);
-    centers.push_back(box.center());
     boxed.push_back(uint32_t(j));
   }
   if (boxes.empty()) return lamps;
   BuildConfig config;
   config.sah.max_leaf = 2;  // a lamp test is cheap, but not cheaper than a box test
-  lamps.bvh = build_bvh(BuilderKind::Sah, boxes.data(), centers.data(), boxes.size(), config);
+  lamps.bvh = build_bvh(BuilderKind::Sah, boxes.data(), boxes.size(), config);
   for (uint32_t& id : lamps.bvh.prim_ids) id = boxed[id];
   return lamps;
 }

@@ -338,7 +338,6 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
     }
     std::vector<uint32_t> placed;
     std::vector<BBox> boxes;
-    std::vector<Vec3> centers;
     for (uint32_t i = 0; i < instances_.size(); ++i) {
       Instance& inst = instances_[i];
       const BBox& b = meshes_[inst.mesh]->bounds();
@@ -356,12 +355,11 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
       }
       placed.push_back(i);
       boxes.push_back(inst.world_bounds);
-      centers.push_back(inst.world_bounds.center());
     }
     check_cancel();
     BuildConfig top_config = config;
     top_config.sah.max_leaf = 1;  // an instance test is a whole traversal: never group them
-    top_ = build_bvh(BuilderKind::Sah, boxes.data(), centers.data(), boxes.size(), top_config);
+    top_ = build_bvh(BuilderKind::Sah, boxes.data(), boxes.size(), top_config);
     for (uint32_t& id : top_.prim_ids) id = placed[id];
   });
   single_identity_ = instances_.size() == 1 && instances_[0].identity;

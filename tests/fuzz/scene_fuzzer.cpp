@@ -259,25 +259,23 @@ void fuzz_scene(FuzzedDataProvider& in) {
 void fuzz_builders(FuzzedDataProvider& in) {
   const size_t count = in.ConsumeIntegralInRange<size_t>(0, 64);
   std::vector<BBox> boxes(count);
-  std::vector<Vec3> centers(count);
   for (size_t i = 0; i < count; ++i) {
     Vec3 a = fuzz_vec3(in), b = fuzz_vec3(in);
     if (!is_finite(a)) a = Vec3(0.0f);
     if (!is_finite(b)) b = a;
     boxes[i].extend(a);
     boxes[i].extend(b);
-    centers[i] = boxes[i].center();
   }
   BinnedSahConfig sah;
   sah.max_leaf = in.ConsumeIntegralInRange<uint32_t>(1, 8);
   sah.bins = in.ConsumeIntegralInRange<int>(2, 32);
-  const Bvh tree = build_binned_sah(boxes.data(), centers.data(), count, sah);
+  const Bvh tree = build_binned_sah(boxes.data(), count, sah);
   const std::string sah_problem = tree.validate(boxes.data(), count);
   if (!sah_problem.empty()) std::fprintf(stderr, "SAH: %s\n", sah_problem.c_str());
   FUZZ_CHECK(sah_problem.empty());
   LbvhConfig lbvh;
   lbvh.bits = in.ConsumeBool() ? MortonBits::k30 : MortonBits::k63;
-  const Bvh linear = build_lbvh_reference(boxes.data(), centers.data(), count, lbvh);
+  const Bvh linear = build_lbvh_reference(boxes.data(), count, lbvh);
   const std::string lbvh_problem = linear.validate(boxes.data(), count);
   if (!lbvh_problem.empty()) std::fprintf(stderr, "LBVH: %s\n", lbvh_problem.c_str());
   FUZZ_CHECK(lbvh_problem.empty());

@@ -24,7 +24,7 @@ Bvh sah_tree(const MeshData& m, int threads = 0) {
   BuildConfig config;
   config.sah.leaf_without_search = kBlockWidth;
   Bvh bvh;
-  run_with_threads(threads, [&] { bvh = build_bvh(BuilderKind::Sah, boxes.data(), nullptr, boxes.size(), config); });
+  run_with_threads(threads, [&] { bvh = build_bvh(BuilderKind::Sah, boxes.data(), boxes.size(), config); });
   return bvh;
 }
 

@@ -39,9 +39,8 @@ MeshData first_triangles(const MeshData& m, size_t n) {
 void expect_same_as_reference(const MeshData& m, MortonBits bits) {
   const Prims p = prims_of(m);
   const LbvhConfig config{bits};
-  const LbvhHierarchy gpu =
-      build_lbvh_hierarchy_opencl(p.boxes.data(), p.centers.data(), p.boxes.size(), config, nullptr, true);
-  const LbvhHierarchy cpu = build_lbvh_hierarchy_reference(p.boxes.data(), p.centers.data(), p.boxes.size(), config);
+  const LbvhHierarchy gpu = build_lbvh_hierarchy_opencl(p.boxes.data(), p.boxes.size(), config, nullptr, true);
+  const LbvhHierarchy cpu = build_lbvh_hierarchy_reference(p.boxes.data(), p.boxes.size(), config);
   EXPECT_EQ(gpu.keys, cpu.keys);
   EXPECT_EQ(gpu.values, cpu.values);
   EXPECT_EQ(gpu.root, cpu.root);
@@ -51,7 +50,7 @@ void expect_same_as_reference(const MeshData& m, MortonBits bits) {
     EXPECT_EQ(0, std::memcmp(gpu.nodes.data(), cpu.nodes.data(), gpu.nodes.size() * sizeof(LbvhNode)));
   }
   // And the flat Bvh written on the device equals the host conversion of the reference.
-  const Bvh flat = build_lbvh(p.boxes.data(), p.centers.data(), p.boxes.size(), config);
+  const Bvh flat = build_lbvh(p.boxes.data(), p.boxes.size(), config);
   const Bvh ref = to_bvh(cpu, p.boxes.data());
   ASSERT_EQ(flat.nodes.size(), ref.nodes.size());
   EXPECT_EQ(0, std::memcmp(flat.nodes.data(), ref.nodes.data(), flat.nodes.size() * sizeof(Node)));
@@ -73,7 +72,7 @@ void expect_same_as_reference(const MeshData& m, MortonBits bits) {
   // the same wide tree, byte for byte, as collapsing the reference's flat Bvh, for leaves of one
   // block and of one primitive.
   for (const uint32_t leaf_size : {uint32_t(kBlockWidth), 1u}) {
-    const WideBuild direct = build_lbvh_wide(p.boxes.data(), p.centers.data(), p.boxes.size(), leaf_size, config);
+    const WideBuild direct = build_lbvh_wide(p.boxes.data(), p.boxes.size(), leaf_size, config);
     const WideBvh expected = collapse(ref, leaf_size);
     EXPECT_EQ(direct.prim_ids, ref.prim_ids);
     ASSERT_EQ(direct.wide.nodes.size(), expected.nodes.size());
@@ -110,7 +109,7 @@ TEST(Lbvh, OneAndTwoTrianglesBuild) {
   expect_same_as_reference(first_triangles(two, 1), MortonBits::k30);
   expect_same_as_reference(two, MortonBits::k30);
   const Prims p = prims_of(first_triangles(two, 1));
-  const Bvh one = build_lbvh(p.boxes.data(), p.centers.data(), 1);
+  const Bvh one = build_lbvh(p.boxes.data(), 1);
   ASSERT_EQ(one.nodes.size(), 1u);
   EXPECT_TRUE(one.nodes[0].is_leaf());
 }
@@ -119,7 +118,7 @@ TEST(Lbvh, TreeIsDeepButValidOnAMillionTriangles) {
   const MeshData m = uv_sphere(708, 708, 1.0f, 0.15f);
   const Prims p = prims_of(m);
   LbvhStats stats;
-  const Bvh bvh = build_lbvh(p.boxes.data(), p.centers.data(), p.boxes.size(), {}, &stats);
+  const Bvh bvh = build_lbvh(p.boxes.data(), p.boxes.size(), {}, &stats);
   EXPECT_EQ(bvh.validate(p.boxes.data(), p.boxes.size()), "");
   EXPECT_EQ(bvh.leaf_count(), p.boxes.size());  // one primitive per leaf, as Karras builds it
   EXPECT_FALSE(stats.device.empty());

@@ -16,13 +16,11 @@ namespace {
 
 struct Boxes {
   std::vector<BBox> boxes;
-  std::vector<Vec3> centers;
   void add(const Vec3& a, const Vec3& b) {
     BBox box;
     box.extend(a);
     box.extend(b);
     boxes.push_back(box);
-    centers.push_back(box.center());
   }
 };
 
@@ -48,14 +46,14 @@ TEST(BinnedSah, CentroidsSpanningMoreThanFloatMaxGiveAValidTree) {
   for (int i = 0; i < 20; ++i)
     p.add(Vec3(i % 2 ? FLT_MAX : -FLT_MAX, float(i), 0.0f), Vec3(i % 2 ? FLT_MAX : -FLT_MAX, float(i) + 1, 1.0f));
   p.add(Vec3(0.0f), Vec3(1.0f));
-  const Bvh bvh = build_binned_sah(p.boxes.data(), p.centers.data(), p.boxes.size());
+  const Bvh bvh = build_binned_sah(p.boxes.data(), p.boxes.size());
   EXPECT_EQ(bvh.validate(p.boxes.data(), p.boxes.size()), "");
 }
 
 TEST(BinnedSah, DenormalCentroidExtentGivesAValidTree) {
   Boxes p;
   for (int i = 0; i < 20; ++i) p.add(Vec3(float(i % 3) * 1e-45f, 0.0f, 0.0f), Vec3(float(i % 3) * 1e-45f, 1.0f, 1.0f));
-  const Bvh bvh = build_binned_sah(p.boxes.data(), p.centers.data(), p.boxes.size());
+  const Bvh bvh = build_binned_sah(p.boxes.data(), p.boxes.size());
   EXPECT_EQ(bvh.validate(p.boxes.data(), p.boxes.size()), "");
 }
 
@@ -65,7 +63,7 @@ TEST(LbvhReference, DenormalCentroidExtentGivesAValidTree) {
   for (int i = 0; i < 20; ++i)
     p.add(Vec3(float(i % 3) * 1e-45f, float(i), 0.0f), Vec3(float(i % 3) * 1e-45f, float(i), 1.0f));
   for (MortonBits bits : {MortonBits::k30, MortonBits::k63}) {
-    const Bvh bvh = build_lbvh_reference(p.boxes.data(), p.centers.data(), p.boxes.size(), LbvhConfig{bits});
+    const Bvh bvh = build_lbvh_reference(p.boxes.data(), p.boxes.size(), LbvhConfig{bits});
     EXPECT_EQ(bvh.validate(p.boxes.data(), p.boxes.size()), "");
   }
 }

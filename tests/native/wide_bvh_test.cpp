@@ -23,12 +23,12 @@ Bvh sah_tree(const MeshData& m) {
   const PrimitiveBounds p = triangle_bounds(m);
   BinnedSahConfig config;
   config.leaf_without_search = kLeaf;
-  return build_binned_sah(p.boxes.data(), p.centers.data(), p.boxes.size(), config);
+  return build_binned_sah(p.boxes.data(), p.boxes.size(), config);
 }
 
 Bvh lbvh_tree(const MeshData& m) {
   const PrimitiveBounds p = triangle_bounds(m);
-  return build_lbvh(p.boxes.data(), p.centers.data(), p.boxes.size());
+  return build_lbvh(p.boxes.data(), p.boxes.size());
 }
 
 std::vector<MeshData> varied_meshes() {

@@ -138,7 +138,6 @@ PrimitiveBounds triangle_bounds(const MeshData& mesh) {
     b.extend(mesh.vertices[t.y]);
     b.extend(mesh.vertices[t.z]);
     p.boxes.push_back(b);
-    p.centers.push_back(b.center());
   }
   return p;
 }

@@ -42,10 +42,9 @@ BBox bounds_of(const MeshData& mesh);
 // mesh's extent on each side: the scene where a shadow ray leaving towards a light outside is
 // blocked by a wall, whatever the dense mesh does.
 MeshData in_closed_room(const MeshData& mesh, float margin);
-// Each triangle's box and the box's centre: what the builders take.
+// Each triangle's box: what the builders take.
 struct PrimitiveBounds {
   std::vector<BBox> boxes;
-  std::vector<Vec3> centers;
 };
 PrimitiveBounds triangle_bounds(const MeshData& mesh);
 
