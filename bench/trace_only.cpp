@@ -17,6 +17,7 @@
 //                             by the SAH dynamic programme: children a node, SAH cost, collapse ms
 #include "accel/binned_sah_builder.h"
 #include "accel/lbvh_builder.h"
+#include "accel/morton_wide_builder.h"
 #include "accel/wide_bvh.h"
 #include "embree_oracle.h"
 #include "geometry/triangle_block.h"
@@ -132,6 +133,24 @@ int main(int argc, char** argv) {
     std::sort(ms.begin(), ms.end());
     std::printf("wide: LBVH radix tree collapsed in place (DP): %.1f ms (median of %zu; fastest %.1f)\n",
                 ms[ms.size() / 2], ms.size(), ms[0]);
+    // The host's Morton build, straight to wide nodes, against the OpenCL build and its collapse.
+    std::vector<double> host, device;
+    WideBuild morton;
+    for (int k = 0; k < std::max(repeats, 3); ++k) {
+      double start = wall_ms();
+      morton = build_morton_wide(prims.boxes.data(), prims.boxes.size(), kBlockWidth);
+      host.push_back(wall_ms() - start);
+      start = wall_ms();
+      const WideBuild lbvh = build_lbvh_wide(prims.boxes.data(), prims.boxes.size(), kBlockWidth);
+      device.push_back(wall_ms() - start);
+    }
+    std::sort(host.begin(), host.end());
+    std::sort(device.begin(), device.end());
+    const WideStats mst = wide_stats(morton.wide, kBlockWidth);
+    std::printf(
+        "wide: host Morton build: %zu nodes, %.2f children a node, SAH cost %.2f, %.1f ms; OpenCL build_lbvh_wide "
+        "%.1f ms (medians of %zu)\n",
+        mst.nodes, mst.children_per_node, mst.sah_cost, host[host.size() / 2], device[device.size() / 2], host.size());
     return 0;
   }
   if (kind == "commit" || kind == "commit-all") {

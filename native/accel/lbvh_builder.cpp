@@ -1,5 +1,7 @@
 #include "accel/lbvh_builder.h"
 
+#include "accel/morton_code.h"
+
 #include "lbvh_kernel_source.h"  // generated from kernels/lbvh.cl by CMake
 #include "opencl/device.h"
 
@@ -13,35 +15,17 @@
 namespace toyrt {
 namespace {
 
-// Quantisation shared by the kernel and the reference: the same float operations in the same
-// order (the core and the kernel are both compiled without FMA contraction).
-struct MortonFrame {
-  Vec3 lo, scale;
-  uint32_t bits;
-};
-
-MortonFrame morton_frame(const BBox& centroid_bounds, MortonBits bits) {
-  const uint32_t b = uint32_t(bits);
-  const float cells = float((1u << b) - 1u);
-  const Vec3 extent = centroid_bounds.extent();
-  MortonFrame f{centroid_bounds.lo, Vec3(0.0f), b};
-  for (int a = 0; a < 3; ++a) f.scale[a] = extent[a] > 0.0f ? cells / extent[a] : 0.0f;
-  return f;
-}
-
 uint64_t spread_bits(uint64_t v, uint32_t bits) {
   uint64_t out = 0;
   for (uint32_t k = 0; k < bits; ++k) out |= ((v >> k) & 1u) << (3 * k);
   return out;
 }
 
+// The reference's codes spread the bits one at a time: the kernels and the host build spread them
+// by shifts and masks, so equal codes check both.
 uint64_t morton_code(const Vec3& c, const MortonFrame& f) {
-  const float cells = float((1u << f.bits) - 1u);
-  uint64_t q[3];
-  // fmin/fmax as in the kernel: they drop the NaN of 0 * inf (a denormal extent gives an infinite
-  // scale), where std::min/max would pass it on to an undefined cast (found by tests/fuzz).
-  for (int a = 0; a < 3; ++a) q[a] = uint64_t(std::fmin(std::fmax((c[a] - f.lo[a]) * f.scale[a], 0.0f), cells));
-  return (spread_bits(q[0], f.bits) << 2) | (spread_bits(q[1], f.bits) << 1) | spread_bits(q[2], f.bits);
+  return (spread_bits(morton_cell(c, f, 0), f.bits) << 2) | (spread_bits(morton_cell(c, f, 1), f.bits) << 1) |
+         spread_bits(morton_cell(c, f, 2), f.bits);
 }
 
 // As OpenCL's clz: defined for zero.

@@ -1,0 +1,307 @@
+#include "accel/morton_wide_builder.h"
+
+#include "accel/morton_code.h"
+#include "core/uninitialized_array.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+namespace toyrt {
+
+namespace {
+
+// Fixed sizes, not derived from the thread count, so that the tree and its layout are the same on
+// every machine.
+constexpr size_t kGrain = 16384;            // primitives a chunk of the parallel passes
+constexpr uint32_t kTaskPrimitives = 8192;  // larger subtrees are built as tasks of their own
+constexpr uint32_t kCodeBits = 30;          // 10 bits an axis, as the OpenCL build's default
+
+// Bits 0-9 of v moved to bits 0, 3, ..., 27 in four shift-or-mask steps, each moving groups half
+// as wide as the step before.
+uint32_t spread10(uint32_t v) {
+  v &= 0x3FFu;
+  v = (v | v << 16) & 0x030000FFu;
+  v = (v | v << 8) & 0x0300F00Fu;
+  v = (v | v << 4) & 0x030C30C3u;
+  v = (v | v << 2) & 0x09249249u;
+  return v;
+}
+
+// Sort keys: the code above, the primitive's index below. Sorting by the code alone with a stable
+// sort keeps equal codes in index order, as the reference's stable sort does.
+using Key = uint64_t;
+uint32_t code_of(Key k) { return uint32_t(k >> 32); }
+uint32_t prim_of(Key k) { return uint32_t(k); }
+
+// Stable least-significant-digit radix sort of n keys by their codes, 8 bits a pass, over fixed
+// chunks: each chunk counts its digits, one scan gives every (digit, chunk) its first slot, and
+// each chunk scatters in order. A pass whose digit is the same for every key is skipped. Returns
+// the array holding the result (a or b).
+Key* sort_by_code(Key* a, Key* b, size_t n) {
+  const size_t chunks = (n + kGrain - 1) / kGrain;
+  std::vector<uint32_t> first(chunks * 256);
+  for (uint32_t shift = 32; shift < 32 + kCodeBits; shift += 8) {
+    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+      uint32_t* count = &first[c * 256];
+      std::fill(count, count + 256, 0u);
+      const size_t end = std::min(n, (c + 1) * kGrain);
+      for (size_t i = c * kGrain; i < end; ++i) ++count[(a[i] >> shift) & 255u];
+    });
+    uint32_t sum = 0;
+    bool one_digit = false;
+    for (uint32_t d = 0; d < 256; ++d) {
+      const uint32_t digit_start = sum;
+      for (size_t c = 0; c < chunks; ++c) {
+        const uint32_t count = first[c * 256 + d];
+        first[c * 256 + d] = sum;
+        sum += count;
+      }
+      one_digit |= sum - digit_start == n;
+    }
+    if (one_digit) continue;
+    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+      uint32_t next[256];
+      std::copy(&first[c * 256], &first[c * 256] + 256, next);
+      const size_t end = std::min(n, (c + 1) * kGrain);
+      for (size_t i = c * kGrain; i < end; ++i) b[next[(a[i] >> shift) & 255u]++] = a[i];
+    });
+    std::swap(a, b);
+  }
+  return a;
+}
+
+struct Range {
+  uint32_t begin, end;  // sorted slots [begin, end)
+  uint32_t size() const { return end - begin; }
+};
+
+// A task's part of the tree: its wide nodes (its root at 0; interior children as indices into this
+// array), and the root's slots whose subtrees are tasks of their own.
+struct TaskTree {
+  std::vector<WideNode> nodes;
+  std::vector<std::pair<int, Range>> handed_on;  // (slot of node 0, range), in slot order
+  std::vector<uint32_t> handed_to;               // the task each of them became
+  BBox box;                                      // of the subtrees built here (not those handed on)
+};
+
+struct TopDown {
+  const BBox* bounds;
+  const Key* keys;
+  uint32_t leaf_size;
+
+  // Where the range splits: the first slot whose code has the highest bit in which the range's
+  // first and last codes differ (the codes are sorted, so every code in the range shares the bits
+  // above it); equal codes split in the middle.
+  uint32_t split(Range r) const {
+    const uint32_t a = code_of(keys[r.begin]), z = code_of(keys[r.end - 1]);
+    if (a == z) return r.begin + r.size() / 2;
+    const uint32_t bit = 1u << (31 - __builtin_clz(a ^ z));
+    uint32_t lo = r.begin, hi = r.end - 1;  // lo's code lacks the bit, hi's has it
+    while (hi - lo > 1) {
+      const uint32_t mid = lo + (hi - lo) / 2;
+      (code_of(keys[mid]) & bit ? hi : lo) = mid;
+    }
+    return hi;
+  }
+
+  // The children of a wide node over r (more than leaf_size primitives): r split, then the most
+  // populous child split while it holds more than leaf_size and the node has a free slot.
+  int open(Range r, Range kids[kWidth]) const {
+    int n = 1;
+    kids[0] = r;
+    while (n < kWidth) {
+      int best = -1;
+      uint32_t most = leaf_size;
+      for (int i = 0; i < n; ++i)
+        if (kids[i].size() > most) {
+          best = i;
+          most = kids[i].size();
+        }
+      if (best < 0) break;
+      const uint32_t at = split(kids[best]);
+      kids[n++] = {at, kids[best].end};
+      kids[best].end = at;
+    }
+    return n;
+  }
+
+  BBox leaf_box(Range r) const {
+    BBox b;
+    for (uint32_t k = r.begin; k < r.end; ++k) b.extend(bounds[prim_of(keys[k])]);
+    return b;
+  }
+
+  // Writes the wide node over r at out.nodes[at], its interior children side by side after the
+  // array's end and their subtrees after them (depth first); returns the box of what it built.
+  // Children of more than kTaskPrimitives (only ever met at a task's root) are handed on.
+  BBox build(Range r, size_t at, TaskTree& out) const {
+    Range kids[kWidth];
+    const int n = open(r, kids);
+    WideNode node;
+    for (int a = 0; a < 3; ++a)
+      for (int i = 0; i < kWidth; ++i) {
+        node.bounds[a][i] = kInfinity;
+        node.bounds[a + 3][i] = -kInfinity;
+      }
+    for (int i = 0; i < kWidth; ++i) node.child[i] = node.count[i] = 0;
+    int inline_interior = 0;
+    for (int i = 0; i < n; ++i) inline_interior += kids[i].size() > leaf_size && kids[i].size() <= kTaskPrimitives;
+    size_t next = out.nodes.size();
+    out.nodes.resize(next + size_t(inline_interior));
+    BBox total;
+    for (int i = 0; i < n; ++i) {
+      BBox b;
+      if (kids[i].size() <= leaf_size) {
+        b = leaf_box(kids[i]);
+        node.child[i] = kids[i].begin;
+        node.count[i] = kids[i].size();
+      } else if (kids[i].size() > kTaskPrimitives) {
+        out.handed_on.emplace_back(i, kids[i]);
+        continue;  // its box is set when its task is done
+      } else {
+        node.child[i] = uint32_t(next);
+        b = build(kids[i], next++, out);
+      }
+      for (int a = 0; a < 3; ++a) {
+        node.bounds[a][i] = b.lo[a];
+        node.bounds[a + 3][i] = b.hi[a];
+      }
+      total.extend(b);
+    }
+    out.nodes[at] = node;  // by index: the array may have grown while the children were built
+    return total;
+  }
+};
+
+// Children by decreasing surface area, stably (the order collapse() gives them: the any-hit walk
+// visits the largest first, which finds a wall before the dense model behind it).
+void sort_slots(WideNode& node) {
+  int order[kWidth];
+  float area[kWidth];
+  int n = 0;
+  for (int i = 0; i < kWidth; ++i)
+    if (node.used(i)) {
+      order[n] = i;
+      area[n++] = node.box(i).half_area();
+    }
+  for (int i = 1; i < n; ++i)
+    for (int k = i; k > 0 && area[k - 1] < area[k]; --k) {
+      std::swap(area[k - 1], area[k]);
+      std::swap(order[k - 1], order[k]);
+    }
+  const WideNode in = node;
+  for (int i = 0; i < kWidth; ++i) {
+    const bool from = i < n;
+    const int s = from ? order[i] : 0;
+    for (int b = 0; b < 6; ++b) node.bounds[b][i] = from ? in.bounds[b][s] : (b < 3 ? kInfinity : -kInfinity);
+    node.child[i] = from ? in.child[s] : 0;
+    node.count[i] = from ? in.count[s] : 0;
+  }
+}
+
+}  // namespace
+
+WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf_size) {
+  WideBuild built;
+  if (count == 0) return built;
+  leaf_size = std::max(leaf_size, 1u);
+  const size_t chunks = (count + kGrain - 1) / kGrain;
+  const BBox centres = tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, chunks, 1), BBox{},
+      [&](const tbb::blocked_range<size_t>& r, BBox acc) {
+        for (size_t c = r.begin(); c != r.end(); ++c)
+          for (size_t i = c * kGrain, end = std::min(count, (c + 1) * kGrain); i < end; ++i)
+            acc.extend(prim_bounds[i].center());
+        return acc;
+      },
+      [](BBox a, const BBox& b) {
+        a.extend(b);
+        return a;
+      });
+  const MortonFrame frame = morton_frame(centres, MortonBits::k30);
+  UninitializedArray<Key> a(count), b(count);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const Vec3 c = prim_bounds[i].center();
+      const uint32_t code = spread10(morton_cell(c, frame, 0)) << 2 | spread10(morton_cell(c, frame, 1)) << 1 |
+                            spread10(morton_cell(c, frame, 2));
+      a.emplace(i, Key(code) << 32 | i);
+    }
+  });
+  const Key* keys = sort_by_code(a.data(), b.data(), count);
+  built.prim_ids.resize(count);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) built.prim_ids[i] = prim_of(keys[i]);
+  });
+  if (count <= leaf_size) {
+    built.wide.root_leaf_first = 0;
+    built.wide.root_leaf_count = uint32_t(count);
+    return built;
+  }
+
+  // Tasks level by level: each builds its subtree but for the children it hands on, which become
+  // the next level's tasks in the order they were met, so task numbers (and the layout) do not
+  // depend on which thread ran what.
+  const TopDown top_down{prim_bounds, keys, leaf_size};
+  std::vector<Range> ranges{{0u, uint32_t(count)}};
+  std::vector<TaskTree> tasks;
+  for (size_t level = 0; level < ranges.size();) {
+    const size_t level_end = ranges.size();
+    tasks.resize(level_end);
+    tbb::parallel_for(tbb::blocked_range<size_t>(level, level_end, 1), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t t = r.begin(); t != r.end(); ++t) {
+        // About one wide node for every 17 primitives on meshes (leaves of 8): reserved, so the
+        // array rarely grows while the subtree is built.
+        tasks[t].nodes.reserve(ranges[t].size() / 12 + 8);
+        tasks[t].nodes.resize(1);
+        tasks[t].box = top_down.build(ranges[t], 0, tasks[t]);
+      }
+    });
+    for (size_t t = level; t < level_end; ++t)
+      for (const auto& [slot, range] : tasks[t].handed_on) {
+        tasks[t].handed_to.push_back(uint32_t(ranges.size()));
+        ranges.push_back(range);
+      }
+    level = level_end;
+  }
+  // Boxes of the tasks' roots, from the last task up (a task is numbered after the one that
+  // handed it on), and each task's place in the final array.
+  std::vector<size_t> offset(tasks.size() + 1, 0);
+  for (size_t t = tasks.size(); t-- > 0;) {
+    TaskTree& task = tasks[t];
+    for (size_t j = 0; j < task.handed_on.size(); ++j) {
+      const BBox& b = tasks[task.handed_to[j]].box;
+      const int slot = task.handed_on[j].first;
+      for (int a = 0; a < 3; ++a) {
+        task.nodes[0].bounds[a][slot] = b.lo[a];
+        task.nodes[0].bounds[a + 3][slot] = b.hi[a];
+      }
+      task.box.extend(b);
+    }
+  }
+  for (size_t t = 0; t < tasks.size(); ++t) offset[t + 1] = offset[t] + tasks[t].nodes.size();
+  built.wide.nodes.resize(offset.back());  // not zeroed (HugePageAllocator): every node is written below
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, tasks.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t t = r.begin(); t != r.end(); ++t) {
+      const TaskTree& task = tasks[t];
+      for (size_t i = 0; i < task.nodes.size(); ++i) {
+        WideNode node = task.nodes[i];
+        for (int k = 0; k < kWidth; ++k)
+          if (node.count[k] == 0 && node.used(k)) node.child[k] += uint32_t(offset[t]);
+        if (i == 0)
+          for (size_t j = 0; j < task.handed_on.size(); ++j)
+            node.child[task.handed_on[j].first] = uint32_t(offset[task.handed_to[j]]);
+        sort_slots(node);
+        built.wide.nodes[offset[t] + i] = node;
+      }
+    }
+  });
+  return built;
+}
+
+}  // namespace toyrt

@@ -1,0 +1,131 @@
+// build_morton_wide(): the LBVH built on the host, top down from sorted Morton codes straight to
+// wide nodes. Its order is the LBVH reference's (same codes, stable sort), every primitive sits in
+// exactly one leaf whose box holds it, every box holds what is under it, and the layout does not
+// depend on the thread count.
+#include "accel/lbvh_builder.h"
+#include "accel/morton_wide_builder.h"
+#include "core/parallel.h"
+#include "test_scenes.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+using namespace toyrt;
+using namespace toyrt::testing;
+
+namespace {
+
+constexpr uint32_t kLeaf = 8;  // a mesh's block width
+
+std::vector<MeshData> varied_meshes() {
+  std::vector<MeshData> meshes;
+  for (uint64_t seed = 1; seed <= 4; ++seed) meshes.push_back(triangle_soup(300 * seed * seed, 0.05f, seed));
+  meshes.push_back(uv_sphere(120, 120, 1.0f, 0.15f));  // 28,560 triangles: tasks handed on
+  meshes.push_back(in_closed_room(uv_sphere(30, 30), 0.5f));
+  meshes.push_back(slivers(3000, 7));
+  meshes.push_back(triangle_soup(5, 0.3f, 9));  // one leaf: no wide node at all
+  MeshData same;                                // 20,000 copies of one triangle: every code equal
+  same.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  same.triangles.assign(20000, Triangle(0, 1, 2));
+  meshes.push_back(same);
+  return meshes;
+}
+
+bool holds(const BBox& outer, const BBox& inner) {
+  for (int a = 0; a < 3; ++a)
+    if (inner.lo[a] < outer.lo[a] || inner.hi[a] > outer.hi[a]) return false;
+  return true;
+}
+
+// Walks the tree from the root: each slot's box holds its primitives' boxes (a leaf) or every
+// box of the node it points to; each primitive slot and each node is reached exactly once; no
+// node has fewer than two children. Returns the deepest node's depth.
+int check_tree(const WideBuild& built, const std::vector<BBox>& boxes, uint32_t leaf_size) {
+  const WideBvh& wide = built.wide;
+  std::vector<int> prim_seen(built.prim_ids.size(), 0), node_seen(wide.nodes.size(), 0);
+  if (wide.nodes.empty()) {
+    EXPECT_EQ(wide.root_leaf_count, built.prim_ids.size());
+    return 0;
+  }
+  std::vector<std::pair<uint32_t, int>> stack{{0u, 1}};
+  node_seen[0] = 1;
+  int deepest = 0;
+  while (!stack.empty()) {
+    const auto [index, depth] = stack.back();
+    stack.pop_back();
+    deepest = std::max(deepest, depth);
+    const WideNode& n = wide.nodes[index];
+    int children = 0;
+    for (int i = 0; i < kWidth; ++i) {
+      if (!n.used(i)) continue;
+      ++children;
+      if (n.count[i]) {
+        EXPECT_LE(n.count[i], leaf_size);
+        for (uint32_t k = 0; k < n.count[i]; ++k) {
+          ++prim_seen[n.child[i] + k];
+          EXPECT_TRUE(holds(n.box(i), boxes[built.prim_ids[n.child[i] + k]])) << "leaf slot " << i;
+        }
+      } else {
+        EXPECT_LT(n.child[i], wide.nodes.size());
+        if (n.child[i] >= wide.nodes.size()) continue;
+        const WideNode& c = wide.nodes[n.child[i]];
+        for (int k = 0; k < kWidth; ++k)
+          if (c.used(k)) EXPECT_TRUE(holds(n.box(i), c.box(k))) << "node " << index << " slot " << i;
+        ++node_seen[n.child[i]];
+        stack.push_back({n.child[i], depth + 1});
+      }
+    }
+    EXPECT_GE(children, 2);
+  }
+  for (size_t k = 0; k < prim_seen.size(); ++k) EXPECT_EQ(prim_seen[k], 1) << "primitive slot " << k;
+  for (size_t k = 0; k < node_seen.size(); ++k) EXPECT_EQ(node_seen[k], 1) << "wide node " << k;
+  return deepest;
+}
+
+}  // namespace
+
+TEST(MortonWide, OrderIsTheLbvhReferencesForThirtyBitCodes) {
+  for (const MeshData& m : varied_meshes()) {
+    const PrimitiveBounds p = triangle_bounds(m);
+    const WideBuild built = build_morton_wide(p.boxes.data(), p.boxes.size(), kLeaf);
+    const LbvhHierarchy reference =
+        build_lbvh_hierarchy_reference(p.boxes.data(), p.boxes.size(), LbvhConfig{MortonBits::k30});
+    EXPECT_EQ(built.prim_ids, reference.values) << m.triangles.size() << " triangles";
+  }
+}
+
+TEST(MortonWide, EveryPrimitiveInOneLeafAndEveryBoxHoldsWhatIsUnderIt) {
+  for (const uint32_t leaf : {1u, 4u, kLeaf}) {
+    for (const MeshData& m : varied_meshes()) {
+      SCOPED_TRACE(std::to_string(m.triangles.size()) + " triangles, leaves of " + std::to_string(leaf));
+      const PrimitiveBounds p = triangle_bounds(m);
+      const int depth = check_tree(build_morton_wide(p.boxes.data(), p.boxes.size(), leaf), p.boxes, leaf);
+      // Equal codes split in the middle, so even 20,000 equal triangles stay shallow.
+      EXPECT_LE(depth, 16);
+    }
+  }
+}
+
+TEST(MortonWide, SameLayoutOnAnyThreadCount) {
+  const MeshData m = uv_sphere(300, 300, 1.0f, 0.1f);  // 179,400 triangles: three levels of tasks
+  const PrimitiveBounds p = triangle_bounds(m);
+  auto build = [&](int threads) {
+    WideBuild built;
+    run_with_threads(threads, [&] { built = build_morton_wide(p.boxes.data(), p.boxes.size(), kLeaf); });
+    return built;
+  };
+  const WideBuild one = build(1);
+  for (const int threads : {2, 0}) {
+    const WideBuild other = build(threads);
+    EXPECT_EQ(one.prim_ids, other.prim_ids);
+    ASSERT_EQ(one.wide.nodes.size(), other.wide.nodes.size());
+    EXPECT_EQ(0, std::memcmp(one.wide.nodes.data(), other.wide.nodes.data(), one.wide.nodes.size() * sizeof(WideNode)));
+  }
+}
+
+TEST(MortonWide, NoPrimitivesNoTree) {
+  const WideBuild built = build_morton_wide(nullptr, 0, kLeaf);
+  EXPECT_TRUE(built.wide.empty());
+  EXPECT_TRUE(built.prim_ids.empty());
+}
