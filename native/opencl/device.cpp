@@ -55,6 +55,9 @@ Device open_device() {
   }
   if (!chosen) throw OpenClError("no OpenCL device found on " + std::to_string(platform_count) + " platform(s)");
   dev.name = info(chosen, CL_PLATFORM_NAME) + ": " + info(dev.device, CL_DEVICE_NAME);
+  cl_device_type type = 0;
+  check(clGetDeviceInfo(dev.device, CL_DEVICE_TYPE, sizeof type, &type, nullptr), "clGetDeviceInfo");
+  dev.gpu = (type & CL_DEVICE_TYPE_GPU) != 0;
   cl_int status = CL_SUCCESS;
   dev.context = clCreateContext(nullptr, 1, &dev.device, nullptr, nullptr, &status);
   check(status, "clCreateContext");

@@ -25,6 +25,7 @@ struct Device {
   cl_command_queue queue = nullptr;
   cl_device_id device = nullptr;
   std::string name;  // platform and device, for reports
+  bool gpu = false;  // CL_DEVICE_TYPE_GPU; else a CPU (PoCL's) or an accelerator
 };
 
 // The shared device; throws OpenClError if there is none (or TOYRT_OPENCL=off in the environment,

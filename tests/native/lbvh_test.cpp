@@ -141,6 +141,7 @@ TEST(Lbvh, CompileTimeIsReportedApartFromBuildTime) {
   scene.add_instance(scene.add_mesh(m.vertices, m.triangles), Mat4(1.0f));
   CommitOptions options;
   options.builder = BuilderKind::Lbvh;
+  options.lbvh.bits = MortonBits::k63;  // 63-bit codes take the kernels on any device
   scene.commit(options);
   const CommitStats first = scene.commit_stats();
   scene.add_instance(scene.add_mesh(m.vertices, m.triangles), Mat4(1.0f));
@@ -154,8 +155,42 @@ TEST(Lbvh, CompileTimeIsReportedApartFromBuildTime) {
   EXPECT_EQ(second.lbvh_compile_ms, 0.0);
 }
 
-TEST(LbvhFallback, WithoutOpenClTheSahBuilderStandsInWithOneWarning) {
+TEST(LbvhFallback, WithoutOpenClTheHostBuildsTheLbvhAndTracesTheSahTreesHits) {
   // ctest runs each test in its own process, so switching OpenCL off here affects only this one.
+  setenv("TOYRT_OPENCL", "off", 1);
+  const MeshData m = uv_sphere(120, 240, 1.0f, 0.15f);
+  auto committed = [&](BuilderKind kind) {
+    auto scene = std::make_unique<Scene>();
+    scene->add_instance(scene->add_mesh(m.vertices, m.triangles), Mat4(1.0f));
+    CommitOptions options;
+    options.builder = kind;
+    scene->commit(options);
+    return scene;
+  };
+  const auto lbvh = committed(BuilderKind::Lbvh), sah = committed(BuilderKind::Sah);
+  EXPECT_EQ(lbvh->commit_stats().lbvh_meshes, 1u);
+  EXPECT_EQ(lbvh->commit_stats().sah_meshes, 0u);
+  EXPECT_TRUE(lbvh->commit_stats().warning.empty()) << lbvh->commit_stats().warning;
+  // Rays from outside aimed at triangle centres: the nearest hit is the same triangle at the same
+  // distance whichever tree finds it.
+  int found = 0;
+  for (size_t k = 0; k < m.triangles.size(); k += 97) {
+    const Triangle& t = m.triangles[k];
+    const Vec3 c = (m.vertices[t.x] + m.vertices[t.y] + m.vertices[t.z]) / 3.0f;
+    const Ray ray{3.0f * c, 0.0f, glm::normalize(-c), kInfinity};
+    const Hit a = lbvh->intersect(ray), b = sah->intersect(ray);
+    ASSERT_EQ(a.found(), b.found()) << "triangle " << k;
+    if (!a.found()) continue;
+    ++found;
+    EXPECT_EQ(a.prim, b.prim) << "triangle " << k;
+    EXPECT_EQ(a.t, b.t) << "triangle " << k;
+    EXPECT_EQ(lbvh->occluded(ray), true);
+  }
+  EXPECT_GT(found, 500);
+}
+
+TEST(LbvhFallback, WithoutOpenClSixtyThreeBitCodesFallBackOnSahWithOneWarning) {
+  // The host build makes 30-bit codes only: 63-bit ones need the kernels.
   setenv("TOYRT_OPENCL", "off", 1);
   const MeshData m = uv_sphere(30, 60);
   Scene scene;
@@ -164,6 +199,7 @@ TEST(LbvhFallback, WithoutOpenClTheSahBuilderStandsInWithOneWarning) {
   scene.add_mesh(m.vertices, m.triangles);  // two meshes: still one warning
   CommitOptions options;
   options.builder = BuilderKind::Lbvh;
+  options.lbvh.bits = MortonBits::k63;
   scene.commit(options);
   EXPECT_EQ(scene.commit_stats().sah_meshes, 2u);
   EXPECT_EQ(scene.commit_stats().lbvh_meshes, 0u);

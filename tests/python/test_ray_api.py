@@ -310,7 +310,9 @@ def test_auto_builder_follows_the_expected_ray_count():
     assert s.last_commit["sah_meshes"] == 1
 
 
-def test_lbvh_without_opencl_falls_back_with_one_warning():
+def test_lbvh_without_opencl_builds_on_the_host_without_a_warning():
+    # The LBVH runs its kernels on an OpenCL GPU only; without OpenCL (as on a CPU device) the host
+    # builds it, so nothing falls back and nothing is said.
     import subprocess
     import sys
     code = (
@@ -321,12 +323,9 @@ def test_lbvh_without_opencl_falls_back_with_one_warning():
         "with warnings.catch_warnings(record=True) as w:\n"
         "    warnings.simplefilter('always')\n"
         "    s.commit(builder='lbvh')\n"
-        "print(len(w), w[0].category.__name__, s.last_commit['sah_meshes'])\n"
-        "print(str(w[0].message))\n"
+        "print(len(w), s.last_commit['lbvh_meshes'], s.last_commit['sah_meshes'])\n"
     )
     import os
     env = dict(os.environ, TOYRT_OPENCL="off", PYTHONPATH=os.pathsep.join(sys.path))
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout
-    first, message = out.splitlines()[:2]
-    assert first == "1 RuntimeWarning 2"
-    assert "SAH builder instead" in message and "TOYRT_OPENCL=off" in message
+    assert out.splitlines()[0] == "0 2 0"
