@@ -16,7 +16,7 @@ def main(csv_path, png_path):
         rows = list(csv.DictReader(f))
     n = [int(r["triangles"]) for r in rows]
     series = [("SAH (TBB)", "sah", "o-"), ("LBVH 30-bit (PoCL)", "lbvh", "s-"),
-              ("LBVH 63-bit (PoCL)", "lbvh63", "^--"), ("Embree 3", "embree", "d:")]
+              ("LBVH 63-bit (PoCL)", "lbvh63", "^--"), ("LBVH on the host", "host", "v-"), ("Embree 3", "embree", "d:")]
     fig, (build, trace) = plt.subplots(1, 2, figsize=(11, 4.2))
     for label, key, style in series:
         build.plot(n, [float(r[f"{key}_ms"]) for r in rows], style, label=label)

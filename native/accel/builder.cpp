@@ -44,11 +44,14 @@ Bvh build_linear(const BBox* bounds, size_t count, const BuildConfig& config, Bu
       [&] { return build_sah(bounds, count, config, st); });
 }
 
-// Whether a mesh's LBVH runs the kernels: on an OpenCL GPU. On a CPU device (PoCL's) or with no
-// OpenCL at all the host builds the same Morton order straight into wide nodes
-// (build_morton_wide), 2-3x faster than the kernels and their collapse on the same cores
-// (docs/lbvh.md); it makes 30-bit codes only, so 63-bit codes still take the kernels.
+// Whether a mesh's LBVH runs the kernels (LbvhDevice::Auto: on an OpenCL GPU). On a CPU device
+// (PoCL's) or with no OpenCL at all the host builds the same Morton order straight into wide
+// nodes (build_morton_wide), 2-3x faster than the kernels and their collapse on the same cores
+// (docs/lbvh.md); it makes 30-bit codes only, so 63-bit codes take the kernels.
 bool lbvh_on_device(const LbvhConfig& config) {
+  if (config.device == LbvhDevice::Host && config.bits != MortonBits::k30)
+    throw std::invalid_argument("the host LBVH build makes 30-bit Morton codes only");
+  if (config.device != LbvhDevice::Auto) return config.device == LbvhDevice::OpenCl;
   if (config.bits != MortonBits::k30) return true;
   try {
     return opencl::device().gpu;

@@ -15,10 +15,16 @@
 
 namespace toyrt {
 
+// Where a mesh's LBVH is built (build_wide_bvh): Auto runs the kernels on an OpenCL GPU and builds
+// on the host otherwise (a CPU device such as PoCL's, or no OpenCL), where the host build is the
+// faster (docs/lbvh.md); Host and OpenCl force one side, for tests and benchmarks.
+enum class LbvhDevice { Auto, Host, OpenCl };
+
 struct LbvhConfig {
   // 30-bit codes tell 1024 positions per axis apart, 63-bit codes two million; see docs/lbvh.md
-  // for what the finer codes buy and cost.
+  // for what the finer codes buy and cost. The host build makes 30-bit codes only.
   MortonBits bits = MortonBits::k30;
+  LbvhDevice device = LbvhDevice::Auto;
 };
 
 struct LbvhStats {

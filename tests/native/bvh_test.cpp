@@ -78,11 +78,16 @@ TEST(BinnedSahBuilder, SameTreeForAnyThreadCount) {
 // threads, from either builder: traversal results cannot depend on the thread count.
 TEST(Mesh, TracedLayoutSameForAnyThreadCount) {
   const MeshData m = uv_sphere(300, 600, 1.0f, 0.1f);  // above the collapse's parallel threshold
-  for (const BuilderKind kind : {BuilderKind::Sah, BuilderKind::Lbvh}) {
-    SCOPED_TRACE(builder_name(kind));
+  // The SAH, the host LBVH (a CPU device's) and the kernels' LBVH collapsed in place.
+  for (const auto& [kind, device] :
+       {std::pair{BuilderKind::Sah, LbvhDevice::Auto}, std::pair{BuilderKind::Lbvh, LbvhDevice::Host},
+        std::pair{BuilderKind::Lbvh, LbvhDevice::OpenCl}}) {
+    SCOPED_TRACE(std::string(builder_name(kind)) + (device == LbvhDevice::OpenCl ? " (kernels)" : ""));
+    BuildConfig config;
+    config.lbvh.device = device;
     auto build = [&](int threads) {
       auto mesh = std::make_unique<Mesh>(m.vertices, m.triangles);
-      run_with_threads(threads, [&] { mesh->build(kind); });
+      run_with_threads(threads, [&] { mesh->build(kind, config); });
       return mesh;
     };
     const auto one = build(1), two = build(2), all = build(0);

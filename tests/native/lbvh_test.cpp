@@ -189,6 +189,14 @@ TEST(LbvhFallback, WithoutOpenClTheHostBuildsTheLbvhAndTracesTheSahTreesHits) {
   EXPECT_GT(found, 500);
 }
 
+TEST(LbvhFallback, TheHostBuildRefusesSixtyThreeBitCodes) {
+  const PrimitiveBounds p = triangle_bounds(uv_sphere(10, 10));
+  BuildConfig config;
+  config.lbvh.bits = MortonBits::k63;
+  config.lbvh.device = LbvhDevice::Host;
+  EXPECT_THROW(build_wide_bvh(BuilderKind::Lbvh, p.boxes.data(), p.boxes.size(), 8, config), std::invalid_argument);
+}
+
 TEST(LbvhFallback, WithoutOpenClSixtyThreeBitCodesFallBackOnSahWithOneWarning) {
   // The host build makes 30-bit codes only: 63-bit ones need the kernels.
   setenv("TOYRT_OPENCL", "off", 1);
