@@ -147,6 +147,22 @@ int main(int argc, char** argv) {
     std::sort(host.begin(), host.end());
     std::sort(device.begin(), device.end());
     const WideStats mst = wide_stats(morton.wide, kBlockWidth);
+    // Blocks each tree's leaves fill (a leaf of up to 8 triangles is one block).
+    auto blocks_of = [](const WideBvh& w) {
+      size_t blocks = 0, triangles = 0;
+      for (const WideNode& n : w.nodes)
+        for (int i = 0; i < kWidth; ++i)
+          if (n.count[i]) {
+            blocks += (n.count[i] + kBlockWidth - 1) / kBlockWidth;
+            triangles += n.count[i];
+          }
+      return std::pair{blocks, triangles};
+    };
+    const auto [host_blocks, host_triangles] = blocks_of(morton.wide);
+    const auto [dp_blocks, dp_triangles] = blocks_of(collapse(tree, kBlockWidth));
+    std::printf("wide: triangles a block: host Morton %.2f (%zu blocks), kernels' tree collapsed %.2f (%zu blocks)\n",
+                double(host_triangles) / double(host_blocks), host_blocks, double(dp_triangles) / double(dp_blocks),
+                dp_blocks);
     std::printf(
         "wide: host Morton build: %zu nodes, %.2f children a node, SAH cost %.2f, %.1f ms; OpenCL build_lbvh_wide "
         "%.1f ms (medians of %zu)\n",

@@ -51,7 +51,7 @@ class TOYRTRenderSettings(bpy.types.PropertyGroup):
         name="BVH Builder", description="How acceleration structures are built",
         items=[("auto", "Auto", "Whichever makes build plus tracing cheaper for this render"),
                ("sah", "SAH", "Binned surface area heuristic on the CPU: the fastest trees"),
-               ("lbvh", "LBVH", "Linear BVH as OpenCL kernels: the fastest builds")],
+               ("lbvh", "LBVH", "Linear BVH, on the CPU or as OpenCL kernels on a GPU: the fastest builds")],
         default="auto")
     max_specular_depth: bpy.props.IntProperty(
         name="Max Specular Depth", description="Refractions and reflections a path may take through glass",

@@ -102,7 +102,8 @@ class ViewportSession:
         region = context.region
         rays = float(region.width * region.height * s.viewport_samples * (2 + self.cache.stats.get("lights", 0)))
         # The cost model picks the builder: interactive work (few rays) favours the fast LBVH builds,
-        # whose fallback on SAH (no OpenCL) is a note in the view's header, once per session.
+        # whose fallback on SAH (a GPU that cannot build its kernels) is a note in the view's
+        # header, once per session.
         if self.cache.commit(builder=s.builder, threads=threads, expected_rays=rays):
             engine = self._engine()
             report.commit_notes(self.cache.scene, engine.report if engine is not None else None, self._notes_shown)
