@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
   const std::time_t now = std::time(nullptr);
   std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
   std::ostringstream md;
-  md << "# Builders: LBVH on OpenCL against SAH and Embree\n\n"
+  md << "# Builders: the LBVH (on the host and as OpenCL kernels) against SAH and Embree\n\n"
      << "Written by `make bench-lbvh` (`build/bench/bench_lbvh`) on " << date << ": " << cpu_model() << ", "
      << std::thread::hardware_concurrency() << " hardware threads; OpenCL device: " << device << ". Best of "
      << args->runs
@@ -153,7 +153,7 @@ int main(int argc, char** argv) {
         r.lbvh63_cost, r.sah_mrays, r.lbvh_mrays, r.lbvh63_mrays, r.embree_mrays, 100.0 * r.lbvh_mrays / r.sah_mrays);
     md << line;
   }
-  md << "\nLBVH stages at the largest size (ms): ";
+  md << "\nThe kernels' stages at the largest size, the last run (ms): ";
   for (const auto& [name, ms] : stages.back()) {
     std::snprintf(line, sizeof line, "%s %.1f; ", name.c_str(), ms);
     md << line;
