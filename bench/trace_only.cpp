@@ -67,7 +67,8 @@ int main(int argc, char** argv) {
     std::sort(theirs.begin(), theirs.end());
     std::printf("lbvh-all: %zu triangles, LBVH commit median %.1f ms, Embree Morton %.1f ms wall (%d runs)\n",
                 mesh.triangles.size(), mine[mine.size() / 2], theirs[theirs.size() / 2], repeats);
-    // The stages of the commit's build (the kernels' tree collapsed in place): medians of as many
+    // The stages of the kernels' build collapsed in place (build_lbvh_wide: what a commit runs on
+    // an OpenCL GPU; on a CPU device the commit above builds on the host): medians of as many
     // builds as commits above.
     const PrimitiveBounds prims = triangle_bounds(mesh);
     std::vector<std::pair<std::string, std::vector<double>>> stages;

@@ -4,13 +4,14 @@ the add-on goes through here, so the rule is kept in one place:
 - A failure is an error (error()): Blender's ERROR report, so F12 shows it and `blender -b`
   exits non-zero, failing the farm's task as it should.
 - What TOYRT approximates or falls back on (a Principled BSDF rendered as its Lambert base, a lamp
-  type it skips, the SAH builder standing in for a missing OpenCL LBVH) is a note (note()): a
+  type it skips, the SAH builder standing in for LBVH kernels a GPU cannot build) is a note (note()): a
   WARNING report in Blender's UI, but in background mode (bpy.app.background: farms) a printed
   `TOYRT note: ...` line containing none of the words warning, error or exception in any case.
   A report would print `Warning: ...` there, and farm managers fail a task on those words (AWS
   Deadline Cloud's strict mode: `.*Exception:.*|.*Error:.*|.*Warning.*`), though the frame is
-  fine. The LBVH builder's fallback on SAH (no OpenCL driver) is such a note (commit_notes()), in
-  place of the RuntimeWarning the native module raises for it.
+  fine. The LBVH builder's fallback on SAH (kernels that cannot run where they were to: without
+  an OpenCL driver the host builds the LBVH and nothing is said) is such a note (commit_notes()),
+  in place of the RuntimeWarning the native module raises for it.
 - Progress (Progress) is the render engine's stats line in the layout Cycles gives it, which
   Blender prints in background mode as `Fra:N Mem:.. | Time:.. | Remaining:.. | Mem:.., Peak:.. |
   Scene, ViewLayer | Sample k/N`, the line farm managers parse, and which comes at least every

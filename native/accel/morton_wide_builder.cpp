@@ -8,6 +8,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -103,8 +104,12 @@ struct TopDown {
     const uint32_t bit = 1u << (31 - __builtin_clz(a ^ z));
     uint32_t lo = r.begin, hi = r.end - 1;  // lo's code lacks the bit, hi's has it
     while (hi - lo > 1) {
+      // Both ends chosen by selects, not a branch: which half holds the split is a coin toss
+      // the predictor loses half the time.
       const uint32_t mid = lo + (hi - lo) / 2;
-      (code_of(keys[mid]) & bit ? hi : lo) = mid;
+      const bool set = (code_of(keys[mid]) & bit) != 0;
+      hi = set ? mid : hi;
+      lo = set ? lo : mid;
     }
     return hi;
   }
@@ -209,6 +214,8 @@ void sort_slots(WideNode& node) {
 WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf_size) {
   WideBuild built;
   if (count == 0) return built;
+  // Slots and indices are 32-bit (an index rides in the low half of each sort key).
+  if (count > size_t(UINT32_MAX)) throw std::length_error("host LBVH: more than 2^32 - 1 primitives");
   leaf_size = std::max(leaf_size, 1u);
   const size_t chunks = (count + kGrain - 1) / kGrain;
   const BBox centres = tbb::parallel_reduce(
@@ -256,8 +263,9 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
     tbb::parallel_for(tbb::blocked_range<size_t>(level, level_end, 1), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t t = r.begin(); t != r.end(); ++t) {
         // About one wide node for every 17 primitives on meshes (leaves of 8): reserved, so the
-        // array rarely grows while the subtree is built.
-        tasks[t].nodes.reserve(ranges[t].size() / 12 + 8);
+        // array rarely grows while the subtree is built. A larger task hands most of its subtree
+        // on and builds only its top.
+        tasks[t].nodes.reserve(std::min(ranges[t].size(), 8 * kTaskPrimitives) / 12 + 8);
         tasks[t].nodes.resize(1);
         tasks[t].box = top_down.build(ranges[t], 0, tasks[t]);
       }

@@ -21,13 +21,14 @@ constexpr uint32_t kLeaf = 8;  // a mesh's block width
 std::vector<MeshData> varied_meshes() {
   std::vector<MeshData> meshes;
   for (uint64_t seed = 1; seed <= 4; ++seed) meshes.push_back(triangle_soup(300 * seed * seed, 0.05f, seed));
-  meshes.push_back(uv_sphere(120, 120, 1.0f, 0.15f));  // 28,560 triangles: tasks handed on
+  meshes.push_back(uv_sphere(120, 120, 1.0f, 0.15f));  // 28,560 triangles
+  meshes.push_back(uv_sphere(300, 300, 1.0f, 0.15f));  // 179,400: subtrees of 22K handed on as tasks
   meshes.push_back(in_closed_room(uv_sphere(30, 30), 0.5f));
   meshes.push_back(slivers(3000, 7));
   meshes.push_back(triangle_soup(5, 0.3f, 9));  // one leaf: no wide node at all
-  MeshData same;                                // 20,000 copies of one triangle: every code equal
+  MeshData same;                                // 100,000 copies of one triangle: every code equal, tasks of 12,500
   same.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-  same.triangles.assign(20000, Triangle(0, 1, 2));
+  same.triangles.assign(100000, Triangle(0, 1, 2));
   meshes.push_back(same);
   return meshes;
 }
@@ -70,8 +71,11 @@ int check_tree(const WideBuild& built, const std::vector<BBox>& boxes, uint32_t 
         EXPECT_LT(n.child[i], wide.nodes.size());
         if (n.child[i] >= wide.nodes.size()) continue;
         const WideNode& c = wide.nodes[n.child[i]];
-        for (int k = 0; k < kWidth; ++k)
-          if (c.used(k)) EXPECT_TRUE(holds(n.box(i), c.box(k))) << "node " << index << " slot " << i;
+        for (int k = 0; k < kWidth; ++k) {
+          if (c.used(k)) {
+            EXPECT_TRUE(holds(n.box(i), c.box(k))) << "node " << index << " slot " << i;
+          }
+        }
         ++node_seen[n.child[i]];
         stack.push_back({n.child[i], depth + 1});
       }
@@ -101,14 +105,22 @@ TEST(MortonWide, EveryPrimitiveInOneLeafAndEveryBoxHoldsWhatIsUnderIt) {
       SCOPED_TRACE(std::to_string(m.triangles.size()) + " triangles, leaves of " + std::to_string(leaf));
       const PrimitiveBounds p = triangle_bounds(m);
       const int depth = check_tree(build_morton_wide(p.boxes.data(), p.boxes.size(), leaf), p.boxes, leaf);
-      // Equal codes split in the middle, so even 20,000 equal triangles stay shallow.
+      // Equal codes split in the middle, so even 100,000 equal triangles stay shallow.
       EXPECT_LE(depth, 16);
     }
   }
 }
 
+TEST(MortonWide, BoxesHoldWhatIsUnderThemWhenTasksHandOnTasks) {
+  // 718,800 triangles: the root's children (about 90K) hand theirs (about 11K) on in turn, so
+  // boxes are patched through two levels of tasks.
+  const MeshData m = uv_sphere(600, 600, 1.0f, 0.15f);
+  const PrimitiveBounds p = triangle_bounds(m);
+  check_tree(build_morton_wide(p.boxes.data(), p.boxes.size(), kLeaf), p.boxes, kLeaf);
+}
+
 TEST(MortonWide, SameLayoutOnAnyThreadCount) {
-  const MeshData m = uv_sphere(300, 300, 1.0f, 0.1f);  // 179,400 triangles: three levels of tasks
+  const MeshData m = uv_sphere(300, 300, 1.0f, 0.1f);  // 179,400 triangles: two levels of tasks
   const PrimitiveBounds p = triangle_bounds(m);
   auto build = [&](int threads) {
     WideBuild built;
