@@ -104,12 +104,8 @@ struct TopDown {
     const uint32_t bit = 1u << (31 - __builtin_clz(a ^ z));
     uint32_t lo = r.begin, hi = r.end - 1;  // lo's code lacks the bit, hi's has it
     while (hi - lo > 1) {
-      // Both ends chosen by selects, not a branch: which half holds the split is a coin toss
-      // the predictor loses half the time.
       const uint32_t mid = lo + (hi - lo) / 2;
-      const bool set = (code_of(keys[mid]) & bit) != 0;
-      hi = set ? mid : hi;
-      lo = set ? lo : mid;
+      (code_of(keys[mid]) & bit ? hi : lo) = mid;
     }
     return hi;
   }
