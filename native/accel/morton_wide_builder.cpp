@@ -179,22 +179,18 @@ struct TopDown {
   }
 };
 
-// Children by decreasing surface area, stably (the order collapse() gives them: the any-hit walk
-// visits the largest first, which finds a wall before the dense model behind it).
+// The node's used slots moved into any_hit_order (wide_bvh.h), the order collapse() gives them.
 void sort_slots(WideNode& node) {
-  int order[kWidth];
-  float area[kWidth];
+  int used[kWidth], order[kWidth];
+  BBox boxes[kWidth];
   int n = 0;
   for (int i = 0; i < kWidth; ++i)
     if (node.used(i)) {
-      order[n] = i;
-      area[n++] = node.box(i).half_area();
+      used[n] = i;
+      boxes[n++] = node.box(i);
     }
-  for (int i = 1; i < n; ++i)
-    for (int k = i; k > 0 && area[k - 1] < area[k]; --k) {
-      std::swap(area[k - 1], area[k]);
-      std::swap(order[k - 1], order[k]);
-    }
+  any_hit_order(boxes, n, order);
+  for (int i = 0; i < n; ++i) order[i] = used[order[i]];
   const WideNode in = node;
   for (int i = 0; i < kWidth; ++i) {
     const bool from = i < n;

@@ -251,23 +251,18 @@ struct Collapser : CollapsedTree<Tree> {
         kids[n++] = r;
       }
     }
-    // Children by decreasing surface area: the order an any-hit walk visits them in. A large box
-    // is the likelier to block a shadow ray (a wall beside a dense model: found at once instead
-    // of after the model's subtrees); the closest-hit walk sorts by distance and ignores it.
-    // An insertion sort: stable, and no allocation.
-    BBox boxes[kWidth];
-    for (int i = 0; i < n; ++i) boxes[i] = tree.box(kids[i].node);
-    for (int i = 1; i < n; ++i) {
-      const Ref kid = kids[i];
-      const BBox box = boxes[i];
-      const float area = box.half_area();
-      int k = i;
-      for (; k > 0 && boxes[k - 1].half_area() < area; --k) {
-        kids[k] = kids[k - 1];
-        boxes[k] = boxes[k - 1];
-      }
-      kids[k] = kid;
-      boxes[k] = box;
+    // Children in any_hit_order.
+    BBox unordered[kWidth], boxes[kWidth];
+    Ref found[kWidth];
+    for (int i = 0; i < n; ++i) {
+      found[i] = kids[i];
+      unordered[i] = tree.box(kids[i].node);
+    }
+    int order[kWidth];
+    any_hit_order(unordered, n, order);
+    for (int i = 0; i < n; ++i) {
+      kids[i] = found[order[i]];
+      boxes[i] = unordered[order[i]];
     }
     for (int a = 0; a < 3; ++a)
       for (int i = 0; i < kWidth; ++i) {
@@ -375,6 +370,20 @@ WideBvh collapse(const LbvhTree& tree, uint32_t leaf_size, CollapseMethod method
     return wide;
   }
   return collapse_tree(KarrasTree{tree}, leaf_size, method);
+}
+
+void any_hit_order(const BBox* boxes, int n, int order[kWidth]) {
+  float area[kWidth];
+  for (int i = 0; i < n; ++i) {
+    order[i] = i;
+    area[i] = boxes[i].half_area();
+  }
+  // An insertion sort: stable, and no allocation.
+  for (int i = 1; i < n; ++i)
+    for (int k = i; k > 0 && area[k - 1] < area[k]; --k) {
+      std::swap(area[k - 1], area[k]);
+      std::swap(order[k - 1], order[k]);
+    }
 }
 
 WideStats wide_stats(const WideBvh& wide, uint32_t block_width) {

@@ -89,6 +89,12 @@ WideBvh collapse(const Bvh& bvh, uint32_t leaf_size = 1, CollapseMethod method =
 // tree as collapsing that tree's flat Bvh (to_bvh), without writing the 2n - 1 flat nodes.
 WideBvh collapse(const LbvhTree& tree, uint32_t leaf_size = 1, CollapseMethod method = CollapseMethod::Sah);
 
+// The order every builder gives a wide node's children: by decreasing surface area, stably. The
+// any-hit walk visits them in slot order, and a large box is the likelier to block a shadow ray
+// (a wall beside a dense model: found at once instead of after the model's subtrees); the
+// closest-hit walk sorts by distance and ignores it. Fills order[0..n) with 0..n-1 so ordered.
+void any_hit_order(const BBox* boxes, int n, int order[kWidth]);
+
 struct WideStats {
   size_t nodes = 0;
   double children_per_node = 0.0;
