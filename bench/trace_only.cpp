@@ -9,6 +9,7 @@
 //                                         CPU milliseconds (the process's CPU clock: one thread,
 //                                         so other work on the machine does not inflate it)
 //   trace_only commit-all [rings] [repeats]   the same on every core, in wall-clock milliseconds
+//   trace_only lbvh-commit [rings] [repeats]  the whole LBVH commit on every core, wall-clock ms
 //   trace_only commit[-all] N [repeats] soup  the same over bench_trace's triangle soup of N x 1000
 //   trace_only lbvh-all [rings] [repeats]     the whole LBVH commit on every core against Embree's
 //                                             Morton build (LOW quality, dynamic scene), interleaved,
@@ -170,9 +171,11 @@ int main(int argc, char** argv) {
         mst.nodes, mst.children_per_node, mst.sah_cost, host[host.size() / 2], device[device.size() / 2], host.size());
     return 0;
   }
-  if (kind == "commit" || kind == "commit-all") {
-    // commit-all: on every core, in wall-clock milliseconds.
-    const bool all = kind == "commit-all";
+  if (kind == "commit" || kind == "commit-all" || kind == "lbvh-commit") {
+    // commit-all: on every core, in wall-clock milliseconds; lbvh-commit: the LBVH commit so, TOYRT
+    // alone (for perf; lbvh-all times it against Embree).
+    const bool lbvh = kind == "lbvh-commit";
+    const bool all = kind == "commit-all" || lbvh;
     auto cpu_ms = [all] {
       timespec ts;
       clock_gettime(all ? CLOCK_MONOTONIC : CLOCK_PROCESS_CPUTIME_ID, &ts);
@@ -183,7 +186,7 @@ int main(int argc, char** argv) {
       Scene s;
       s.add_instance(s.add_mesh(mesh.vertices, mesh.triangles), Mat4(1.0f));
       CommitOptions options;
-      options.builder = BuilderKind::Sah;
+      options.builder = lbvh ? BuilderKind::Lbvh : BuilderKind::Sah;
       options.threads = all ? 0 : 1;
       const double start = cpu_ms();
       s.commit(options);

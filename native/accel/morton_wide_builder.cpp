@@ -39,14 +39,14 @@ using Key = uint64_t;
 uint32_t code_of(Key k) { return uint32_t(k >> 32); }
 uint32_t prim_of(Key k) { return uint32_t(k); }
 
-// Stable least-significant-digit radix sort of n keys by their codes, 8 bits a pass, over fixed
-// chunks: each chunk counts its digits, one scan gives every (digit, chunk) its first slot, and
-// each chunk scatters in order. A pass whose digit is the same for every key is skipped. Returns
-// the array holding the result (a or b).
-Key* sort_by_code(Key* a, Key* b, size_t n) {
+// Stable least-significant-digit radix sort of n keys by the code's bits [low, high), 8 bits a
+// pass, over fixed chunks: each chunk counts its digits, one scan gives every (digit, chunk) its
+// first slot, and each chunk scatters in order. A pass whose digit is the same for every key is
+// skipped. Returns the array holding the result (a or b).
+Key* sort_by_bits(Key* a, Key* b, size_t n, uint32_t low, uint32_t high) {
   const size_t chunks = (n + kGrain - 1) / kGrain;
   std::vector<uint32_t> first(chunks * 256);
-  for (uint32_t shift = 32; shift < 32 + kCodeBits; shift += 8) {
+  for (uint32_t shift = 32 + low; shift < 32 + high; shift += 8) {
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
       uint32_t* count = &first[c * 256];
       std::fill(count, count + 256, 0u);
@@ -73,6 +73,82 @@ Key* sort_by_code(Key* a, Key* b, size_t n) {
     });
     std::swap(a, b);
   }
+  return a;
+}
+
+// The bits below the top digit of a bucket's n keys, sorted in cache on one thread, from `in`
+// into `out` (both overwritten). Two passes of 11 bits where the bucket is large enough to fill
+// their 2048 counters, three of 8 bits otherwise (a few thousand keys: the counters' upkeep would
+// outweigh the pass saved); all passes' digits counted in one read. The top pass's digit also
+// holds bits of the top digit, the same for every key of a bucket.
+template <int kPasses>
+void sort_bucket_by(Key* in, Key* out, size_t n) {
+  constexpr uint32_t kDigitBits = kPasses == 2 ? 11 : 8, kDigits = 1u << kDigitBits;
+  static_assert(kPasses * kDigitBits >= kCodeBits - 8, "the passes cover the bits below the top digit");
+  uint32_t count[kPasses][kDigits] = {};
+  auto digit = [](Key k, int p) { return uint32_t(k >> (32 + kDigitBits * p)) & (kDigits - 1); };
+  for (size_t i = 0; i < n; ++i)
+    for (int p = 0; p < kPasses; ++p) ++count[p][digit(in[i], p)];
+  for (int p = 0; p < kPasses; ++p) {
+    uint32_t sum = 0;
+    for (uint32_t& c : count[p]) sum += std::exchange(c, sum);
+  }
+  Key* from = in;
+  Key* to = out;
+  for (int p = 0; p < kPasses; ++p) {
+    for (size_t i = 0; i < n; ++i) to[count[p][digit(from[i], p)]++] = from[i];
+    std::swap(from, to);
+  }
+  if (from != out) std::copy(from, from + n, out);  // an even number of passes ends in `in`
+}
+
+void sort_bucket(Key* in, Key* out, size_t n) {
+  if (n >= 4096)
+    sort_bucket_by<2>(in, out, n);
+  else
+    sort_bucket_by<3>(in, out, n);
+}
+
+// Sorts n keys by code (the keys are distinct, so the order is the one stable order whatever the
+// thread count). An LSD sort by 8-bit digits moved every key through memory four times, the most
+// costly stage of the build; here one pass scatters the keys by the code's top 8 bits into 256
+// buckets (a few thousand keys each on a mesh), and each bucket sorts the rest in cache. A bucket
+// too large for that (geometry crowded into one 256th of the frame) takes the parallel LSD sort.
+// Returns the array holding the result (a or b).
+Key* sort_by_code(Key* a, Key* b, size_t n) {
+  constexpr uint32_t kTop = kCodeBits - 8;          // the top digit's lowest bit
+  constexpr size_t kLargeBucket = size_t(1) << 17;  // 1 MB of keys: about what the L2 cache holds
+  const size_t chunks = (n + kGrain - 1) / kGrain;
+  std::vector<uint32_t> first(chunks * 256);
+  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    uint32_t* count = &first[c * 256];
+    std::fill(count, count + 256, 0u);
+    const size_t end = std::min(n, (c + 1) * kGrain);
+    for (size_t i = c * kGrain; i < end; ++i) ++count[(a[i] >> (32 + kTop)) & 255u];
+  });
+  uint32_t bucket[257];
+  uint32_t sum = 0;
+  for (uint32_t d = 0; d < 256; ++d) {
+    bucket[d] = sum;
+    for (size_t c = 0; c < chunks; ++c) sum += std::exchange(first[c * 256 + d], sum);
+  }
+  bucket[256] = sum;
+  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    uint32_t next[256];
+    std::copy(&first[c * 256], &first[c * 256] + 256, next);
+    const size_t end = std::min(n, (c + 1) * kGrain);
+    for (size_t i = c * kGrain; i < end; ++i) b[next[(a[i] >> (32 + kTop)) & 255u]++] = a[i];
+  });
+  tbb::parallel_for(tbb::blocked_range<uint32_t>(0, 256, 1), [&](const tbb::blocked_range<uint32_t>& r) {
+    for (uint32_t d = r.begin(); d != r.end(); ++d) {
+      const size_t at = bucket[d], size = bucket[d + 1] - at;
+      if (size <= kLargeBucket) {
+        sort_bucket(b + at, a + at, size);
+      } else if (Key* sorted = sort_by_bits(b + at, a + at, size, 0, kTop); sorted != a + at) {
+        std::copy(sorted, sorted + size, a + at);
+      }
+    }
+  });
   return a;
 }
 

@@ -26,7 +26,14 @@ std::vector<MeshData> varied_meshes() {
   meshes.push_back(in_closed_room(uv_sphere(30, 30), 0.5f));
   meshes.push_back(slivers(3000, 7));
   meshes.push_back(triangle_soup(5, 0.3f, 9));  // one leaf: no wide node at all
-  MeshData same;                                // 100,000 copies of one triangle: every code equal, tasks of 12,500
+  // 200,000 triangles in the unit cube and one far off: the cluster shares the codes' top 8
+  // bits, one sort bucket too large for the in-cache sort (the parallel radix sort's path).
+  MeshData crowded = triangle_soup(200000, 0.01f, 5);
+  const uint32_t far = uint32_t(crowded.vertices.size());
+  for (float d : {0.0f, 0.1f, 0.2f}) crowded.vertices.push_back({10.0f + d, 10.0f, 10.0f + 2 * d});
+  crowded.triangles.push_back({far, far + 1, far + 2});
+  meshes.push_back(crowded);
+  MeshData same;  // 100,000 copies of one triangle: every code equal, tasks of 12,500
   same.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   same.triangles.assign(100000, Triangle(0, 1, 2));
   meshes.push_back(same);
