@@ -124,6 +124,24 @@ struct WideSlabTest {
   if (n.count[i] == 0) __builtin_prefetch(&bvh.nodes[n.child[i]]);
 }
 
+// The closest-hit walk's caller may also start fetching a leaf's primitives as soon as the leaf
+// is entered or stacked (prefetch_leaf(first, count)): a mesh's triangle blocks missed the cache
+// on most leaves of a large mesh. Diffuse rays at 1M triangles on a first-generation EPYC: 5-6 %
+// faster; 1 % when only the stacked leaves were fetched (all of a block's lines requested at
+// once beat the block test's own loads). The any-hit walk measured no gain. Callers without
+// one get this.
+struct NoLeafPrefetch {
+  void operator()(uint32_t, uint32_t) const {}
+};
+template <class PrefetchLeaf>
+[[gnu::always_inline]] inline void prefetch_child(const WideBvh& bvh, const WideNode& n, int i,
+                                                  PrefetchLeaf& prefetch_leaf) {
+  if (n.count[i] == 0)
+    __builtin_prefetch(&bvh.nodes[n.child[i]]);
+  else
+    prefetch_leaf(n.child[i], n.count[i]);
+}
+
 #if defined(__AVX2__)
 // For each set of slots (a bit mask), the slots from the highest to the lowest, three bits each
 // (the rest of the word: slot 0, filler): the order in which the any-hit walk stacks them, so that
@@ -223,9 +241,9 @@ template <class LeafFn>
 
 // The closest-hit walk: the children entered visited nearest first, the others stacked with
 // their entry distance and skipped when they pop beyond the nearest hit found by then.
-template <class LeafFn>
+template <class LeafFn, class PrefetchLeaf = NoLeafPrefetch>
 [[gnu::always_inline]] inline bool closest_hit_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear, float& tfar,
-                                                    LeafFn&& leaf) {
+                                                    LeafFn&& leaf, PrefetchLeaf&& prefetch_leaf = {}) {
   using namespace simd;
   if (bvh.nodes.empty()) return bvh.root_leaf_count && leaf(bvh.root_leaf_first, bvh.root_leaf_count, tfar);
   const WideSlabTest slab(ray, tnear);
@@ -249,6 +267,7 @@ template <class LeafFn>
         const uint32_t rest = mask & (mask - 1);
         if (rest == 0) {
           current = Entry{n.child[first], n.count[first], tmin[first]};
+          if (current.count != 0) prefetch_leaf(current.child, current.count);
           continue;
         }
         if ((rest & (rest - 1)) == 0) {
@@ -259,8 +278,9 @@ template <class LeafFn>
           const bool swapped = tmin[second] < tmin[first];
           const int near = swapped ? second : first, far = swapped ? first : second;
           stack[sp++] = Entry{n.child[far], n.count[far], tmin[far]};
-          prefetch_child(bvh, n, far);
+          prefetch_child(bvh, n, far, prefetch_leaf);
           current = Entry{n.child[near], n.count[near], tmin[near]};
+          if (current.count != 0) prefetch_leaf(current.child, current.count);
           continue;
         }
         // Three or more: sorted by entry distance, ties in slot order (a stable sort), as
@@ -285,10 +305,11 @@ template <class LeafFn>
           const int i = int(keys[k] & (kWidth - 1));
           stack[sp++] = Entry{n.child[i], n.count[i], tmin[i]};
           // Start fetching the stacked subtrees now: traversal is bound by memory latency.
-          prefetch_child(bvh, n, i);
+          prefetch_child(bvh, n, i, prefetch_leaf);
         }
         const int i = int(keys[0] & (kWidth - 1));
         current = Entry{n.child[i], n.count[i], tmin[i]};
+        if (current.count != 0) prefetch_leaf(current.child, current.count);
         continue;
       }
     } else if (leaf(current.child, current.count, tfar)) {
@@ -304,13 +325,13 @@ template <class LeafFn>
 }
 
 // Both walks behind one name: AnyHit stops at the first hit (occlusion), else the nearest.
-template <bool AnyHit, class LeafFn>
+template <bool AnyHit, class LeafFn, class PrefetchLeaf = NoLeafPrefetch>
 [[gnu::always_inline]] inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear, float& tfar,
-                                                 LeafFn&& leaf) {
+                                                 LeafFn&& leaf, PrefetchLeaf&& prefetch_leaf = {}) {
   if constexpr (AnyHit)
     return any_hit_wide(bvh, ray, tnear, tfar, leaf);
   else
-    return closest_hit_wide(bvh, ray, tnear, tfar, leaf);
+    return closest_hit_wide(bvh, ray, tnear, tfar, leaf, prefetch_leaf);
 }
 
 }  // namespace toyrt

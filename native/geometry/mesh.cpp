@@ -162,6 +162,9 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
       }
     }
   });
+  // Blocks beyond the caches are fetched ahead by the closest-hit walk; where they fit, the
+  // prefetches were pure cost (1-3 % slower at 10K and 100K triangles, 3-8 % faster at 1M).
+  prefetch_blocks_ = blocks_.size() * sizeof(TriangleBlock) > kPrefetchBlockBytes;
   built_ = true;
 }
 
@@ -181,7 +184,8 @@ bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, flo
   uint32_t found_block = 0;
   int found_lane = 0;
   const bool found = traverse_wide<AnyHit>(
-      wide_, box_ray, tnear, tfar, [&](uint32_t first, uint32_t count, float& t_max) __attribute__((always_inline)) {
+      wide_, box_ray, tnear, tfar,
+      [&](uint32_t first, uint32_t count, float& t_max) __attribute__((always_inline)) {
         bool hit = false;
         const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
         for (uint32_t k = first; k < end; ++k) {
@@ -195,6 +199,12 @@ bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, flo
           if (AnyHit && hit) return true;
         }
         return hit;
+      },
+      [ blocks, prefetch = prefetch_blocks_ ](uint32_t first, uint32_t) __attribute__((always_inline)) {
+        // The leaf's first block, its five cache lines (most leaves are one block).
+        if (!prefetch) return;
+        const char* b = reinterpret_cast<const char*>(blocks + first);
+        for (size_t line = 0; line < sizeof(TriangleBlock); line += 64) __builtin_prefetch(b + line);
       });
   if constexpr (!AnyHit) {
     if (found) {
