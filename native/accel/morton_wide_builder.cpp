@@ -79,8 +79,8 @@ Key* sort_by_bits(Key* a, Key* b, size_t n, uint32_t low, uint32_t high) {
 // The bits below the top digit of a bucket's n keys, sorted in cache on one thread, from `in`
 // into `out` (both overwritten). Two passes of 11 bits where the bucket is large enough to fill
 // their 2048 counters, three of 8 bits otherwise (a few thousand keys: the counters' upkeep would
-// outweigh the pass saved); all passes' digits counted in one read. The top pass's digit also
-// holds bits of the top digit, the same for every key of a bucket.
+// outweigh the pass saved); all passes' digits counted in one read. Three 8-bit passes reach bits
+// 22-23, which belong to the top digit and are the same for every key of a bucket.
 template <int kPasses>
 void sort_bucket_by(Key* in, Key* out, size_t n) {
   constexpr uint32_t kDigitBits = kPasses == 2 ? 11 : 8, kDigits = 1u << kDigitBits;
@@ -116,8 +116,10 @@ void sort_bucket(Key* in, Key* out, size_t n) {
 // too large for that (geometry crowded into one 256th of the frame) takes the parallel LSD sort.
 // Returns the array holding the result (a or b).
 Key* sort_by_code(Key* a, Key* b, size_t n) {
-  constexpr uint32_t kTop = kCodeBits - 8;          // the top digit's lowest bit
-  constexpr size_t kLargeBucket = size_t(1) << 17;  // 1 MB of keys: about what the L2 cache holds
+  constexpr uint32_t kTop = kCodeBits - 8;  // the top digit's lowest bit
+  // 1 MB of keys (2 MB with the buffer sorted into): a few times a core's L2 cache, well inside
+  // the last level; the largest bucket of the 1M sphere holds 31,343 keys.
+  constexpr size_t kLargeBucket = size_t(1) << 17;
   const size_t chunks = (n + kGrain - 1) / kGrain;
   std::vector<uint32_t> first(chunks * 256);
   tbb::parallel_for(size_t(0), chunks, [&](size_t c) {

@@ -125,6 +125,7 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
     first_block[i] = block_count;
     for (int k = 0; k < kWidth; ++k) block_count += blocks_of(wide_.nodes[i].count[k]);
   }
+  prefetch_blocks_ = false;  // until the blocks are made
   blocks_.clear();
   blocks_.shrink_to_fit();
   blocks_.resize(block_count);  // exactly, and not zeroed (HugePageAllocator): every field is written below

@@ -65,7 +65,7 @@ class Mesh {
   std::vector<Triangle> triangles_;
   WideBvh wide_;  // the builder's tree in the traced layout
   // The leaves' triangles in blocks of eight, in traversal order: a wide leaf child's `child`
-  // is its first block, its `count` the number of triangles (blocks = count rounded up to 4).
+  // is its first block, its `count` the number of triangles (blocks: count / kBlockWidth rounded up).
   std::vector<TriangleBlock, HugePageAllocator<TriangleBlock>> blocks_;  // huge pages: read at random
   BBox bounds_;
   bool built_ = false;

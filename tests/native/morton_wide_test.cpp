@@ -27,12 +27,18 @@ std::vector<MeshData> varied_meshes() {
   meshes.push_back(slivers(3000, 7));
   meshes.push_back(triangle_soup(5, 0.3f, 9));  // one leaf: no wide node at all
   // 200,000 triangles in the unit cube and one far off: the cluster shares the codes' top 8
-  // bits, one sort bucket too large for the in-cache sort (the parallel radix sort's path).
-  MeshData crowded = triangle_soup(200000, 0.01f, 5);
-  const uint32_t far = uint32_t(crowded.vertices.size());
-  for (float d : {0.0f, 0.1f, 0.2f}) crowded.vertices.push_back({10.0f + d, 10.0f, 10.0f + 2 * d});
-  crowded.triangles.push_back({far, far + 1, far + 2});
-  meshes.push_back(crowded);
+  // bits, one sort bucket too large for the in-cache sort (the parallel radix sort's path). At
+  // 10 units the cluster's codes differ in all three of that sort's 8-bit digits; at 100 in the
+  // lower two only, so one pass is skipped and the result is copied from the other buffer.
+  for (const float distance : {10.0f, 100.0f}) {
+    MeshData crowded = triangle_soup(200000, 0.01f, 5);
+    const uint32_t far = uint32_t(crowded.vertices.size());
+    crowded.vertices.push_back(Vec3(distance));
+    crowded.vertices.push_back(Vec3(distance + 1.0f, distance, distance));
+    crowded.vertices.push_back(Vec3(distance, distance + 1.0f, distance + 0.5f));
+    crowded.triangles.push_back({far, far + 1, far + 2});
+    meshes.push_back(crowded);
+  }
   MeshData same;  // 100,000 copies of one triangle: every code equal, tasks of 12,500
   same.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   same.triangles.assign(100000, Triangle(0, 1, 2));
