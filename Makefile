@@ -267,6 +267,10 @@ FUZZ_SECONDS ?= 60
 FUZZ_SEED    ?= 1
 SAN_BUILD    ?= $(BUILD)-asan
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+# -O1 and line tables only (-g1: file and line in every report, no variables): the build is the
+# stage's largest part, and this compiles in 421 s what -O2 -g did in 735 s on a first-generation
+# EPYC, the tests then taking 381 s instead of 344 s.
+SANITIZE_OPT   := -O1 -g1 -DNDEBUG
 # UBSan stops at the first finding; Python's interpreter keeps memory until exit, so leak checks are
 # for the C++ tests only.
 SAN_ENV := UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
@@ -301,6 +305,7 @@ test-levels: apt
 
 sanitize: apt venv
 	@[ -f $(SAN_BUILD)/CMakeCache.txt ] || cmake -S . -B $(SAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+		-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="$(SANITIZE_OPT)" \
 		-DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
 		-DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DTOYRT_BUILD_BENCH=OFF $(CMAKE_ARGS) \
 		|| { rm -f $(SAN_BUILD)/CMakeCache.txt; exit 1; }
