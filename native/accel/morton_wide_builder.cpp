@@ -39,40 +39,45 @@ using Key = uint64_t;
 uint32_t code_of(Key k) { return uint32_t(k >> 32); }
 uint32_t prim_of(Key k) { return uint32_t(k); }
 
-// Stable least-significant-digit radix sort of n keys by the code's bits [low, high), 8 bits a
-// pass, over fixed chunks: each chunk counts its digits, one scan gives every (digit, chunk) its
-// first slot, and each chunk scatters in order. A pass whose digit is the same for every key is
-// skipped. Returns the array holding the result (a or b).
-Key* sort_by_bits(Key* a, Key* b, size_t n, uint32_t low, uint32_t high) {
+// One stable pass over n keys by their 8-bit digit at `shift`, from `from` into `to`, over fixed
+// chunks: each chunk counts its digits, one scan gives every (digit, chunk) its first slot, and each
+// chunk scatters in order. Writes each digit's first slot to start[0..255] and n to start[256].
+// With skip_one_digit, a pass whose digit is the same for every key scatters nothing and returns
+// false (the keys stay in `from`).
+bool scatter_by_digit(const Key* from, Key* to, size_t n, uint32_t shift, bool skip_one_digit, uint32_t start[257]) {
   const size_t chunks = (n + kGrain - 1) / kGrain;
   std::vector<uint32_t> first(chunks * 256);
-  for (uint32_t shift = 32 + low; shift < 32 + high; shift += 8) {
-    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-      uint32_t* count = &first[c * 256];
-      std::fill(count, count + 256, 0u);
-      const size_t end = std::min(n, (c + 1) * kGrain);
-      for (size_t i = c * kGrain; i < end; ++i) ++count[(a[i] >> shift) & 255u];
-    });
-    uint32_t sum = 0;
-    bool one_digit = false;
-    for (uint32_t d = 0; d < 256; ++d) {
-      const uint32_t digit_start = sum;
-      for (size_t c = 0; c < chunks; ++c) {
-        const uint32_t count = first[c * 256 + d];
-        first[c * 256 + d] = sum;
-        sum += count;
-      }
-      one_digit |= sum - digit_start == n;
-    }
-    if (one_digit) continue;
-    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-      uint32_t next[256];
-      std::copy(&first[c * 256], &first[c * 256] + 256, next);
-      const size_t end = std::min(n, (c + 1) * kGrain);
-      for (size_t i = c * kGrain; i < end; ++i) b[next[(a[i] >> shift) & 255u]++] = a[i];
-    });
-    std::swap(a, b);
+  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    uint32_t* count = &first[c * 256];
+    std::fill(count, count + 256, 0u);
+    const size_t end = std::min(n, (c + 1) * kGrain);
+    for (size_t i = c * kGrain; i < end; ++i) ++count[(from[i] >> shift) & 255u];
+  });
+  uint32_t sum = 0;
+  bool one_digit = false;
+  for (uint32_t d = 0; d < 256; ++d) {
+    start[d] = sum;
+    for (size_t c = 0; c < chunks; ++c) sum += std::exchange(first[c * 256 + d], sum);
+    one_digit |= sum - start[d] == n;
   }
+  start[256] = sum;
+  if (skip_one_digit && one_digit) return false;
+  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    uint32_t next[256];
+    std::copy(&first[c * 256], &first[c * 256] + 256, next);
+    const size_t end = std::min(n, (c + 1) * kGrain);
+    for (size_t i = c * kGrain; i < end; ++i) to[next[(from[i] >> shift) & 255u]++] = from[i];
+  });
+  return true;
+}
+
+// Stable least-significant-digit radix sort of n keys by the code's bits [low, high), 8 bits a
+// pass; a pass whose digit is the same for every key is skipped. Returns the array holding the
+// result (a or b).
+Key* sort_by_bits(Key* a, Key* b, size_t n, uint32_t low, uint32_t high) {
+  uint32_t start[257];
+  for (uint32_t shift = 32 + low; shift < 32 + high; shift += 8)
+    if (scatter_by_digit(a, b, n, shift, true, start)) std::swap(a, b);
   return a;
 }
 
@@ -120,27 +125,8 @@ Key* sort_by_code(Key* a, Key* b, size_t n) {
   // 1 MB of keys (2 MB with the buffer sorted into): a few times a core's L2 cache, well inside
   // the last level; the largest bucket of the 1M sphere holds 31,343 keys.
   constexpr size_t kLargeBucket = size_t(1) << 17;
-  const size_t chunks = (n + kGrain - 1) / kGrain;
-  std::vector<uint32_t> first(chunks * 256);
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-    uint32_t* count = &first[c * 256];
-    std::fill(count, count + 256, 0u);
-    const size_t end = std::min(n, (c + 1) * kGrain);
-    for (size_t i = c * kGrain; i < end; ++i) ++count[(a[i] >> (32 + kTop)) & 255u];
-  });
   uint32_t bucket[257];
-  uint32_t sum = 0;
-  for (uint32_t d = 0; d < 256; ++d) {
-    bucket[d] = sum;
-    for (size_t c = 0; c < chunks; ++c) sum += std::exchange(first[c * 256 + d], sum);
-  }
-  bucket[256] = sum;
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-    uint32_t next[256];
-    std::copy(&first[c * 256], &first[c * 256] + 256, next);
-    const size_t end = std::min(n, (c + 1) * kGrain);
-    for (size_t i = c * kGrain; i < end; ++i) b[next[(a[i] >> (32 + kTop)) & 255u]++] = a[i];
-  });
+  scatter_by_digit(a, b, n, 32 + kTop, false, bucket);  // every key in b, by its top digit
   tbb::parallel_for(tbb::blocked_range<uint32_t>(0, 256, 1), [&](const tbb::blocked_range<uint32_t>& r) {
     for (uint32_t d = r.begin(); d != r.end(); ++d) {
       const size_t at = bucket[d], size = bucket[d + 1] - at;
