@@ -23,12 +23,13 @@
 
 namespace toyrt {
 
+// Swaps of neighbouring bits, pairs and nibbles, then the byte order (one bswap for the swaps of
+// bytes and halves).
 inline uint32_t reverse_bits(uint32_t x) {
   x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
   x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
   x = ((x >> 4) & 0x0F0F0F0Fu) | ((x & 0x0F0F0F0Fu) << 4);
-  x = ((x >> 8) & 0x00FF00FFu) | ((x & 0x00FF00FFu) << 8);
-  return (x >> 16) | (x << 16);
+  return __builtin_bswap32(x);
 }
 
 // Laine and Karras's hash-based permutation, with the constants Burley's paper gives: adding the
@@ -49,24 +50,33 @@ inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
   return reverse_bits(laine_karras_permutation(reverse_bits(x), seed));
 }
 
-// Sobol dimension 0 (van der Corput in base 2) and dimension 1 (primitive polynomial x + 1,
-// direction numbers v_0 = 1/2, v_k = v_{k-1} ^ (v_{k-1} >> 1), i.e. Pascal's triangle mod 2), as
-// 32-bit fractions.
-inline uint32_t sobol_dimension0(uint32_t index) { return reverse_bits(index); }
-inline uint32_t sobol_dimension1(uint32_t index) {
-  uint32_t result = 0;
-  for (uint32_t v = 1u << 31; index != 0; index >>= 1, v ^= v >> 1)
-    if (index & 1u) result ^= v;
-  return result;
+// Sobol dimension 1 (primitive polynomial x + 1, direction numbers v_0 = 1/2,
+// v_k = v_{k-1} ^ (v_{k-1} >> 1), i.e. Pascal's triangle mod 2), bit-reversed: bit i is the sum
+// over the index's bits j of C(j, i) mod 2. As polynomials over GF(2) (bit i the coefficient of
+// z^i) that is X(1 + z), composed block by block: in each block of 2s bits, whose halves are
+// already done, (1 + z)^s = 1 + z^s adds the upper half into the lower one; s = 1, 2, 4, 8, 16.
+// Five shifts where summing the direction numbers took a step, and a branch, for every bit.
+inline uint32_t sobol_dimension1_reversed(uint32_t index) {
+  index ^= (index >> 1) & 0x55555555u;
+  index ^= (index >> 2) & 0x33333333u;
+  index ^= (index >> 4) & 0x0F0F0F0Fu;
+  index ^= (index >> 8) & 0x00FF00FFu;
+  index ^= (index >> 16) & 0x0000FFFFu;
+  return index;
 }
 
+// Sobol dimension 0 (van der Corput in base 2) and dimension 1, as 32-bit fractions.
+inline uint32_t sobol_dimension0(uint32_t index) { return reverse_bits(index); }
+inline uint32_t sobol_dimension1(uint32_t index) { return reverse_bits(sobol_dimension1_reversed(index)); }
+
 // Sample `sample` of pixel `pixel` in the 2D dimension `dimension` (0: position in the pixel, then
-// one per 2D decision), a point of [0, 1)^2.
+// one per 2D decision), a point of [0, 1)^2: nested_uniform_scramble(sobol_dimensionK(index), ...),
+// written without the two bit reversals that cancel (the scramble reverses its input first).
 inline Vec2 sobol_owen_2d(uint32_t pixel, uint32_t sample, uint32_t dimension, uint32_t seed) {
   const uint32_t key = hash_keys(pixel, dimension, seed, 0x736f626cu);
   const uint32_t index = nested_uniform_scramble(sample, key);
-  const uint32_t x = nested_uniform_scramble(sobol_dimension0(index), pcg_hash(key ^ 0x1u));
-  const uint32_t y = nested_uniform_scramble(sobol_dimension1(index), pcg_hash(key ^ 0x2u));
+  const uint32_t x = reverse_bits(laine_karras_permutation(index, pcg_hash(key ^ 0x1u)));
+  const uint32_t y = reverse_bits(laine_karras_permutation(sobol_dimension1_reversed(index), pcg_hash(key ^ 0x2u)));
   return {bits_to_unit_float(x), bits_to_unit_float(y)};
 }
 
@@ -74,7 +84,7 @@ inline Vec2 sobol_owen_2d(uint32_t pixel, uint32_t sample, uint32_t dimension, u
 inline float sobol_owen_1d(uint32_t pixel, uint32_t sample, uint32_t dimension, uint32_t seed) {
   const uint32_t key = hash_keys(pixel, dimension, seed, 0x31646f77u);
   const uint32_t index = nested_uniform_scramble(sample, key);
-  return bits_to_unit_float(nested_uniform_scramble(sobol_dimension0(index), pcg_hash(key ^ 0x3u)));
+  return bits_to_unit_float(reverse_bits(laine_karras_permutation(index, pcg_hash(key ^ 0x3u))));
 }
 
 }  // namespace toyrt

@@ -136,6 +136,36 @@ TEST(SamplingRng, ConsecutiveDimensionsAndPixelsAreIndependent) {
   expect_fits(pixels, probabilities, kN, "pairs of neighbouring pixels");
 }
 
+TEST(SamplingSobolOwen, FastFormsEqualTheirDefinitions) {
+  // The definitions, one bit at a time: the reversal, and dimension 1 as the sum of the direction
+  // numbers v_0 = 1/2, v_k = v_{k-1} ^ (v_{k-1} >> 1) of the index's set bits.
+  auto reversed = [](uint32_t x) {
+    uint32_t r = 0;
+    for (int i = 0; i < 32; ++i) r |= (x >> i & 1u) << (31 - i);
+    return r;
+  };
+  auto dimension1 = [](uint32_t index) {
+    uint32_t result = 0;
+    for (uint32_t v = 1u << 31; index != 0; index >>= 1, v ^= v >> 1)
+      if (index & 1u) result ^= v;
+    return result;
+  };
+  std::vector<uint32_t> xs;
+  for (uint32_t i = 0; i < (1u << 16); ++i) xs.push_back(i);
+  for (uint32_t i = 0; i < 100000; ++i) xs.push_back(pcg_hash(i));
+  for (int bit = 0; bit < 32; ++bit) xs.push_back(1u << bit), xs.push_back(~0u >> bit);
+  for (size_t k = 0; k < xs.size(); ++k) {
+    const uint32_t x = xs[k], seed = pcg_hash(uint32_t(k) ^ 0x9e3779b9u);
+    ASSERT_EQ(reverse_bits(x), reversed(x)) << x;
+    ASSERT_EQ(sobol_dimension1(x), dimension1(x)) << x;
+    ASSERT_EQ(sobol_dimension1_reversed(x), reversed(dimension1(x))) << x;
+    // sobol_owen_2d and _1d skip the two reversals that cancel in this composition.
+    ASSERT_EQ(nested_uniform_scramble(sobol_dimension0(x), seed), reverse_bits(laine_karras_permutation(x, seed)));
+    ASSERT_EQ(nested_uniform_scramble(sobol_dimension1(x), seed),
+              reverse_bits(laine_karras_permutation(sobol_dimension1_reversed(x), seed)));
+  }
+}
+
 TEST(SamplingSobolOwen, EveryPowerOfTwoOfSamplesIsANet) {
   // For N = 2^m samples of one pixel, each elementary box 2^-a x 2^-(m-a) holds exactly one
   // point, for every a: stratified in all aspect ratios, including the N^(1/2) x N^(1/2) grid.
