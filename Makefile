@@ -269,7 +269,8 @@ SAN_BUILD    ?= $(BUILD)-asan
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 # -O1 and line tables only (-g1: file and line in every report, no variables): the build is the
 # stage's largest part, and this compiles in 421 s what -O2 -g did in 735 s on a first-generation
-# EPYC, the tests then taking 381 s instead of 344 s.
+# EPYC, the tests then taking 381 s instead of 344 s. (A build-asan/ configured before keeps its
+# flags: `make clean` first.)
 SANITIZE_OPT   := -O1 -g1 -DNDEBUG
 # UBSan stops at the first finding; Python's interpreter keeps memory until exit, so leak checks are
 # for the C++ tests only.

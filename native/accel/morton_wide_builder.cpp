@@ -42,8 +42,8 @@ uint32_t prim_of(Key k) { return uint32_t(k); }
 // One stable pass over n keys by their 8-bit digit at `shift`, from `from` into `to`, over fixed
 // chunks: each chunk counts its digits, one scan gives every (digit, chunk) its first slot, and each
 // chunk scatters in order. Writes each digit's first slot to start[0..255] and n to start[256].
-// With skip_one_digit, a pass whose digit is the same for every key scatters nothing and returns
-// false (the keys stay in `from`).
+// Returns whether it scattered: always, unless skip_one_digit and the digit is the same for every
+// key (the keys then stay in `from`).
 bool scatter_by_digit(const Key* from, Key* to, size_t n, uint32_t shift, bool skip_one_digit, uint32_t start[257]) {
   const size_t chunks = (n + kGrain - 1) / kGrain;
   std::vector<uint32_t> first(chunks * 256);

@@ -52,10 +52,10 @@ inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
 
 // Sobol dimension 1 (primitive polynomial x + 1, direction numbers v_0 = 1/2,
 // v_k = v_{k-1} ^ (v_{k-1} >> 1), i.e. Pascal's triangle mod 2), bit-reversed: bit i is the sum
-// over the index's bits j of C(j, i) mod 2. As polynomials over GF(2) (bit i the coefficient of
-// z^i) that is X(1 + z), composed block by block: in each block of 2s bits, whose halves are
-// already done, (1 + z)^s = 1 + z^s adds the upper half into the lower one; s = 1, 2, 4, 8, 16.
-// Five shifts where summing the direction numbers took a step, and a branch, for every bit.
+// over the index's set bits j of C(j, i) mod 2. As polynomials over GF(2) (bit i the coefficient
+// of z^i) that is X(1 + z), X composed with 1 + z (not multiplied by it), block by block: in each block of 2s bits,
+// whose halves are already done, (1 + z)^s = 1 + z^s adds the upper half into the lower one; s = 1, 2, 4, 8, 16. Five
+// shifts where summing the direction numbers took a step, and a branch, for every bit.
 inline uint32_t sobol_dimension1_reversed(uint32_t index) {
   index ^= (index >> 1) & 0x55555555u;
   index ^= (index >> 2) & 0x33333333u;
@@ -65,7 +65,8 @@ inline uint32_t sobol_dimension1_reversed(uint32_t index) {
   return index;
 }
 
-// Sobol dimension 0 (van der Corput in base 2) and dimension 1, as 32-bit fractions.
+// Sobol dimension 0 (van der Corput in base 2) and dimension 1, as 32-bit fractions (what the
+// samplers below compute, without the reversals that cancel; tests/native/sampling_test.cpp).
 inline uint32_t sobol_dimension0(uint32_t index) { return reverse_bits(index); }
 inline uint32_t sobol_dimension1(uint32_t index) { return reverse_bits(sobol_dimension1_reversed(index)); }
 
