@@ -53,9 +53,10 @@ inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
 // Sobol dimension 1 (primitive polynomial x + 1, direction numbers v_0 = 1/2,
 // v_k = v_{k-1} ^ (v_{k-1} >> 1), i.e. Pascal's triangle mod 2), bit-reversed: bit i is the sum
 // over the index's set bits j of C(j, i) mod 2. As polynomials over GF(2) (bit i the coefficient
-// of z^i) that is X(1 + z), X composed with 1 + z (not multiplied by it), block by block: in each block of 2s bits,
-// whose halves are already done, (1 + z)^s = 1 + z^s adds the upper half into the lower one; s = 1, 2, 4, 8, 16. Five
-// shifts where summing the direction numbers took a step, and a branch, for every bit.
+// of z^i) that is X(1 + z), X composed with 1 + z (not multiplied by it), block by block: in each
+// block of 2s bits, whose halves are already done, (1 + z)^s = 1 + z^s adds the upper half into
+// the lower one; s = 1, 2, 4, 8, 16. Five shifts where summing the direction numbers took a step,
+// and a branch, for every bit.
 inline uint32_t sobol_dimension1_reversed(uint32_t index) {
   index ^= (index >> 1) & 0x55555555u;
   index ^= (index >> 2) & 0x33333333u;
