@@ -14,6 +14,9 @@
 //   trace_only lbvh-all [rings] [repeats]     the whole LBVH commit on every core against Embree's
 //                                             Morton build (LOW quality, dynamic scene), interleaved,
 //                                             wall-clock medians, with the LBVH's stage times
+//   trace_only sah-all [rings] [repeats] [soup]   the whole SAH commit against Embree's default
+//                                             build, both on every core (TOYRT_THREADS=N: on N
+//                                             threads, as bench_trace's rows), interleaved, wall ms
 //   trace_only wide [rings]   the 8-wide layout of the SAH and LBVH trees, collapsed greedily and
 //                             by the SAH dynamic programme: children a node, SAH cost, collapse ms
 #include "accel/binned_sah_builder.h"
@@ -44,7 +47,9 @@ int main(int argc, char** argv) {
   // `rings` x 1000 triangles instead of the sphere.
   const bool soup = argc > 4 && std::string(argv[4]) == "soup";
   const MeshData mesh = soup ? triangle_soup(size_t(rings) * 1000, 0.02f, 1) : uv_sphere(rings, rings, 1.0f, 0.15f);
-  if (kind == "lbvh-all") {
+  if (kind == "lbvh-all" || kind == "sah-all") {
+    const bool sah = kind == "sah-all";
+    const int threads = sah && std::getenv("TOYRT_THREADS") ? std::atoi(std::getenv("TOYRT_THREADS")) : 0;
     auto wall_ms = [] {
       timespec ts;
       clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -55,19 +60,22 @@ int main(int argc, char** argv) {
       Scene s;
       s.add_instance(s.add_mesh(mesh.vertices, mesh.triangles), Mat4(1.0f));
       CommitOptions options;
-      options.builder = BuilderKind::Lbvh;
+      options.builder = sah ? BuilderKind::Sah : BuilderKind::Lbvh;
+      options.threads = threads;
       double start = wall_ms();
       s.commit(options);
       if (k) mine.push_back(wall_ms() - start);
       if (!s.commit_stats().warning.empty()) std::fprintf(stderr, "%s\n", s.commit_stats().warning.c_str());
       start = wall_ms();
-      { EmbreeScene e(mesh.vertices, mesh.triangles, false, 0, true); }
+      { EmbreeScene e(mesh.vertices, mesh.triangles, false, threads, !sah); }
       if (k) theirs.push_back(wall_ms() - start);
     }
     std::sort(mine.begin(), mine.end());
     std::sort(theirs.begin(), theirs.end());
-    std::printf("lbvh-all: %zu triangles, LBVH commit median %.1f ms, Embree Morton %.1f ms wall (%d runs)\n",
-                mesh.triangles.size(), mine[mine.size() / 2], theirs[theirs.size() / 2], repeats);
+    std::printf("%s: %zu triangles, %s commit median %.1f ms, Embree %s %.1f ms wall (%d runs)\n", kind.c_str(),
+                mesh.triangles.size(), sah ? "SAH" : "LBVH", mine[mine.size() / 2], sah ? "default" : "Morton",
+                theirs[theirs.size() / 2], repeats);
+    if (sah) return 0;
     // The stages of the kernels' build collapsed in place (build_lbvh_wide: what a commit runs on
     // an OpenCL GPU; on a CPU device the commit above builds on the host): medians of as many
     // builds as commits above.

@@ -9,8 +9,11 @@
 // The large arrays are mapped and unmapped directly (mmap/munmap), not taken from malloc: glibc
 // serves a freed mmap-sized block's successors from its heap (its mmap threshold rises to the
 // freed size), where freed huge pages stay resident; a 100-frame animation that rebuilt one
-// 10 MB mesh per frame grew by 60 MB that way (tests/blender/test_animation_memory.py).
+// 10 MB mesh per frame grew by 60 MB that way (tests/blender/test_animation_memory.py). A freed
+// mapping goes to huge_page_pool.h, which keeps a bounded few for the next commit's arrays.
 #pragma once
+
+#include "core/huge_page_pool.h"
 
 #include <cstddef>
 #include <cstdlib>
@@ -44,6 +47,8 @@ struct HugePageAllocator {
     if (!is_large(n)) return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(alignof(T))));
     const size_t bytes = rounded_bytes(n);
 #if defined(__linux__)
+    // A mapping the last commits released (already faulted in and marked), else a new one.
+    if (void* kept = huge_page_pool::take(bytes)) return static_cast<T*>(kept);
     // Map one huge page more than needed and unmap the unaligned head and the tail beyond.
     void* raw = mmap(nullptr, bytes + kHugePageBytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (raw == MAP_FAILED) throw std::bad_alloc();
@@ -64,13 +69,14 @@ struct HugePageAllocator {
   }
 
   void deallocate(T* p, size_t n) noexcept {
-    if (!is_large(n))
+    if (!is_large(n)) {
       ::operator delete(p, std::align_val_t(alignof(T)));
-    else
+      return;
+    }
 #if defined(__linux__)
-      munmap(p, rounded_bytes(n));
+    if (!huge_page_pool::keep(p, rounded_bytes(n))) munmap(p, rounded_bytes(n));
 #else
-      std::free(p);
+    std::free(p);
 #endif
   }
 

@@ -1,0 +1,35 @@
+// Huge-page mappings released by one commit, kept for the next. A commit's traced arrays (the
+// triangle blocks and the wide nodes: 55 MB at a million triangles) are mapped fresh
+// (huge_page_allocator.h), and the kernel zeroes every page on first touch: 16 % of the CPU time
+// of a 1M-triangle LBVH commit went to that zeroing. Rebuilding a scene (an animation's frames,
+// the viewport's edits, a benchmark's repeats) frees arrays of the same sizes as it makes, so the
+// mappings freed are kept here, up to a bound, and the next allocation that fits takes one,
+// already faulted in and backed by huge pages. What glibc does for smaller blocks (its heap keeps
+// freed memory), but bounded: kPoolBytes at most stay mapped once every scene is gone (glibc's
+// heap had grown without bound here; huge_page_allocator.h).
+#pragma once
+
+#include <cstddef>
+
+namespace toyrt::huge_page_pool {
+
+// At most this many bytes, in at most kPoolSlots mappings, are kept.
+inline constexpr size_t kPoolBytes = size_t(256) << 20;
+inline constexpr int kPoolSlots = 8;
+
+// A kept mapping of at least `bytes` (a multiple of the huge page), cut to exactly `bytes` (the
+// tail beyond is unmapped), or nullptr. The smallest that fits, so a small array does not take a
+// large one's mapping while that one's owner is about to come back for it.
+void* take(size_t bytes) noexcept;
+
+// Keeps the mapping [p, p + bytes) for a later take(); the oldest kept ones are unmapped to stay
+// within the bounds. False (the caller unmaps it) for a mapping over kPoolBytes.
+bool keep(void* p, size_t bytes) noexcept;
+
+// Bytes kept now (for tests and memory reports).
+size_t kept_bytes() noexcept;
+
+// Unmaps everything kept.
+void release() noexcept;
+
+}  // namespace toyrt::huge_page_pool

@@ -1,0 +1,81 @@
+// The pool of released huge-page mappings (native/core/huge_page_pool.h): what it hands back, and
+// its bounds.
+#include "core/huge_page_pool.h"
+#include "core/huge_page_allocator.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+namespace toyrt {
+namespace {
+
+using Bytes = std::vector<uint8_t, HugePageAllocator<uint8_t>>;
+constexpr size_t kMB = size_t(1) << 20;
+
+#if defined(__linux__)
+TEST(HugePagePool, AFreedArrayIsTheNextOfItsSize) {
+  huge_page_pool::release();
+  const uint8_t* first;
+  {
+    Bytes a(10 * kMB);
+    std::memset(a.data(), 7, a.size());
+    first = a.data();
+  }
+  EXPECT_EQ(huge_page_pool::kept_bytes(), 10 * kMB);  // 10 MB: five huge pages exactly
+  Bytes b(9 * kMB + 1);                               // rounds up to the same five huge pages
+  EXPECT_EQ(b.data(), first);
+  EXPECT_EQ(huge_page_pool::kept_bytes(), 0u);
+  // Usable whole: written and read back at both ends.
+  b.front() = 1, b.back() = 2;
+  EXPECT_EQ(b.front() + b.back(), 3);
+}
+
+TEST(HugePagePool, TheSmallestFittingMappingIsTakenAndCut) {
+  huge_page_pool::release();
+  const uint8_t *small_one, *large_one;
+  {
+    Bytes small(4 * kMB), large(20 * kMB);
+    small_one = small.data(), large_one = large.data();
+  }
+  EXPECT_EQ(huge_page_pool::kept_bytes(), 24 * kMB);
+  Bytes c(3 * kMB);  // 4 MB: the small mapping, not the large
+  EXPECT_EQ(c.data(), small_one);
+  Bytes d(6 * kMB);  // the large one, cut to 6 MB: its 14 MB tail is unmapped
+  EXPECT_EQ(d.data(), large_one);
+  EXPECT_EQ(huge_page_pool::kept_bytes(), 0u);
+  std::memset(d.data(), 1, d.size());
+}
+
+TEST(HugePagePool, StaysWithinItsBounds) {
+  huge_page_pool::release();
+  {  // over the byte bound on its own: unmapped, not kept
+    Bytes huge(huge_page_pool::kPoolBytes + 2 * kMB);
+  }
+  EXPECT_EQ(huge_page_pool::kept_bytes(), 0u);
+  // More mappings than slots, then more bytes than the bound: the oldest go.
+  for (int i = 0; i < huge_page_pool::kPoolSlots + 3; ++i) {
+    std::vector<Bytes> arrays;
+    for (int k = 0; k <= i; ++k) arrays.emplace_back(2 * kMB * size_t(k + 1));
+  }
+  EXPECT_LE(huge_page_pool::kept_bytes(), huge_page_pool::kPoolBytes);
+  std::vector<Bytes> big;
+  for (int i = 0; i < 6; ++i) big.emplace_back(60 * kMB);
+  big.clear();
+  EXPECT_LE(huge_page_pool::kept_bytes(), huge_page_pool::kPoolBytes);
+  EXPECT_GE(huge_page_pool::kept_bytes(), 4 * 60 * kMB);  // the four newest fit in 256 MB
+  huge_page_pool::release();
+  EXPECT_EQ(huge_page_pool::kept_bytes(), 0u);
+}
+#endif
+
+TEST(HugePagePool, SmallArraysNeverEnterIt) {
+  huge_page_pool::release();
+  { Bytes a(kMB); }
+  EXPECT_EQ(huge_page_pool::kept_bytes(), 0u);
+}
+
+}  // namespace
+}  // namespace toyrt
