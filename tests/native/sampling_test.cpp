@@ -166,6 +166,28 @@ TEST(SamplingSobolOwen, FastFormsEqualTheirDefinitions) {
   }
 }
 
+TEST(SamplingSobolOwen, SamplersAreTheScrambledSobolDimensionsOfTheShuffledIndex) {
+  // The samplers' definition, composed from its parts: the sample index shuffled by a nested
+  // scramble keyed by (pixel, dimension, seed), then x = Sobol dimension 0 and y = dimension 1 of
+  // it, each scrambled with its own key (the 1D sampler: dimension 0 with a third key). The fast
+  // forms above are checked on their own; this checks the wiring (which dimension and which key
+  // goes to x and to y): a swap of either fails it.
+  for (uint32_t pixel : {0u, 7u, 4096u, 999999u})
+    for (uint32_t dimension : {0u, 1u, 9u})
+      for (uint32_t seed : {0u, 3u})
+        for (uint32_t sample = 0; sample < 4096; sample += 37) {
+          const uint32_t key2 = hash_keys(pixel, dimension, seed, 0x736f626cu);
+          const uint32_t index2 = nested_uniform_scramble(sample, key2);
+          const Vec2 p = sobol_owen_2d(pixel, sample, dimension, seed);
+          ASSERT_EQ(p.x, bits_to_unit_float(nested_uniform_scramble(sobol_dimension0(index2), pcg_hash(key2 ^ 0x1u))));
+          ASSERT_EQ(p.y, bits_to_unit_float(nested_uniform_scramble(sobol_dimension1(index2), pcg_hash(key2 ^ 0x2u))));
+          const uint32_t key1 = hash_keys(pixel, dimension, seed, 0x31646f77u);
+          const uint32_t index1 = nested_uniform_scramble(sample, key1);
+          ASSERT_EQ(sobol_owen_1d(pixel, sample, dimension, seed),
+                    bits_to_unit_float(nested_uniform_scramble(sobol_dimension0(index1), pcg_hash(key1 ^ 0x3u))));
+        }
+}
+
 TEST(SamplingSobolOwen, EveryPowerOfTwoOfSamplesIsANet) {
   // For N = 2^m samples of one pixel, each elementary box 2^-a x 2^-(m-a) holds exactly one
   // point, for every a: stratified in all aspect ratios, including the N^(1/2) x N^(1/2) grid.
