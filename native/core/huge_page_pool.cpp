@@ -5,7 +5,10 @@
 
 #if defined(__linux__)
 #include <sys/mman.h>
+#include <unistd.h>
 #endif
+
+#include <algorithm>
 
 namespace toyrt::huge_page_pool {
 namespace {
@@ -37,6 +40,18 @@ void unmap(void* p, size_t bytes) {
 
 }  // namespace
 
+size_t bound_bytes() noexcept {
+  static const size_t bound = [] {
+    constexpr size_t kMin = size_t(256) << 20, kMax = size_t(1) << 30;
+#if defined(__linux__)
+    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    if (pages > 0 && page > 0) return std::clamp(size_t(pages) * size_t(page) / 32, kMin, kMax);
+#endif
+    return kMin;
+  }();
+  return bound;
+}
+
 void* take(size_t bytes) noexcept {
 #if defined(__linux__)
   Pool& pl = pool();
@@ -57,7 +72,8 @@ void* take(size_t bytes) noexcept {
 
 bool keep(void* p, size_t bytes) noexcept {
 #if defined(__linux__)
-  if (bytes > kPoolBytes) return false;
+  const size_t bound = bound_bytes();
+  if (bytes > bound) return false;
   Pool& pl = pool();
   std::lock_guard<std::mutex> lock(pl.mutex);
   for (;;) {
@@ -69,12 +85,12 @@ bool keep(void* p, size_t bytes) noexcept {
       else if (!oldest || s.age < oldest->age)
         oldest = &s;
     }
-    if (free_slot && pl.bytes + bytes <= kPoolBytes) {
+    if (free_slot && pl.bytes + bytes <= bound) {
       *free_slot = Slot{p, bytes, ++pl.clock};
       pl.bytes += bytes;
       return true;
     }
-    // Full, by count or by bytes (then something is kept, since bytes <= kPoolBytes): the oldest goes.
+    // Full, by count or by bytes (then something is kept, since bytes <= bound): the oldest goes.
     unmap(oldest->p, oldest->bytes);
     pl.bytes -= oldest->bytes;
     *oldest = Slot{};

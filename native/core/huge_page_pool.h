@@ -5,7 +5,7 @@
 // the viewport's edits, a benchmark's repeats) frees arrays of the same sizes as it makes, so the
 // mappings freed are kept here, up to a bound, and the next allocation that fits takes one,
 // already faulted in and backed by huge pages. What glibc does for smaller blocks (its heap keeps
-// freed memory), but bounded: kPoolBytes at most stay mapped once every scene is gone (glibc's
+// freed memory), but bounded: bound_bytes() at most stay mapped once every scene is gone (glibc's
 // heap had grown without bound here; huge_page_allocator.h).
 #pragma once
 
@@ -13,9 +13,11 @@
 
 namespace toyrt::huge_page_pool {
 
-// At most this many bytes, in at most kPoolSlots mappings, are kept.
-inline constexpr size_t kPoolBytes = size_t(256) << 20;
-inline constexpr int kPoolSlots = 8;
+// At most bound_bytes(), in at most kPoolSlots mappings, are kept: a 32nd of the machine's memory,
+// from 256 MB to 1 GB (768 MB on 24 GB: all of a 4M-triangle LBVH commit's arrays and temporaries,
+// about 470 MB, whose commit the pool made 13 % faster than a 256 MB bound did).
+inline constexpr int kPoolSlots = 12;
+size_t bound_bytes() noexcept;
 
 // A kept mapping of at least `bytes` (a multiple of the huge page), cut to exactly `bytes` (the
 // tail beyond is unmapped), or nullptr. The smallest that fits, so a small array does not take a
@@ -23,7 +25,7 @@ inline constexpr int kPoolSlots = 8;
 void* take(size_t bytes) noexcept;
 
 // Keeps the mapping [p, p + bytes) for a later take(); the oldest kept ones are unmapped to stay
-// within the bounds. False (the caller unmaps it) for a mapping over kPoolBytes.
+// within the bounds. False (the caller unmaps it) for a mapping over bound_bytes().
 bool keep(void* p, size_t bytes) noexcept;
 
 // Bytes kept now (for tests and memory reports).

@@ -51,21 +51,28 @@ TEST(HugePagePool, TheSmallestFittingMappingIsTakenAndCut) {
 
 TEST(HugePagePool, StaysWithinItsBounds) {
   huge_page_pool::release();
-  {  // over the byte bound on its own: unmapped, not kept
-    Bytes huge(huge_page_pool::kPoolBytes + 2 * kMB);
+  const size_t bound = huge_page_pool::bound_bytes();
+  EXPECT_GE(bound, 256 * kMB);
+  EXPECT_LE(bound, 1024 * kMB);
+  {  // over the byte bound on its own: unmapped, not kept (mapped, never touched)
+    Bytes huge(bound + 2 * kMB);
   }
   EXPECT_EQ(huge_page_pool::kept_bytes(), 0u);
-  // More mappings than slots, then more bytes than the bound: the oldest go.
-  for (int i = 0; i < huge_page_pool::kPoolSlots + 3; ++i) {
+  // More mappings than slots: the oldest go.
+  {
     std::vector<Bytes> arrays;
-    for (int k = 0; k <= i; ++k) arrays.emplace_back(2 * kMB * size_t(k + 1));
+    for (int k = 0; k < huge_page_pool::kPoolSlots + 3; ++k) arrays.emplace_back(2 * kMB);
   }
-  EXPECT_LE(huge_page_pool::kept_bytes(), huge_page_pool::kPoolBytes);
-  std::vector<Bytes> big;
-  for (int i = 0; i < 6; ++i) big.emplace_back(60 * kMB);
-  big.clear();
-  EXPECT_LE(huge_page_pool::kept_bytes(), huge_page_pool::kPoolBytes);
-  EXPECT_GE(huge_page_pool::kept_bytes(), 4 * 60 * kMB);  // the four newest fit in 256 MB
+  EXPECT_EQ(huge_page_pool::kept_bytes(), size_t(huge_page_pool::kPoolSlots) * 2 * kMB);
+  // More bytes than the bound: four arrays of a bit over a third of it, of which the two newest
+  // fit (the slots' small ones go first, being older).
+  const size_t third = (bound / 3 / kMB + 2) * kMB;
+  {
+    std::vector<Bytes> arrays;
+    for (int k = 0; k < 4; ++k) arrays.emplace_back(third);
+  }
+  EXPECT_LE(huge_page_pool::kept_bytes(), bound);
+  EXPECT_GE(huge_page_pool::kept_bytes(), 2 * third);
   huge_page_pool::release();
   EXPECT_EQ(huge_page_pool::kept_bytes(), 0u);
 }
