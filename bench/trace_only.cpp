@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
     }
     std::sort(mine.begin(), mine.end());
     std::sort(theirs.begin(), theirs.end());
-    std::printf("%s: %zu triangles, %s commit median %.3g ms, Embree %s %.3g ms wall (%d runs)\n", kind.c_str(),
+    std::printf("%s: %zu triangles, %s commit median %.4g ms, Embree %s %.4g ms wall (%d runs)\n", kind.c_str(),
                 mesh.triangles.size(), sah ? "SAH" : "LBVH", mine[mine.size() / 2], sah ? "default" : "Morton",
                 theirs[theirs.size() / 2], repeats);
     if (sah) return 0;
@@ -202,7 +202,7 @@ int main(int argc, char** argv) {
       if (k) ms.push_back(cpu_ms() - start);
     }
     std::sort(ms.begin(), ms.end());
-    std::printf("%s: %zu triangles, median %.3g ms %s (%d runs)\n", kind.c_str(), mesh.triangles.size(),
+    std::printf("%s: %zu triangles, median %.4g ms %s (%d runs)\n", kind.c_str(), mesh.triangles.size(),
                 ms[ms.size() / 2], all ? "wall" : "CPU", repeats);
     return 0;
   }

@@ -47,10 +47,18 @@ struct HugePageAllocator {
     if (!is_large(n)) return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(alignof(T))));
     const size_t bytes = rounded_bytes(n);
 #if defined(__linux__)
-    // A mapping the last commits released (already faulted in and marked), else a new one.
+    // A mapping the last commits released (already marked, and faulted in as far as it was
+    // written), else a new one.
     if (void* kept = huge_page_pool::take(bytes)) return static_cast<T*>(kept);
     // Map one huge page more than needed and unmap the unaligned head and the tail beyond.
-    void* raw = mmap(nullptr, bytes + kHugePageBytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    auto map = [&] {
+      return mmap(nullptr, bytes + kHugePageBytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    };
+    void* raw = map();
+    if (raw == MAP_FAILED) {  // the kept mappings first give way
+      huge_page_pool::release();
+      raw = map();
+    }
     if (raw == MAP_FAILED) throw std::bad_alloc();
     const size_t start = reinterpret_cast<size_t>(raw);
     const size_t aligned = (start + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;

@@ -1,5 +1,6 @@
 #include "core/huge_page_pool.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <mutex>
 
@@ -7,8 +8,6 @@
 #include <sys/mman.h>
 #include <unistd.h>
 #endif
-
-#include <algorithm>
 
 namespace toyrt::huge_page_pool {
 namespace {
@@ -27,14 +26,15 @@ struct Pool {
   uint64_t clock = 0;
 };
 
+// Never destroyed: arrays in other static objects may be freed into it at exit, after it.
 Pool& pool() {
-  static Pool p;
-  return p;
+  static Pool* p = new Pool;
+  return *p;
 }
 
 void unmap(void* p, size_t bytes) {
 #if defined(__linux__)
-  munmap(p, bytes);
+  if (p && bytes) munmap(p, bytes);
 #endif
 }
 
@@ -54,16 +54,22 @@ size_t bound_bytes() noexcept {
 
 void* take(size_t bytes) noexcept {
 #if defined(__linux__)
+  if (bytes == 0) return nullptr;
   Pool& pl = pool();
-  std::lock_guard<std::mutex> lock(pl.mutex);
-  Slot* best = nullptr;
-  for (Slot& s : pl.slots)
-    if (s.p && s.bytes >= bytes && (!best || s.bytes < best->bytes)) best = &s;
-  if (!best) return nullptr;
-  void* p = best->p;
-  if (best->bytes > bytes) unmap(static_cast<char*>(p) + bytes, best->bytes - bytes);
-  pl.bytes -= best->bytes;
-  *best = Slot{};
+  void* p;
+  Slot cut;  // the tail beyond `bytes`, unmapped outside the lock (other threads allocate too)
+  {
+    std::lock_guard<std::mutex> lock(pl.mutex);
+    Slot* best = nullptr;
+    for (Slot& s : pl.slots)
+      if (s.p && s.bytes >= bytes && s.bytes <= 2 * bytes && (!best || s.bytes < best->bytes)) best = &s;
+    if (!best) return nullptr;
+    p = best->p;
+    cut = Slot{static_cast<char*>(p) + bytes, best->bytes - bytes};
+    pl.bytes -= best->bytes;
+    *best = Slot{};
+  }
+  unmap(cut.p, cut.bytes);
   return p;
 #else
   return nullptr;
@@ -73,28 +79,34 @@ void* take(size_t bytes) noexcept {
 bool keep(void* p, size_t bytes) noexcept {
 #if defined(__linux__)
   const size_t bound = bound_bytes();
-  if (bytes > bound) return false;
+  if (!p || bytes == 0 || bytes > bound) return false;
   Pool& pl = pool();
-  std::lock_guard<std::mutex> lock(pl.mutex);
-  for (;;) {
-    Slot* free_slot = nullptr;
-    Slot* oldest = nullptr;
-    for (Slot& s : pl.slots) {
-      if (!s.p)
-        free_slot = free_slot ? free_slot : &s;
-      else if (!oldest || s.age < oldest->age)
-        oldest = &s;
+  Slot evicted[kPoolSlots];  // unmapped outside the lock
+  int n_evicted = 0;
+  {
+    std::lock_guard<std::mutex> lock(pl.mutex);
+    for (;;) {
+      Slot* free_slot = nullptr;
+      Slot* oldest = nullptr;
+      for (Slot& s : pl.slots) {
+        if (!s.p)
+          free_slot = free_slot ? free_slot : &s;
+        else if (!oldest || s.age < oldest->age)
+          oldest = &s;
+      }
+      if (free_slot && pl.bytes + bytes <= bound) {
+        *free_slot = Slot{p, bytes, ++pl.clock};
+        pl.bytes += bytes;
+        break;
+      }
+      // Full, by count or by bytes (then something is kept, since bytes <= bound): the oldest goes.
+      evicted[n_evicted++] = *oldest;
+      pl.bytes -= oldest->bytes;
+      *oldest = Slot{};
     }
-    if (free_slot && pl.bytes + bytes <= bound) {
-      *free_slot = Slot{p, bytes, ++pl.clock};
-      pl.bytes += bytes;
-      return true;
-    }
-    // Full, by count or by bytes (then something is kept, since bytes <= bound): the oldest goes.
-    unmap(oldest->p, oldest->bytes);
-    pl.bytes -= oldest->bytes;
-    *oldest = Slot{};
   }
+  for (int i = 0; i < n_evicted; ++i) unmap(evicted[i].p, evicted[i].bytes);
+  return true;
 #else
   return false;
 #endif
@@ -108,13 +120,14 @@ size_t kept_bytes() noexcept {
 
 void release() noexcept {
   Pool& pl = pool();
-  std::lock_guard<std::mutex> lock(pl.mutex);
-  for (Slot& s : pl.slots)
-    if (s.p) {
-      unmap(s.p, s.bytes);
-      s = Slot{};
-    }
-  pl.bytes = 0;
+  Slot all[kPoolSlots];
+  {
+    std::lock_guard<std::mutex> lock(pl.mutex);
+    std::copy(std::begin(pl.slots), std::end(pl.slots), all);
+    std::fill(std::begin(pl.slots), std::end(pl.slots), Slot{});
+    pl.bytes = 0;
+  }
+  for (const Slot& s : all) unmap(s.p, s.bytes);
 }
 
 }  // namespace toyrt::huge_page_pool

@@ -2,12 +2,13 @@
 // For the commit's large temporaries: a std::vector constructs (or zeroes) every element on one
 // thread before the parallel loop that fills it, and at a million triangles that serial pass,
 // most of it the kernel supplying 36 MB of fresh pages, was 15 ms of the 2-thread commit. Here
-// the threads that fill the array also touch its pages first, each its own part.
+// the threads that fill the array also touch its fresh pages first, each its own part.
 //
 // The memory comes from HugePageAllocator: from 2 MB up, huge pages, and the mappings the last
 // commit released (huge_page_pool.h), already faulted in. From malloc, a repeated 1M-triangle SAH
-// commit spent about a tenth of its time (kernel zeroing of fresh pages) on these temporaries:
-// glibc hands large freed blocks back to the system.
+// commit spent about a tenth of its time in the kernel's zeroing of fresh pages for these
+// temporaries: glibc maps blocks above its threshold (up to 32 MB) afresh each time, and hands a
+// large freed top of its heap back to the system.
 //
 // Elements are created with emplace() (placement new); T must be trivially destructible, since
 // nothing here knows which elements were made.
@@ -16,7 +17,6 @@
 #include "core/huge_page_allocator.h"
 
 #include <cstddef>
-#include <cstdlib>
 #include <memory>
 #include <new>
 #include <type_traits>
