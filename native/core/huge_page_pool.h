@@ -7,8 +7,8 @@
 // backed by huge pages, and faulted in as far as its last owner wrote it (a commit's arrays are
 // written whole). What glibc does for smaller blocks (its heap keeps freed memory), but bounded:
 // bound_bytes() at most stay mapped once every scene is gone (glibc's heap had grown without bound
-// here; huge_page_allocator.h). The allocator also empties the pool and retries when a new mapping
-// fails, so what is kept never stands in the way of memory a commit needs.
+// here; huge_page_allocator.h). The allocator also empties the pool and retries when the kernel
+// refuses a new mapping, so what is kept is given back before an allocation fails for want of it.
 #pragma once
 
 #include <cstddef>

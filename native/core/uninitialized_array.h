@@ -7,8 +7,8 @@
 // The memory comes from HugePageAllocator: from 2 MB up, huge pages, and the mappings the last
 // commit released (huge_page_pool.h), already faulted in. From malloc, a repeated 1M-triangle SAH
 // commit spent about a tenth of its time in the kernel's zeroing of fresh pages for these
-// temporaries: glibc maps blocks above its threshold (up to 32 MB) afresh each time, and hands a
-// large freed top of its heap back to the system.
+// temporaries: glibc maps blocks above its threshold (which rises to at most 32 MB) afresh each
+// time, and hands a large freed top of its heap back to the system.
 //
 // Elements are created with emplace() (placement new); T must be trivially destructible, since
 // nothing here knows which elements were made.
