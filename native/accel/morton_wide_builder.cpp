@@ -1,6 +1,7 @@
 #include "accel/morton_wide_builder.h"
 
 #include "accel/morton_code.h"
+#include "core/parallel.h"
 #include "core/uninitialized_array.h"
 
 #include <tbb/blocked_range.h>
@@ -18,9 +19,14 @@ namespace {
 
 // Fixed sizes, not derived from the thread count, so that the tree and its layout are the same on
 // every machine.
-constexpr size_t kGrain = 16384;            // primitives a chunk of the parallel passes
-constexpr uint32_t kTaskPrimitives = 8192;  // larger subtrees are built as tasks of their own
-constexpr uint32_t kCodeBits = 30;          // 10 bits an axis, as the OpenCL build's default
+// Larger subtrees are built as tasks of their own; on meshes under 128K primitives, subtrees
+// larger than a 16th of the mesh (at least 512), so that a small mesh's top-down build is not one
+// task on one core (at 10K triangles it was a sixth of the commit, serial).
+constexpr uint32_t kTaskPrimitives = 8192;
+uint32_t task_primitives(size_t count) {
+  return uint32_t(std::clamp(count / 16, size_t(512), size_t(kTaskPrimitives)));
+}
+constexpr uint32_t kCodeBits = 30;  // 10 bits an axis, as the OpenCL build's default
 
 // Bits 0-9 of v moved to bits 0, 3, ..., 27 in four shift-or-mask steps, each moving groups half
 // as wide as the step before.
@@ -45,13 +51,14 @@ uint32_t prim_of(Key k) { return uint32_t(k); }
 // Returns whether it scattered: always, unless skip_one_digit and the digit is the same for every
 // key (the keys then stay in `from`).
 bool scatter_by_digit(const Key* from, Key* to, size_t n, uint32_t shift, bool skip_one_digit, uint32_t start[257]) {
-  const size_t chunks = (n + kGrain - 1) / kGrain;
+  const size_t grain = chunk_size(n);
+  const size_t chunks = (n + grain - 1) / grain;
   std::vector<uint32_t> first(chunks * 256);
   tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
     uint32_t* count = &first[c * 256];
     std::fill(count, count + 256, 0u);
-    const size_t end = std::min(n, (c + 1) * kGrain);
-    for (size_t i = c * kGrain; i < end; ++i) ++count[(from[i] >> shift) & 255u];
+    const size_t end = std::min(n, (c + 1) * grain);
+    for (size_t i = c * grain; i < end; ++i) ++count[(from[i] >> shift) & 255u];
   });
   uint32_t sum = 0;
   bool one_digit = false;
@@ -65,8 +72,8 @@ bool scatter_by_digit(const Key* from, Key* to, size_t n, uint32_t shift, bool s
   tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
     uint32_t next[256];
     std::copy(&first[c * 256], &first[c * 256] + 256, next);
-    const size_t end = std::min(n, (c + 1) * kGrain);
-    for (size_t i = c * kGrain; i < end; ++i) to[next[(from[i] >> shift) & 255u]++] = from[i];
+    const size_t end = std::min(n, (c + 1) * grain);
+    for (size_t i = c * grain; i < end; ++i) to[next[(from[i] >> shift) & 255u]++] = from[i];
   });
   return true;
 }
@@ -169,6 +176,7 @@ struct TopDown {
   const BBox* bounds;
   const Key* keys;
   uint32_t leaf_size;
+  uint32_t task_size;  // task_primitives() of the mesh
 
   // Where the range splits: the first slot whose code has the highest bit in which the range's
   // first and last codes differ (the codes are sorted, so every code in the range shares the bits
@@ -214,7 +222,7 @@ struct TopDown {
 
   // Writes the wide node over r at out.nodes[at], its interior children side by side after the
   // array's end and their subtrees after them (depth first); returns the box of what it built.
-  // Children of more than kTaskPrimitives (only ever met at a task's root) are handed on.
+  // Children of more than task_size (only ever met at a task's root) are handed on.
   BBox build(Range r, size_t at, TaskTree& out) const {
     Range kids[kWidth];
     const int n = open(r, kids);
@@ -226,7 +234,7 @@ struct TopDown {
       }
     for (int i = 0; i < kWidth; ++i) node.child[i] = node.count[i] = 0;
     int inline_interior = 0;
-    for (int i = 0; i < n; ++i) inline_interior += kids[i].size() > leaf_size && kids[i].size() <= kTaskPrimitives;
+    for (int i = 0; i < n; ++i) inline_interior += kids[i].size() > leaf_size && kids[i].size() <= task_size;
     size_t next = out.nodes.size();
     out.nodes.resize(next + size_t(inline_interior));
     BBox total;
@@ -236,7 +244,7 @@ struct TopDown {
         b = leaf_box(kids[i]);
         node.child[i] = kids[i].begin;
         node.count[i] = kids[i].size();
-      } else if (kids[i].size() > kTaskPrimitives) {
+      } else if (kids[i].size() > task_size) {
         out.handed_on.emplace_back(i, kids[i]);
         continue;  // its box is set when its task is done
       } else {
@@ -284,12 +292,13 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
   // Slots and indices are 32-bit (an index rides in the low half of each sort key).
   if (count > size_t(UINT32_MAX)) throw std::length_error("host LBVH: more than 2^32 - 1 primitives");
   leaf_size = std::max(leaf_size, 1u);
-  const size_t chunks = (count + kGrain - 1) / kGrain;
+  const size_t grain = chunk_size(count);
+  const size_t chunks = (count + grain - 1) / grain;
   const BBox centres = tbb::parallel_reduce(
       tbb::blocked_range<size_t>(0, chunks, 1), BBox{},
       [&](const tbb::blocked_range<size_t>& r, BBox acc) {
         for (size_t c = r.begin(); c != r.end(); ++c)
-          for (size_t i = c * kGrain, end = std::min(count, (c + 1) * kGrain); i < end; ++i)
+          for (size_t i = c * grain, end = std::min(count, (c + 1) * grain); i < end; ++i)
             acc.extend(prim_bounds[i].center());
         return acc;
       },
@@ -299,7 +308,7 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
       });
   const MortonFrame frame = morton_frame(centres, MortonBits::k30);
   UninitializedArray<Key> a(count), b(count);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, grain), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i != r.end(); ++i) {
       const Vec3 c = prim_bounds[i].center();
       const uint32_t code = spread10(morton_cell(c, frame, 0)) << 2 | spread10(morton_cell(c, frame, 1)) << 1 |
@@ -309,7 +318,7 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
   });
   const Key* keys = sort_by_code(a.data(), b.data(), count);
   built.prim_ids.resize(count);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, grain), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i != r.end(); ++i) built.prim_ids[i] = prim_of(keys[i]);
   });
   if (count <= leaf_size) {
@@ -321,7 +330,7 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
   // Tasks level by level: each builds its subtree but for the children it hands on, which become
   // the next level's tasks in the order they were met, so task numbers (and the layout) do not
   // depend on which thread ran what.
-  const TopDown top_down{prim_bounds, keys, leaf_size};
+  const TopDown top_down{prim_bounds, keys, leaf_size, task_primitives(count)};
   std::vector<Range> ranges{{0u, uint32_t(count)}};
   std::vector<TaskTree> tasks;
   for (size_t level = 0; level < ranges.size();) {
@@ -332,7 +341,7 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
         // About one wide node for every 17 primitives on meshes (leaves of 8): reserved, so the
         // array rarely grows while the subtree is built. A larger task hands most of its subtree
         // on and builds only its top.
-        tasks[t].nodes.reserve(std::min(ranges[t].size(), 8 * kTaskPrimitives) / 12 + 8);
+        tasks[t].nodes.reserve(std::min(ranges[t].size(), 8 * top_down.task_size) / 12 + 8);
         tasks[t].nodes.resize(1);
         tasks[t].box = top_down.build(ranges[t], 0, tasks[t]);
       }

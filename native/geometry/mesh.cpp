@@ -1,6 +1,7 @@
 #include "geometry/mesh.h"
 
 #include "accel/wide_traverse.h"
+#include "core/parallel.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -48,18 +49,18 @@ Mesh::Prepared Mesh::prepare() {
   // to mark and one to write the boxes, read every triangle and vertex twice: 9 ms of the 1M
   // commit on a first-generation EPYC.) Nothing is constructed or zeroed beforehand on one
   // thread (UninitializedArray).
-  constexpr size_t kGrain = 16384;
   const size_t n = triangles_.size();
-  const size_t chunks = (n + kGrain - 1) / kGrain;
+  const size_t grain = chunk_size(n);
+  const size_t chunks = (n + grain - 1) / grain;
   UninitializedArray<BBox> boxes(n);
   UninitializedArray<uint8_t> keep(n);
   std::vector<uint32_t> offset(chunks + 1, 0u);
   std::vector<BBox> chunk_bounds(chunks);
   tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-    const size_t end = std::min(n, (c + 1) * kGrain);
+    const size_t end = std::min(n, (c + 1) * grain);
     uint32_t kept = 0;
     BBox hittable_bounds;
-    for (size_t i = c * kGrain; i < end; ++i) {
+    for (size_t i = c * grain; i < end; ++i) {
       const Triangle& t = triangles_[i];
       const Vec3 &p0 = vertices_[t.x], &p1 = vertices_[t.y], &p2 = vertices_[t.z];
       BBox b;
@@ -90,7 +91,7 @@ Mesh::Prepared Mesh::prepare() {
   p.valid = UninitializedArray<uint32_t>(p.count);
   tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
     size_t slot = offset[c];
-    for (size_t i = c * kGrain, end = std::min(n, (c + 1) * kGrain); i < end; ++i) {
+    for (size_t i = c * grain, end = std::min(n, (c + 1) * grain); i < end; ++i) {
       if (!keep[i]) continue;
       p.boxes.emplace(slot, boxes[i]);
       p.valid.emplace(slot++, uint32_t(i));

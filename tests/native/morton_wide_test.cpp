@@ -133,19 +133,25 @@ TEST(MortonWide, BoxesHoldWhatIsUnderThemWhenTasksHandOnTasks) {
 }
 
 TEST(MortonWide, SameLayoutOnAnyThreadCount) {
-  const MeshData m = uv_sphere(300, 300, 1.0f, 0.1f);  // 179,400 triangles: two levels of tasks
-  const PrimitiveBounds p = triangle_bounds(m);
-  auto build = [&](int threads) {
-    WideBuild built;
-    run_with_threads(threads, [&] { built = build_morton_wide(p.boxes.data(), p.boxes.size(), kLeaf); });
-    return built;
-  };
-  const WideBuild one = build(1);
-  for (const int threads : {2, 0}) {
-    const WideBuild other = build(threads);
-    EXPECT_EQ(one.prim_ids, other.prim_ids);
-    ASSERT_EQ(one.wide.nodes.size(), other.wide.nodes.size());
-    EXPECT_EQ(0, std::memcmp(one.wide.nodes.data(), other.wide.nodes.data(), one.wide.nodes.size() * sizeof(WideNode)));
+  // 179,400 triangles: two levels of tasks of up to 8,192; 9,940: tasks of up to a 16th of the
+  // mesh, and the passes in chunks of 2,048 (a small mesh's own sizes, core/parallel.h).
+  for (const int rings : {300, 71}) {
+    const MeshData m = uv_sphere(rings, rings, 1.0f, 0.1f);
+    SCOPED_TRACE(std::to_string(m.triangles.size()) + " triangles");
+    const PrimitiveBounds p = triangle_bounds(m);
+    auto build = [&](int threads) {
+      WideBuild built;
+      run_with_threads(threads, [&] { built = build_morton_wide(p.boxes.data(), p.boxes.size(), kLeaf); });
+      return built;
+    };
+    const WideBuild one = build(1);
+    for (const int threads : {2, 0}) {
+      const WideBuild other = build(threads);
+      EXPECT_EQ(one.prim_ids, other.prim_ids);
+      ASSERT_EQ(one.wide.nodes.size(), other.wide.nodes.size());
+      EXPECT_EQ(0,
+                std::memcmp(one.wide.nodes.data(), other.wide.nodes.data(), one.wide.nodes.size() * sizeof(WideNode)));
+    }
   }
 }
 
