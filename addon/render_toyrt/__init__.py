@@ -40,6 +40,16 @@ def native() -> types.ModuleType:
     return _native
 
 
+def release_cached_memory() -> None:
+    """Gives back the memory the native module keeps for the next commit (freed BVH and commit
+    arrays, up to a 32nd of the machine's memory): after every render, and when a viewport render
+    stops. A no-op when the module cannot be imported (whoever needed it has reported why)."""
+    try:
+        native().release_cached_memory()
+    except ImportError:
+        pass
+
+
 def _other_copy() -> str:
     """The module name and folder of another enabled copy of TOYRT (the legacy add-on beside the extension, or the
     reverse), or "". Both would register the engine "TOYRT" and scene.toyrt, and disabling one

@@ -49,7 +49,7 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
         passes.register(self, scene, renderlayer)
 
     def render(self, depsgraph) -> None:
-        from . import native, report
+        from . import native, release_cached_memory, report
 
         try:
             if self.is_preview:
@@ -60,6 +60,11 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
                 self._render(depsgraph, native())
         except Exception as err:  # reaches the user (and makes a farm's frame fail), never crashes Blender
             report.error(f"render failed: {err}", self.report)
+        finally:
+            # The arrays a commit freed stay mapped in Blender's process for the next commit (up to
+            # a 32nd of the machine's memory): give them back to the system, since the next render
+            # is seconds away at the soonest. Its commit then maps its arrays afresh.
+            release_cached_memory()
 
     def _render(self, depsgraph, toyrt):
         from . import denoise, passes, render_cache, report, sync

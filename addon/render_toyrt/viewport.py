@@ -176,6 +176,9 @@ class ViewportSession:
         self._drawn = None
         self._latest = None
         _sessions.discard(self)
+        from . import release_cached_memory
+
+        release_cached_memory()  # the edits' re-commits reused it; nothing does now
 
     @property
     def rendering(self) -> bool:

@@ -1,6 +1,7 @@
 // The Python module `toyrt`: the definitions (classes, functions, argument names, defaults and
 // docstrings). Converters live in python/convert.*, the scene wrapper in python/py_scene.*, the
 // policy in the core. Argument defaults are read from the core's structs, never written here.
+#include "core/huge_page_pool.h"
 #include "core/params.h"
 #include "geometry/offset_ray.h"
 #include "python/convert.h"
@@ -454,6 +455,19 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
       "The image size (resolution times percentage) and the pixel window render() fills (the border,\n"
       "or the whole image), rows counted from the top: dict of width, height, x0, y0, x1, y1.");
 
+  m.def("cached_memory_bytes", &huge_page_pool::kept_bytes,
+        "Bytes of freed BVH and commit arrays the module keeps mapped for the next commit (in huge\n"
+        "pages, already faulted in): at most a 32nd of the machine's memory, 256 MB to 1 GB.");
+  m.def(
+      "release_cached_memory",
+      [] {
+        const size_t bytes = huge_page_pool::kept_bytes();
+        huge_page_pool::release();
+        return bytes;
+      },
+      "Gives the memory cached_memory_bytes() counts back to the system; returns how many bytes.\n"
+      "The next commit then maps its arrays afresh (the kernel zeroes each page on first touch: about\n"
+      "a sixth of a 1M-triangle LBVH commit). The Blender add-on calls it after every render.");
   m.def(
       "offset_ray_origin",
       [](py::handle points, py::handle normals) {

@@ -3,6 +3,8 @@
 #   - meshes that do not change between frames are exported once (a static plane; a cube that only
 #     moves keeps its mesh and gets a new transform), a mesh deformed by an animated Wave modifier
 #     is exported again every frame, in place: the cache's counters say exactly that;
+#   - the engine gives back the arrays commits freed after each render (a throwaway scene's,
+#     built before the animation through the native module, are gone after it);
 #   - memory stays flat: the process's resident memory (VmRSS) grows by less than one frame's mesh
 #     data plus 8 MB between frame 10 and frame 100. A leak of the re-exported mesh (its native
 #     copy is about 10 MB) would add that every frame, about 900 MB over 90 frames; the first 10
@@ -14,6 +16,7 @@ import sys
 import tempfile
 
 import bpy
+import render_toyrt
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "scenes")]  # harness and the scene kit (see harness)
@@ -57,9 +60,31 @@ def build():
     return scene, sphere
 
 
+def fill_cache():
+    """Builds a throwaway 180,000-triangle grid twice through the native module and drops it: the
+    arrays its commits freed (each over 2 MB) are kept for a next commit. Returns their bytes."""
+    import numpy as np
+
+    toyrt = render_toyrt.native()
+    n = 300
+    xs, ys = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1))
+    vertices = np.stack([xs.ravel(), ys.ravel(), np.zeros(xs.size)], axis=1).astype(np.float32)
+    i = (np.arange(n)[:, None] * (n + 1) + np.arange(n)[None, :]).ravel()
+    triangles = np.concatenate([np.stack([i, i + 1, i + n + 2], 1), np.stack([i, i + n + 2, i + n + 1], 1)])
+    s = toyrt.Scene()
+    mesh = s.add_mesh(vertices, triangles.astype(np.uint32))
+    s.commit()
+    s.replace_mesh(mesh, vertices, triangles.astype(np.uint32))
+    s.commit()
+    del s
+    return toyrt.cached_memory_bytes()
+
+
 def main():
     from render_toyrt import render_cache
 
+    before = fill_cache()
+    check(before > 0, f"a throwaway scene's freed arrays cached before the animation ({before / 1e6:.1f} MB)")
     scene, sphere = build()
     samples = {}
 
@@ -85,6 +110,11 @@ def main():
     check(c["instance_resets"] == 1, f"instances laid out once ({c['instance_resets']})")
     check(cache.scene.mesh_count == 3,
           f"the native scene holds 3 meshes after {FRAMES} frames ({cache.scene.mesh_count})")
+
+    # What a commit frees is kept for the next commit, but the engine gives it back after every
+    # render (engine.py): what fill_cache() left is gone.
+    cached = render_toyrt.native().cached_memory_bytes()
+    check(cached == 0, f"no freed BVH arrays kept after the render ({cached / 1e6:.1f} MB)")
 
     sphere_bytes = cache.scene.memory_bytes  # the whole scene: a bound above the sphere's own bytes
     growth = samples[FRAMES] - samples[10]
