@@ -62,9 +62,12 @@ class TOYRTRenderEngine(bpy.types.RenderEngine):
             report.error(f"render failed: {err}", self.report)
         finally:
             # The arrays a commit freed stay mapped in Blender's process for the next commit (up to
-            # a 32nd of the machine's memory): give them back to the system, since the next render
-            # is seconds away at the soonest. Its commit then maps its arrays afresh.
-            release_cached_memory()
+            # a 32nd of the machine's memory): give them back to the system after a final render,
+            # since the next one is seconds away at the soonest (its commit then maps its arrays
+            # afresh). Not after a material preview: its arrays are small, and the viewport's
+            # re-commits may be using what is kept.
+            if not self.is_preview:
+                release_cached_memory()
 
     def _render(self, depsgraph, toyrt):
         from . import denoise, passes, render_cache, report, sync
@@ -249,10 +252,11 @@ def _set_rect(rect, pixels):
 @persistent
 def _on_load_pre(*_args):
     """A file is about to close: stop every viewport render and drop the final-render cache."""
-    from . import render_cache, viewport
+    from . import release_cached_memory, render_cache, viewport
 
     viewport.close_all()
     render_cache.free_render_caches()
+    release_cached_memory()  # the freed scenes' arrays, kept by the module until now
 
 
 def register() -> None:
@@ -269,10 +273,11 @@ def register() -> None:
 def unregister() -> None:
     import atexit
 
-    from . import render_cache, viewport
+    from . import release_cached_memory, render_cache, viewport
 
     viewport.close_all()
     render_cache.free_render_caches()
+    release_cached_memory()
     atexit.unregister(viewport.close_all)
     if _on_load_pre in bpy.app.handlers.load_pre:
         bpy.app.handlers.load_pre.remove(_on_load_pre)

@@ -177,8 +177,13 @@ class ViewportSession:
         self._latest = None
         _sessions.discard(self)
         from . import release_cached_memory
+        from .sync import SceneSync
 
-        release_cached_memory()  # the edits' re-commits reused it; nothing does now
+        # The native scene freed now (an update after a close syncs a new one from scratch), so
+        # that its arrays are among what the release gives back: the edits' re-commits reused
+        # that memory, and nothing does now.
+        self.cache = SceneSync(self.cache.toyrt)
+        release_cached_memory()
 
     @property
     def rendering(self) -> bool:

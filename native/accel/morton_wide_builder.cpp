@@ -48,7 +48,7 @@ using LaneFloats = float __attribute__((vector_size(kCodeLanes * sizeof(float)))
 using LaneInts = uint32_t __attribute__((vector_size(kCodeLanes * sizeof(uint32_t))));
 using LaneSigned = int32_t __attribute__((vector_size(kCodeLanes * sizeof(int32_t))));
 
-LaneInts morton_codes(const BBox* boxes, const MortonFrame& f) {
+[[gnu::always_inline]] inline LaneInts morton_codes(const BBox* boxes, const MortonFrame& f) {
   const float cells = float((1u << f.bits) - 1u);
   LaneInts code{};
   for (int a = 0; a < 3; ++a) {
@@ -333,13 +333,15 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
       });
   const MortonFrame frame = morton_frame(centres, MortonBits::k30);
   UninitializedArray<Key> a(count), b(count);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, grain), [&](const tbb::blocked_range<size_t>& r) {
-    size_t i = r.begin();
-    for (; i + kCodeLanes <= r.end(); i += kCodeLanes) {
+  // By fixed chunks (which primitives take the scalar tail does not depend on how TBB splits).
+  tbb::parallel_for(size_t(0), chunks, [&](size_t chunk) {
+    const size_t end = std::min(count, (chunk + 1) * grain);
+    size_t i = chunk * grain;
+    for (; i + kCodeLanes <= end; i += kCodeLanes) {
       const LaneInts codes = morton_codes(prim_bounds + i, frame);
       for (int k = 0; k < kCodeLanes; ++k) a.emplace(i + k, Key(uint32_t(codes[k])) << 32 | (i + k));
     }
-    for (; i != r.end(); ++i) {
+    for (; i != end; ++i) {
       const Vec3 c = prim_bounds[i].center();
       const uint32_t code = spread10(morton_cell(c, frame, 0)) << 2 | spread10(morton_cell(c, frame, 1)) << 1 |
                             spread10(morton_cell(c, frame, 2));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <mutex>
+#include <utility>
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -118,16 +119,18 @@ size_t kept_bytes() noexcept {
   return pl.bytes;
 }
 
-void release() noexcept {
+size_t release() noexcept {
   Pool& pl = pool();
   Slot all[kPoolSlots];
+  size_t bytes;
   {
     std::lock_guard<std::mutex> lock(pl.mutex);
     std::copy(std::begin(pl.slots), std::end(pl.slots), all);
     std::fill(std::begin(pl.slots), std::end(pl.slots), Slot{});
-    pl.bytes = 0;
+    bytes = std::exchange(pl.bytes, 0);
   }
   for (const Slot& s : all) unmap(s.p, s.bytes);
+  return bytes;
 }
 
 }  // namespace toyrt::huge_page_pool

@@ -34,7 +34,8 @@ bool keep(void* p, size_t bytes) noexcept;
 // Bytes kept now (for tests and memory reports).
 size_t kept_bytes() noexcept;
 
-// Unmaps everything kept (the allocator, when a new mapping fails; tests).
-void release() noexcept;
+// Unmaps everything kept (the allocator, when a new mapping fails; toyrt.release_cached_memory();
+// tests); returns how many bytes that was.
+size_t release() noexcept;
 
 }  // namespace toyrt::huge_page_pool

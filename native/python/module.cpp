@@ -458,16 +458,10 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
   m.def("cached_memory_bytes", &huge_page_pool::kept_bytes,
         "Bytes of freed BVH and commit arrays the module keeps mapped for the next commit (in huge\n"
         "pages, already faulted in): at most a 32nd of the machine's memory, 256 MB to 1 GB.");
-  m.def(
-      "release_cached_memory",
-      [] {
-        const size_t bytes = huge_page_pool::kept_bytes();
-        huge_page_pool::release();
-        return bytes;
-      },
-      "Gives the memory cached_memory_bytes() counts back to the system; returns how many bytes.\n"
-      "The next commit then maps its arrays afresh (the kernel zeroes each page on first touch: about\n"
-      "a sixth of a 1M-triangle LBVH commit). The Blender add-on calls it after every render.");
+  m.def("release_cached_memory", &huge_page_pool::release,
+        "Gives the memory cached_memory_bytes() counts back to the system; returns how many bytes.\n"
+        "The next commit then maps its arrays afresh (the kernel zeroes each page on first touch: about\n"
+        "a sixth of a 1M-triangle LBVH commit). The Blender add-on calls it after every render.");
   m.def(
       "offset_ray_origin",
       [](py::handle points, py::handle normals) {

@@ -26,6 +26,12 @@ std::vector<MeshData> varied_meshes() {
   meshes.push_back(in_closed_room(uv_sphere(30, 30), 0.5f));
   meshes.push_back(slivers(3000, 7));
   meshes.push_back(triangle_soup(5, 0.3f, 9));  // one leaf: no wide node at all
+  // Flat but for denormal heights: the centres' z extent is denormal, its scale infinite, so the
+  // z cells are 0 * inf = NaN (clamped to 0) at the bottom and inf (clamped to the top cell) above
+  // it, in the codes' vector path and its scalar tail alike (2,001 primitives: 2,000 by eights).
+  MeshData flat = triangle_soup(2001, 0.05f, 11);
+  for (size_t i = 0; i < flat.vertices.size(); ++i) flat.vertices[i].z = float(i % 3) * 1e-41f;
+  meshes.push_back(flat);
   // 200,000 triangles in the unit cube and one far off: the cluster shares the codes' top 8
   // bits, one sort bucket too large for the in-cache sort (the parallel radix sort's path). At
   // 10 units the cluster's codes differ in all three of that sort's 8-bit digits; at 100 in the
