@@ -42,7 +42,7 @@ def native() -> types.ModuleType:
 
 def release_cached_memory() -> None:
     """Gives back the memory the native module keeps for the next commit (freed BVH and commit
-    arrays, up to a 32nd of the machine's memory): after every render, and when a viewport render
+    arrays, up to a 32nd of the machine's memory): after every final render, and when a viewport render
     stops. A no-op when the module cannot be imported (whoever needed it has reported why) or
     predates the call (a stale module beside the add-on): never an error after a good render."""
     try:

@@ -461,7 +461,7 @@ PYBIND11_MODULE(TOYRT_MODULE_NAME, m) {
   m.def("release_cached_memory", &huge_page_pool::release,
         "Gives the memory cached_memory_bytes() counts back to the system; returns how many bytes.\n"
         "The next commit then maps its arrays afresh (the kernel zeroes each page on first touch: about\n"
-        "a sixth of a 1M-triangle LBVH commit). The Blender add-on calls it after every render.");
+        "a sixth of a 1M-triangle LBVH commit). The Blender add-on calls it after every final render.");
   m.def(
       "offset_ray_origin",
       [](py::handle points, py::handle normals) {

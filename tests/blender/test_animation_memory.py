@@ -3,7 +3,7 @@
 #   - meshes that do not change between frames are exported once (a static plane; a cube that only
 #     moves keeps its mesh and gets a new transform), a mesh deformed by an animated Wave modifier
 #     is exported again every frame, in place: the cache's counters say exactly that;
-#   - the engine gives back the arrays commits freed after each render (a throwaway scene's,
+#   - the engine gives back the arrays commits freed after each final render (a throwaway scene's,
 #     built before the animation through the native module, are gone after it);
 #   - memory stays flat: the process's resident memory (VmRSS) grows by less than one frame's mesh
 #     data plus 8 MB between frame 10 and frame 100. A leak of the re-exported mesh (its native
