@@ -249,14 +249,19 @@ def _set_rect(rect, pixels):
     rect.foreach_set(pixels.ravel() if _RECT_FLAT[0] else pixels.reshape(-1, channels))
 
 
-@persistent
-def _on_load_pre(*_args):
-    """A file is about to close: stop every viewport render and drop the final-render cache."""
+def _free_everything() -> None:
+    """Stop every viewport render, drop the final-render cache and give the freed memory back."""
     from . import release_cached_memory, render_cache, viewport
 
     viewport.close_all()
     render_cache.free_render_caches()
     release_cached_memory()  # the freed scenes' arrays, kept by the module until now
+
+
+@persistent
+def _on_load_pre(*_args):
+    """A file is about to close: nothing of its scenes stays in memory."""
+    _free_everything()
 
 
 def register() -> None:
@@ -273,11 +278,9 @@ def register() -> None:
 def unregister() -> None:
     import atexit
 
-    from . import release_cached_memory, render_cache, viewport
+    from . import viewport
 
-    viewport.close_all()
-    render_cache.free_render_caches()
-    release_cached_memory()
+    _free_everything()
     atexit.unregister(viewport.close_all)
     if _on_load_pre in bpy.app.handlers.load_pre:
         bpy.app.handlers.load_pre.remove(_on_load_pre)

@@ -76,14 +76,12 @@ uint32_t prim_of(Key k) { return uint32_t(k); }
 // Returns whether it scattered: always, unless skip_one_digit and the digit is the same for every
 // key (the keys then stay in `from`).
 bool scatter_by_digit(const Key* from, Key* to, size_t n, uint32_t shift, bool skip_one_digit, uint32_t start[257]) {
-  const size_t grain = chunk_size(n);
-  const size_t chunks = (n + grain - 1) / grain;
+  const size_t chunks = chunk_count(n);
   std::vector<uint32_t> first(chunks * 256);
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+  for_each_chunk(n, [&](size_t c, size_t begin, size_t end) {
     uint32_t* count = &first[c * 256];
     std::fill(count, count + 256, 0u);
-    const size_t end = std::min(n, (c + 1) * grain);
-    for (size_t i = c * grain; i < end; ++i) ++count[(from[i] >> shift) & 255u];
+    for (size_t i = begin; i < end; ++i) ++count[(from[i] >> shift) & 255u];
   });
   uint32_t sum = 0;
   bool one_digit = false;
@@ -94,11 +92,10 @@ bool scatter_by_digit(const Key* from, Key* to, size_t n, uint32_t shift, bool s
   }
   start[256] = sum;
   if (skip_one_digit && one_digit) return false;
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+  for_each_chunk(n, [&](size_t c, size_t begin, size_t end) {
     uint32_t next[256];
     std::copy(&first[c * 256], &first[c * 256] + 256, next);
-    const size_t end = std::min(n, (c + 1) * grain);
-    for (size_t i = c * grain; i < end; ++i) to[next[(from[i] >> shift) & 255u]++] = from[i];
+    for (size_t i = begin; i < end; ++i) to[next[(from[i] >> shift) & 255u]++] = from[i];
   });
   return true;
 }
@@ -317,26 +314,18 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
   // Slots and indices are 32-bit (an index rides in the low half of each sort key).
   if (count > size_t(UINT32_MAX)) throw std::length_error("host LBVH: more than 2^32 - 1 primitives");
   leaf_size = std::max(leaf_size, 1u);
-  const size_t grain = chunk_size(count);
-  const size_t chunks = (count + grain - 1) / grain;
-  const BBox centres = tbb::parallel_reduce(
-      tbb::blocked_range<size_t>(0, chunks, 1), BBox{},
-      [&](const tbb::blocked_range<size_t>& r, BBox acc) {
-        for (size_t c = r.begin(); c != r.end(); ++c)
-          for (size_t i = c * grain, end = std::min(count, (c + 1) * grain); i < end; ++i)
-            acc.extend(prim_bounds[i].center());
-        return acc;
-      },
-      [](BBox a, const BBox& b) {
-        a.extend(b);
-        return a;
-      });
+  // The centres' bounds chunk by chunk, combined in chunk order.
+  std::vector<BBox> chunk_centres(chunk_count(count));
+  for_each_chunk(count, [&](size_t c, size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) chunk_centres[c].extend(prim_bounds[i].center());
+  });
+  BBox centres;
+  for (const BBox& b : chunk_centres) centres.extend(b);
   const MortonFrame frame = morton_frame(centres, MortonBits::k30);
   UninitializedArray<Key> a(count), b(count);
   // By fixed chunks (which primitives take the scalar tail does not depend on how TBB splits).
-  tbb::parallel_for(size_t(0), chunks, [&](size_t chunk) {
-    const size_t end = std::min(count, (chunk + 1) * grain);
-    size_t i = chunk * grain;
+  for_each_chunk(count, [&](size_t, size_t begin, size_t end) {
+    size_t i = begin;
     for (; i + kCodeLanes <= end; i += kCodeLanes) {
       const LaneInts codes = morton_codes(prim_bounds + i, frame);
       for (int k = 0; k < kCodeLanes; ++k) a.emplace(i + k, Key(uint32_t(codes[k])) << 32 | (i + k));
@@ -350,8 +339,8 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
   });
   const Key* keys = sort_by_code(a.data(), b.data(), count);
   built.prim_ids.resize(count);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, grain), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i != r.end(); ++i) built.prim_ids[i] = prim_of(keys[i]);
+  for_each_chunk(count, [&](size_t, size_t begin, size_t end) {
+    for (size_t i = begin; i != end; ++i) built.prim_ids[i] = prim_of(keys[i]);
   });
   if (count <= leaf_size) {
     built.wide.root_leaf_first = 0;

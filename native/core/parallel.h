@@ -2,6 +2,7 @@
 // limited to `threads`. Every parallel entry point of the core takes its thread count this way.
 #pragma once
 
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -35,5 +36,16 @@ void run_with_threads(int threads, F&& work) {
 // microseconds). A function of n alone, so the chunks, and all a pass derives from them, do not
 // depend on the thread count.
 inline size_t chunk_size(size_t n) { return std::clamp(n / 8, size_t(2048), size_t(16384)); }
+
+// How many chunks of chunk_size(n) cover [0, n).
+inline size_t chunk_count(size_t n) { return (n + chunk_size(n) - 1) / chunk_size(n); }
+
+// Calls work(chunk, begin, end) for every chunk of [0, n), in parallel; chunk numbers run from 0
+// to chunk_count(n) - 1, so a pass can keep one result a chunk and combine them in order.
+template <class F>
+void for_each_chunk(size_t n, F&& work) {
+  const size_t grain = chunk_size(n);
+  tbb::parallel_for(size_t(0), chunk_count(n), [&](size_t c) { work(c, c * grain, std::min(n, (c + 1) * grain)); });
+}
 
 }  // namespace toyrt

@@ -50,17 +50,15 @@ Mesh::Prepared Mesh::prepare() {
   // commit on a first-generation EPYC.) Nothing is constructed or zeroed beforehand on one
   // thread (UninitializedArray).
   const size_t n = triangles_.size();
-  const size_t grain = chunk_size(n);
-  const size_t chunks = (n + grain - 1) / grain;
+  const size_t chunks = chunk_count(n);
   UninitializedArray<BBox> boxes(n);
   UninitializedArray<uint8_t> keep(n);
   std::vector<uint32_t> offset(chunks + 1, 0u);
   std::vector<BBox> chunk_bounds(chunks);
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-    const size_t end = std::min(n, (c + 1) * grain);
+  for_each_chunk(n, [&](size_t c, size_t begin, size_t end) {
     uint32_t kept = 0;
     BBox hittable_bounds;
-    for (size_t i = c * grain; i < end; ++i) {
+    for (size_t i = begin; i < end; ++i) {
       const Triangle& t = triangles_[i];
       const Vec3 &p0 = vertices_[t.x], &p1 = vertices_[t.y], &p2 = vertices_[t.z];
       BBox b;
@@ -89,9 +87,9 @@ Mesh::Prepared Mesh::prepare() {
   }
   p.boxes = UninitializedArray<BBox>(p.count);
   p.valid = UninitializedArray<uint32_t>(p.count);
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+  for_each_chunk(n, [&](size_t c, size_t begin, size_t end) {
     size_t slot = offset[c];
-    for (size_t i = c * grain, end = std::min(n, (c + 1) * grain); i < end; ++i) {
+    for (size_t i = begin; i < end; ++i) {
       if (!keep[i]) continue;
       p.boxes.emplace(slot, boxes[i]);
       p.valid.emplace(slot++, uint32_t(i));

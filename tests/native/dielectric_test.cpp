@@ -266,7 +266,9 @@ TEST(Dielectric, UncheckedRefractionIsWaltersFormWhereNoMicrofacetRefracts) {
                               (lobe.wo.z * glm::dot(big_h, big_h));
         const double f_cos = double(unchecked.f.x) * std::abs(wi.z);
         EXPECT_NEAR(f_cos, common / (1.0 + lo + li), 1e-4 * (1.0 + common)) << "eta " << eta;
-        if (ggx) EXPECT_NEAR(unchecked.pdf, common / (1.0 + lo), 1e-4 * (1.0 + common)) << "eta " << eta;
+        if (ggx) {
+          EXPECT_NEAR(unchecked.pdf, common / (1.0 + lo), 1e-4 * (1.0 + common)) << "eta " << eta;
+        }
       }
     }
   }

@@ -109,7 +109,9 @@ TEST(PrincipledTransmission, PartialTransmissionDrawsEachPartWithItsWeight) {
         }
         const double share = (1.0 - metallic) * t;
         EXPECT_NEAR(double(glass) / kN, share, 2e-3) << "metallic " << metallic << " t " << t;
-        if (new_model) EXPECT_NEAR(double(metal) / kN, metallic, 2e-3) << "metallic " << metallic << " t " << t;
+        if (new_model) {
+          EXPECT_NEAR(double(metal) / kN, metallic, 2e-3) << "metallic " << metallic << " t " << t;
+        }
         const Vec3 want = float(1.0 - t) * f_opaque / float(kN);
         const Vec3 got = f_sum / float(kN);
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 2e-3f * want[c] + 1e-7f) << "channel " << c;

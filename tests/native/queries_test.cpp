@@ -152,7 +152,9 @@ TEST(ExactCrossing, SharedEdgeIsCrossedByExactlyOneTriangle) {
         const int n =
             int(queries::exact_crossing(r, p[0], p[1], p[2], c)) + queries::exact_crossing(r, p[0], p[2], p[3], c);
         const bool corner = s == 0.0f || s == 1.0f;  // corners (0,0), (1,1) are on the quad's outline
-        if (!corner) EXPECT_EQ(n, 1) << "s=" << s << " dz=" << dz << " tilt=" << tilt;
+        if (!corner) {
+          EXPECT_EQ(n, 1) << "s=" << s << " dz=" << dz << " tilt=" << tilt;
+        }
         EXPECT_LE(n, 1);
       }
 }
@@ -434,7 +436,9 @@ TEST(ListIntersections, HitsComeInRayAndDistanceOrderWithinTheBound) {
     EXPECT_EQ(counts[i] % 2, 0u);  // a line from outside through a closed mesh
     for (int64_t k = hits.offsets[i]; k < hits.offsets[i + 1]; ++k) {
       EXPECT_EQ(hits.ray[size_t(k)], i);
-      if (k > hits.offsets[i]) EXPECT_LE(hits.t[size_t(k) - 1], hits.t[size_t(k)]);
+      if (k > hits.offsets[i]) {
+        EXPECT_LE(hits.t[size_t(k) - 1], hits.t[size_t(k)]);
+      }
     }
   }
   EXPECT_THROW(queries::list_intersections(c.scene, batch, hits.size() - 1), std::length_error);

@@ -206,7 +206,9 @@ TEST(SpotLight, RoundSpotEvaluateAgreesWithSampleAndImportanceNeverHidesLight) {
       ASSERT_TRUE(e.hit());
       EXPECT_NEAR(e.radiance.x, ls.radiance.x, 2e-3f * ls.radiance.x + 1e-7f);
     }
-    if (any) EXPECT_GT(light_importance(light, p, Vec3(0, 0, 1)), 0.0f);
+    if (any) {
+      EXPECT_GT(light_importance(light, p, Vec3(0, 0, 1)), 0.0f);
+    }
   }
 }
 
