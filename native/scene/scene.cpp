@@ -390,48 +390,59 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
 }
 
 template <bool AnyHit, bool ShadowCastersOnly, bool Visibility>
+[[gnu::always_inline]] inline bool Scene::trace_instance(uint32_t id, const Ray& ray, float& t_max, Hit& hit,
+                                                         uint64_t blockers, uint8_t seen_by) const {
+  const Instance& inst = instances_[id];
+  if constexpr (ShadowCastersOnly) {
+    if (!inst.visible_shadow || !in_light_sets(blockers, inst.blocker_set)) return false;
+  }
+  if constexpr (Visibility) {
+    if (!(inst.visibility & seen_by)) return false;
+  }
+  const Mesh& mesh = *meshes_[inst.mesh];
+  Vec3 org = ray.org, dir = ray.dir;
+  if (!inst.identity) {
+    org = Vec3(inst.to_object * glm::vec4(org, 1.0f));
+    dir = glm::mat3(inst.to_object) * dir;
+  }
+  if constexpr (AnyHit) {
+    return mesh.occluded(org, dir, ray.tnear, t_max, inst.identity);
+  } else {
+    if (!mesh.intersect(org, dir, ray.tnear, t_max, hit.u, hit.v, hit.prim, inst.identity)) return false;
+    hit.instance = int32_t(id);
+    return true;
+  }
+}
+
+template <bool AnyHit, bool ShadowCastersOnly, bool Visibility>
 bool Scene::trace(const Ray& ray, Hit& hit, uint64_t blockers, uint8_t seen_by) const {
   if (!is_traceable(ray)) return false;
+  if (!single_identity_) return trace_instances<AnyHit, ShadowCastersOnly, Visibility>(ray, hit, blockers, seen_by);
+  // One untransformed instance (a single mesh): no top level. Kept apart from the top-level walk,
+  // whose stack and registers made this path's every call set up a 1 KB frame (about 40
+  // instructions a ray of the ~1,050 a diffuse ray costs at 10K triangles).
   float tfar = ray.tfar;
-  auto trace_instance = [&](uint32_t id, float& t_max) {
-    const Instance& inst = instances_[id];
-    if constexpr (ShadowCastersOnly) {
-      if (!inst.visible_shadow || !in_light_sets(blockers, inst.blocker_set)) return false;
-    }
-    if constexpr (Visibility) {
-      if (!(inst.visibility & seen_by)) return false;
-    }
-    const Mesh& mesh = *meshes_[inst.mesh];
-    Vec3 org = ray.org, dir = ray.dir;
-    if (!inst.identity) {
-      org = Vec3(inst.to_object * glm::vec4(org, 1.0f));
-      dir = glm::mat3(inst.to_object) * dir;
-    }
-    if constexpr (AnyHit) {
-      return mesh.occluded(org, dir, ray.tnear, t_max, inst.identity);
-    } else {
-      if (!mesh.intersect(org, dir, ray.tnear, t_max, hit.u, hit.v, hit.prim, inst.identity)) return false;
-      hit.instance = int32_t(id);
-      return true;
-    }
-  };
-  bool found;
-  if (single_identity_) {
-    found = trace_instance(0, tfar);
-    if (found) hit.t = tfar;
-    return found;
-  }
+  const bool found = trace_instance<AnyHit, ShadowCastersOnly, Visibility>(0, ray, tfar, hit, blockers, seen_by);
+  if (found) hit.t = tfar;
+  return found;
+}
+
+template <bool AnyHit, bool ShadowCastersOnly, bool Visibility>
+[[gnu::noinline]] bool Scene::trace_instances(const Ray& ray, Hit& hit, uint64_t blockers, uint8_t seen_by) const {
+  float tfar = ray.tfar;
   const RayBoxData box_ray = make_ray_box_data(ray.org, ray.dir);
-  found = traverse<AnyHit>(top_, box_ray, ray.tnear, tfar, [&](uint32_t first, uint32_t count, float& t_max) {
-    bool any = false;
-    for (uint32_t k = first; k < first + count; ++k) {
-      if (trace_instance(top_.prim_ids[k], t_max)) {
-        any = true;
-        if constexpr (AnyHit) return true;
-      }
-    }
-    return any;
-  });
+  const bool found =
+      traverse<AnyHit>(top_, box_ray, ray.tnear, tfar, [&](uint32_t first, uint32_t count, float& t_max) {
+        bool any = false;
+        for (uint32_t k = first; k < first + count; ++k) {
+          if (trace_instance<AnyHit, ShadowCastersOnly, Visibility>(top_.prim_ids[k], ray, t_max, hit, blockers,
+                                                                    seen_by)) {
+            any = true;
+            if constexpr (AnyHit) return true;
+          }
+        }
+        return any;
+      });
   if (found) hit.t = tfar;
   return found;
 }

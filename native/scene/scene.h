@@ -257,6 +257,12 @@ class Scene {
  private:
   template <bool AnyHit, bool ShadowCastersOnly = false, bool Visibility = false>
   bool trace(const Ray& ray, Hit& hit, uint64_t blockers = kAllLightSets, uint8_t seen_by = kVisibleAll) const;
+  // trace()'s walk of the top level (more than one instance, or a transformed one).
+  template <bool AnyHit, bool ShadowCastersOnly, bool Visibility>
+  bool trace_instances(const Ray& ray, Hit& hit, uint64_t blockers, uint8_t seen_by) const;
+  // One instance's part of trace(): its mesh traced in object space within [tnear, t_max).
+  template <bool AnyHit, bool ShadowCastersOnly, bool Visibility>
+  bool trace_instance(uint32_t id, const Ray& ray, float& t_max, Hit& hit, uint64_t blockers, uint8_t seen_by) const;
   Hit intersect_visible(const Ray& ray, uint8_t seen_by) const;
   bool occluded_visible(const Ray& ray, uint8_t seen_by) const;
   bool occluded_by_shadow_casters(const Ray& ray, uint64_t blockers = kAllLightSets) const;
