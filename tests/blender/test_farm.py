@@ -151,10 +151,20 @@ def test_deadline():
     no_opencl = os.path.join(TMP, "no-opencl-vendors")
     os.makedirs(no_opencl, exist_ok=True)
     runs = {}
+    # After each TOYRT frame, the builders of its commit (toyrt.Scene.last_commit), printed by a
+    # render_post handler that the command line adds before -a: the log shows the LBVH ran.
+    said_builders = ("import bpy\n"
+                     "def said(*_):\n"
+                     "    from render_toyrt import render_cache\n"
+                     "    for c in render_cache.render_caches():\n"
+                     "        n = c.scene.last_commit\n"
+                     "        print('toyrt-test: meshes built', n['lbvh_meshes'], 'lbvh', n['sah_meshes'], 'sah')\n"
+                     "bpy.app.handlers.render_post.append(said)\n")
     for engine in ("CYCLES", "TOYRT"):
         blend = build_scene(engine, os.path.join(TMP, f"deadline_{engine}.blend"), builder="lbvh")
         out = os.path.join(TMP, f"deadline_{engine}_out", "frame_####")
-        code, lines = blender(["-b", blend, "-t", "2", "-x", "1", "-o", out, "-s", "1", "-e", "2", "-a"],
+        code, lines = blender(["-b", blend, "-t", "2", "-x", "1", "-o", out, "-s", "1", "-e", "2"]
+                              + (["--python-expr", said_builders] if engine == "TOYRT" else []) + ["-a"],
                               dict(env, OCL_ICD_VENDORS=no_opencl))
         files = [out.replace("####", f"{f:04d}") + ".png" for f in (1, 2)]
         check(code == 0 and all(map(os.path.exists, files)), f"Deadline, {engine}: exit {code}, frames 1-2 written")
@@ -162,6 +172,10 @@ def test_deadline():
     compare("Deadline", runs["TOYRT"], runs["CYCLES"], (1, 2))
     said = [line for line in runs["TOYRT"] if "LBVH" in line or "OpenCL" in line]
     check(not said, f"Deadline: without OpenCL the LBVH builds on the host, with nothing to report: {said[:1]}")
+    built = [line for line in runs["TOYRT"] if line.startswith("toyrt-test: meshes built")]
+    check(built and built[0].endswith(" 0 sah") and not built[0].startswith("toyrt-test: meshes built 0 "),
+          f"Deadline: frame 1's commit built its meshes with the LBVH (on the host), none with SAH: {built[:2]}")
+    MEASURED["Deadline TOYRT builders by frame"] = built
 
 
 def test_exit_codes():

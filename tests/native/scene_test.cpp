@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <limits>
 #include <random>
 
 using namespace toyrt;
@@ -279,6 +280,35 @@ TEST(Scene, RejectsBadTransformsAndIndices) {
   EXPECT_THROW(scene.add_instance(id, nan), std::invalid_argument);
   EXPECT_THROW(scene.add_mesh({{0, 0, 0}}, {{0, 0, 1}}), std::invalid_argument);
   EXPECT_THROW(scene.add_mesh({{0, 0, std::nanf("")}}, {}), std::invalid_argument);
+}
+
+// The mesh is checked chunk by chunk on every core; the error still names the first bad vertex or
+// triangle, whichever chunk finds one first, and a refused mesh adds nothing.
+TEST(Scene, BadMeshErrorNamesTheFirstBadElementOfALargeMesh) {
+  const MeshData m = uv_sphere(200, 200, 1.0f, 0.0f);  // 79,600 triangles: many chunks
+  auto message = [](const std::vector<Vec3>& v, const std::vector<Triangle>& t) {
+    Scene scene;
+    try {
+      scene.add_mesh(v, t);
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(scene.mesh_count(), 0u);
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  std::vector<Vec3> v = m.vertices;
+  v[v.size() - 5].y = std::numeric_limits<float>::infinity();
+  v[30001].x = std::nanf("");
+  v[30002].z = -std::numeric_limits<float>::infinity();
+  EXPECT_EQ(message(v, m.triangles), "vertex 30001 is not finite (NaN or inf)");
+  std::vector<Triangle> t = m.triangles;
+  const uint32_t n = uint32_t(m.vertices.size());
+  t[t.size() - 1].z = n + 7;
+  t[25003].y = n;
+  t[60000].x = n + 1;
+  EXPECT_EQ(message(m.vertices, t),
+            "triangle 25003 indexes a vertex out of range (" + std::to_string(n) + " vertices)");
+  EXPECT_EQ(message(m.vertices, m.triangles), "accepted");
 }
 
 // ---- the scene's policy: shading, materials, lights, commit ----------------------------------
