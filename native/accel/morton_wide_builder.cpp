@@ -6,7 +6,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <stdexcept>
@@ -317,7 +316,9 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
   // The centres' bounds chunk by chunk, combined in chunk order.
   std::vector<BBox> chunk_centres(chunk_count(count));
   for_each_chunk(count, [&](size_t c, size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) chunk_centres[c].extend(prim_bounds[i].center());
+    BBox box;  // a local: the array's element might alias prim_bounds, and shares lines with its neighbours
+    for (size_t i = begin; i < end; ++i) box.extend(prim_bounds[i].center());
+    chunk_centres[c] = box;
   });
   BBox centres;
   for (const BBox& b : chunk_centres) centres.extend(b);

@@ -4,8 +4,8 @@
 # and by Cycles. Every regular expression of those managers' parsers that Cycles' output matches
 # on this Blender must match TOYRT's too; the last Sample line of a frame says N/N; nothing trips
 # Deadline Cloud's strict mode although the scene has what TOYRT approximates (a Principled BSDF,
-# a Diffuse BSDF's roughness) and the SAH builder stands in for a missing OpenCL; the exit codes with and without
-# -E TOYRT where the add-on is missing; the longest silence while a large mesh is exported and
+# a Diffuse BSDF's roughness) and the LBVH builds on the host where OpenCL is missing; the exit codes
+# with and without -E TOYRT where the add-on is missing; the longest silence while a large mesh is exported and
 # its BVH built. The command lines run against a copy of the installed add-on in an empty user
 # folder, as on a fresh farm worker; under the bpy module (no blender executable,
 # TOYRT_NO_BLENDER_BINARY) only the in-process session runs.
@@ -146,19 +146,27 @@ def test_flamenco():
 def test_deadline():
     """Deadline 10's Blender plugin: -t 2 -x 1 -o OUT -s 1 -e 2 -a; for TOYRT without OpenCL
     (OCL_ICD_VENDORS: an empty folder) and the LBVH builder asked for: the host builds it, so the
-    log says nothing about it."""
+    log says nothing about it. The test adds one argument to Deadline's line, a --python-expr
+    before -a whose render_post handler prints each frame's builders (not something Deadline runs:
+    it shows that the LBVH built the mesh)."""
     env = worker("deadline")
     no_opencl = os.path.join(TMP, "no-opencl-vendors")
     os.makedirs(no_opencl, exist_ok=True)
     runs = {}
     # After each TOYRT frame, the builders of its commit (toyrt.Scene.last_commit), printed by a
     # render_post handler that the command line adds before -a: the log shows the LBVH ran.
+    # A failure in the handler is printed by its type's name alone (a traceback's "KeyError:"
+    # line would fail the strict-mode check above with a misleading message).
     said_builders = ("import bpy\n"
                      "def said(*_):\n"
-                     "    from render_toyrt import render_cache\n"
-                     "    for c in render_cache.render_caches():\n"
-                     "        n = c.scene.last_commit\n"
-                     "        print('toyrt-test: meshes built', n['lbvh_meshes'], 'lbvh', n['sah_meshes'], 'sah')\n"
+                     "    try:\n"
+                     "        from render_toyrt import render_cache\n"
+                     "        for c in render_cache.render_caches():\n"
+                     "            n = c.scene.last_commit\n"
+                     "            print('toyrt-test: meshes built', n['lbvh_meshes'], 'lbvh', n['sah_meshes'], 'sah',\n"
+                     "                  flush=True)\n"
+                     "    except BaseException as e:\n"
+                     "        print('toyrt-test: the handler failed:', type(e).__name__, flush=True)\n"
                      "bpy.app.handlers.render_post.append(said)\n")
     for engine in ("CYCLES", "TOYRT"):
         blend = build_scene(engine, os.path.join(TMP, f"deadline_{engine}.blend"), builder="lbvh")

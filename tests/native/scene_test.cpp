@@ -282,10 +282,10 @@ TEST(Scene, RejectsBadTransformsAndIndices) {
   EXPECT_THROW(scene.add_mesh({{0, 0, std::nanf("")}}, {}), std::invalid_argument);
 }
 
-// The mesh is checked chunk by chunk on every core; the error still names the first bad vertex or
-// triangle, whichever chunk finds one first, and a refused mesh adds nothing.
+// The mesh's checks look for a culprit only after a pass without early exits has found one; the
+// error names the first bad vertex or triangle, and a refused mesh adds nothing.
 TEST(Scene, BadMeshErrorNamesTheFirstBadElementOfALargeMesh) {
-  const MeshData m = uv_sphere(200, 200, 1.0f, 0.0f);  // 79,600 triangles: many chunks
+  const MeshData m = uv_sphere(200, 200, 1.0f, 0.0f);  // 79,600 triangles
   auto message = [](const std::vector<Vec3>& v, const std::vector<Triangle>& t) {
     Scene scene;
     try {
@@ -305,6 +305,7 @@ TEST(Scene, BadMeshErrorNamesTheFirstBadElementOfALargeMesh) {
   const uint32_t n = uint32_t(m.vertices.size());
   t[t.size() - 1].z = n + 7;
   t[25003].y = n;
+  t[25004].x = n;
   t[60000].x = n + 1;
   EXPECT_EQ(message(m.vertices, t),
             "triangle 25003 indexes a vertex out of range (" + std::to_string(n) + " vertices)");
