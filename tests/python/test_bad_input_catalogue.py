@@ -89,6 +89,30 @@ def test_negative_index_is_refused():
             "triangle 1 has a negative vertex index")
 
 
+def test_every_index_dtype_gives_the_same_mesh_and_names_the_same_bad_triangle():
+    # Each integer dtype is read as it is (uint32 and int32 in place); whatever the type, the mesh
+    # is the same and a bad index is reported at the first triangle holding one.
+    v, t, org, dirs = random_soup(5, 300, 2000, 500)
+    want = committed((v, t)).intersect(org, dirs)
+    dtypes = (np.int16, np.uint16, np.int32, np.uint32, np.int64, np.uint64, np.dtype(">i4"), np.dtype("<u8"))
+    for dt in dtypes:
+        got = committed((v, t.astype(dt))).intersect(org, dirs)
+        assert np.array_equal(got["prim"], want["prim"]) and np.array_equal(got["t"], want["t"]), dt
+        past = t.astype(dt)
+        past[1500, 2], past[1700, 0] = 300, 299  # 1700 is fine; 1500 names the vertex count
+        refused(lambda: toyrt.Scene().add_mesh(v, past), ValueError,
+                "triangle 1500 indexes a vertex out of range (300 vertices)")
+        if np.dtype(dt).kind == "i":
+            negative = t.astype(dt)
+            negative[1900, 0], negative[1200, 1] = -1, -3
+            refused(lambda: toyrt.Scene().add_mesh(v, negative), ValueError,
+                    "triangle 1200 has a negative vertex index")
+        if np.dtype(dt).itemsize == 8:
+            huge = t.astype(dt)
+            huge[1999, 1], huge[1300, 2] = 2**32 + 1, 2**32
+            refused(lambda: toyrt.Scene().add_mesh(v, huge), ValueError, "triangle 1300 has an index out of range")
+
+
 def test_float_indices_are_refused_as_not_integers():
     refused(lambda: toyrt.Scene().add_mesh(TRI_V, TRI_T.astype(np.float32)), TypeError,
             "triangles must be an integer array")
