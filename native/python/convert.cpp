@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <set>
+#include <type_traits>
 
 namespace toyrt::binding {
 
@@ -80,24 +81,34 @@ namespace {
 // 2M-triangle add_mesh's ms); the culprit is looked for only when one of them is out of range.
 template <class T>
 std::vector<Triangle> indices_to_triangles(py::handle a, size_t m) {
-  static_assert(sizeof(Triangle) == 3 * sizeof(uint32_t), "Triangle: three packed indices");
+  static_assert(sizeof(Triangle) == 3 * sizeof(uint32_t) && std::is_trivially_copyable_v<Triangle>,
+                "Triangle: three packed indices");
   const auto idx = contiguous<T>(a, "triangles");
   const T* p = idx.data();
   std::vector<Triangle> out(m);
-  uint32_t* o = reinterpret_cast<uint32_t*>(out.data());
+  char* bytes = reinterpret_cast<char*>(out.data());  // written index by index as bytes
   T lo = 0, hi = 0;
   for (size_t i = 0; i < 3 * m; ++i) {
     lo = std::min(lo, p[i]);
     hi = std::max(hi, p[i]);
-    o[i] = uint32_t(p[i]);
+    const uint32_t index = uint32_t(p[i]);
+    std::memcpy(bytes + i * sizeof(uint32_t), &index, sizeof index);
   }
-  if (lo < T(0) || uint64_t(hi) > UINT32_MAX)
+  // Each test only where the type can fail it (for uint32, neither).
+  bool bad = false;
+  if constexpr (std::is_signed_v<T>) bad |= lo < 0;
+  if constexpr (sizeof(T) > sizeof(uint32_t)) bad |= uint64_t(hi) > UINT32_MAX;
+  if (bad)
     for (size_t i = 0; i < m; ++i)
       for (int k = 0; k < 3; ++k) {
         const T v = p[3 * i + k];
-        if (v < T(0)) throw py::value_error("triangle " + std::to_string(i) + " has a negative vertex index");
-        if (uint64_t(v) > UINT32_MAX)
-          throw py::value_error("triangle " + std::to_string(i) + " has an index out of range");
+        if constexpr (std::is_signed_v<T>) {
+          if (v < 0) throw py::value_error("triangle " + std::to_string(i) + " has a negative vertex index");
+        }
+        if constexpr (sizeof(T) > sizeof(uint32_t)) {
+          if (uint64_t(v) > UINT32_MAX)
+            throw py::value_error("triangle " + std::to_string(i) + " has an index out of range");
+        }
       }
   return out;
 }

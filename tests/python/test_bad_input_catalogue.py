@@ -94,22 +94,24 @@ def test_every_index_dtype_gives_the_same_mesh_and_names_the_same_bad_triangle()
     # is the same and a bad index is reported at the first triangle holding one.
     v, t, org, dirs = random_soup(5, 300, 2000, 500)
     want = committed((v, t)).intersect(org, dirs)
-    dtypes = (np.int16, np.uint16, np.int32, np.uint32, np.int64, np.uint64, np.dtype(">i4"), np.dtype("<u8"))
+    dtypes = (np.int16, np.uint16, np.int32, np.uint32, np.int64, np.uint64, np.dtype(">i4"), np.dtype(">u8"))
     for dt in dtypes:
-        got = committed((v, t.astype(dt))).intersect(org, dirs)
-        assert np.array_equal(got["prim"], want["prim"]) and np.array_equal(got["t"], want["t"]), dt
+        for layout in (t.astype(dt), np.asfortranarray(t.astype(dt)), np.repeat(t.astype(dt), 2, axis=0)[::2]):
+            got = committed((v, layout)).intersect(org, dirs)
+            assert np.array_equal(got["prim"], want["prim"]) and np.array_equal(got["t"], want["t"]), dt
+        assert committed((v, np.zeros((0, 3), dt))).triangle_count == 0
         past = t.astype(dt)
         past[1500, 2], past[1700, 0] = 300, 299  # 1700 is fine; 1500 names the vertex count
         refused(lambda: toyrt.Scene().add_mesh(v, past), ValueError,
                 "triangle 1500 indexes a vertex out of range (300 vertices)")
         if np.dtype(dt).kind == "i":
             negative = t.astype(dt)
-            negative[1900, 0], negative[1200, 1] = -1, -3
+            negative[1900, 0], negative[1200, 1] = -3, -1  # the first, not the smallest
             refused(lambda: toyrt.Scene().add_mesh(v, negative), ValueError,
                     "triangle 1200 has a negative vertex index")
         if np.dtype(dt).itemsize == 8:
             huge = t.astype(dt)
-            huge[1999, 1], huge[1300, 2] = 2**32 + 1, 2**32
+            huge[1999, 1], huge[1300, 2] = 2**32 + 1, 2**32  # the first, not the largest
             refused(lambda: toyrt.Scene().add_mesh(v, huge), ValueError, "triangle 1300 has an index out of range")
 
 
