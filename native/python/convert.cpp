@@ -76,9 +76,9 @@ std::vector<Vec3> to_vec3s(const FloatArray& a) {
 
 namespace {
 // m triangles' indices of type T (read in place where the array already is C-contiguous T),
-// copied in one loop without early exits that also finds the smallest and largest index (so it
-// runs at memory speed: the former check of each index, converted to int64, took 30-40 of a
-// 2M-triangle add_mesh's ms); the culprit is looked for only when one of them is out of range.
+// copied in one loop without early exits that also finds the smallest and largest index (a
+// 2M-triangle add_mesh with int32 or uint32 indices: 30 ms when every index was converted to
+// int64 and checked by a branch, 17 now); the culprit is looked for only when one is out of range.
 template <class T>
 std::vector<Triangle> indices_to_triangles(py::handle a, size_t m) {
   static_assert(sizeof(Triangle) == 3 * sizeof(uint32_t) && std::is_trivially_copyable_v<Triangle>,
