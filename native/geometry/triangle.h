@@ -36,20 +36,23 @@ inline WatertightRay make_watertight_ray(const Vec3& org, const Vec3& dir) {
   return r;
 }
 
-// Bound on the rounding error of the scaled distance T computed below (the derivation of pbrt-v4,
-// section 6.8.4: errors of the translated and sheared coordinates, then of the edge functions,
-// then of their weighted sum). A hit whose T is within this bound of tnear may really be behind
-// the ray's start; those few are decided in double.
-inline float near_start_error(float ax, float ay, float bx, float by, float cx, float cy, float az, float bz, float cz,
-                              float eu, float ev, float ew) {
-  const float max_z = std::max({std::fabs(az), std::fabs(bz), std::fabs(cz)});
-  const float max_x = std::max({std::fabs(ax), std::fabs(bx), std::fabs(cx)});
-  const float max_y = std::max({std::fabs(ay), std::fabs(by), std::fabs(cy)});
-  const float max_e = std::max({std::fabs(eu), std::fabs(ev), std::fabs(ew)});
-  const float delta_z = gamma(3) * max_z;
-  const float delta_x = gamma(5) * (max_x + max_z), delta_y = gamma(5) * (max_y + max_z);
-  const float delta_e = 2.0f * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
-  return 3.0f * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e);
+// Bound on the rounding error of the scaled distance T computed below. pbrt-v4's derivation
+// (section 6.8.4: errors of the translated and sheared coordinates, then of the edge functions,
+// then of their weighted sum) gives 3 (g3 E Z + de Z + dz E) with dz = g3 Z, dx = g5 (X + Z),
+// dy = g5 (Y + Z), de = 2 (g2 X Y + dy X + dx Y), where X, Y, Z and E are the largest magnitudes of
+// the sheared x, y, z and of the edge functions, and gN = gamma(N). The bound only grows with each
+// of them, so larger stand-ins keep it conservative, and two are cheaper (the block test computes
+// this for eight lanes at every leaf a ray leaves): M = max(X, Y) for both X and Y, and |det| for E
+// (a candidate's edge functions share one sign, so their float sum is at least as large as each:
+// rounding is monotone). That is 3 Z (2 g3 |det| + 2 g2 M^2 + 4 g5 (M + Z) M). Its own float
+// evaluation (a dozen operations on non-negative values, each rounded by at most 2^-24) is
+// covered by rounding the factor 3 up by 2^-18. A T within the bound of tnear may really be behind
+// the ray's start; those few are decided in double. F is float or a vector of floats.
+template <class F>
+inline F near_start_error(F max_xy, F max_z, F abs_det) {
+  constexpr float three = 3.0f * (1.0f + 0x1p-18f);
+  const F edge_error = (2.0f * gamma(2)) * max_xy * max_xy + (4.0f * gamma(5)) * (max_xy + max_z) * max_xy;
+  return (three * max_z) * ((2.0f * gamma(3)) * abs_det + edge_error);
 }
 
 // The hit test for a candidate whose float distance is too close to tnear to trust: the plane
@@ -120,7 +123,10 @@ inline float near_start_error(float ax, float ay, float bx, float by, float cx, 
   const float signed_t = det < 0.0f ? -scaled_t : scaled_t;
   if (!(signed_t < tfar * abs_det)) return false;
   const float past_start = signed_t - tnear * abs_det;
-  const float error = near_start_error(ax, ay, bx, by, cx, cy, az, bz, cz, eu, ev, ew);
+  const float max_xy =
+      std::max({std::fabs(ax), std::fabs(bx), std::fabs(cx), std::fabs(ay), std::fabs(by), std::fabs(cy)});
+  const float max_z = std::max({std::fabs(az), std::fabs(bz), std::fabs(cz)});
+  const float error = near_start_error(max_xy, max_z, abs_det);
   if (!(past_start > error)) {
     // As far before tnear as the bound: surely behind the start (the same bound as the accept).
     if (past_start < -error) return false;

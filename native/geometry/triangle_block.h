@@ -106,13 +106,8 @@ template <bool AnyHit, class OnHit>
 
   // near_start_error of triangle.h, lane-wise.
   const vfloat max_z = max(max(abs(z[0]), abs(z[1])), abs(z[2]));
-  const vfloat max_x = max(max(abs(x[0]), abs(x[1])), abs(x[2]));
-  const vfloat max_y = max(max(abs(y[0]), abs(y[1])), abs(y[2]));
-  const vfloat max_e = max(max(abs(eu), abs(ev)), abs(ew));
-  const vfloat delta_x = splat(gamma(5)) * (max_x + max_z), delta_y = splat(gamma(5)) * (max_y + max_z);
-  const vfloat delta_e = splat(2.0f) * (splat(gamma(2)) * max_x * max_y + delta_y * max_x + delta_x * max_y);
-  const vfloat error =
-      splat(3.0f) * (splat(gamma(3)) * max_e * max_z + delta_e * max_z + splat(gamma(3)) * max_z * max_e);
+  const vfloat max_xy = max(max(max(abs(x[0]), abs(x[1])), abs(x[2])), max(max(abs(y[0]), abs(y[1])), abs(y[2])));
+  const vfloat error = near_start_error(max_xy, max_z, abs_det);
   const vfloat past_start = signed_t - splat(tnear) * abs_det;
   const vint clear_of_start = past_start > error;
   // As far before the start as clear_of_start is after it (the same bound, so as sure): a miss in

@@ -80,3 +80,110 @@ TEST(Triangle, SharedEdgeNeverLetsARayThrough) {
   }
   EXPECT_EQ(misses, 0);
 }
+
+namespace {
+
+// The float quantities of intersect_triangle for one ray and triangle, computed as it does, with
+// the magnitudes the near-start bound takes.
+struct ScaledDistance {
+  bool candidate = false;  // the edge functions share one sign, none zero
+  float signed_t = 0, abs_det = 0, max_xy = 0, max_z = 0;
+  double pbrt_bound = 0;  // pbrt-v4's bound from the largest x, y, z and edge function, in double
+  long double exact_signed_t = 0;
+};
+
+ScaledDistance scaled_distance(const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+  ScaledDistance s;
+  const Vec3 p[3] = {p0, p1, p2};
+  float x[3], y[3], z[3];
+  long double xe[3], ye[3], ze[3];  // the same transform without rounding (long double's 64 bits)
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 a = p[k] - r.org;
+    x[k] = a[r.kx] - r.sx * a[r.kz];
+    y[k] = a[r.ky] - r.sy * a[r.kz];
+    z[k] = r.sz * a[r.kz];
+    const long double ax = (long double)p[k][r.kx] - r.org[r.kx], ay = (long double)p[k][r.ky] - r.org[r.ky],
+                      az = (long double)p[k][r.kz] - r.org[r.kz];
+    xe[k] = ax - (long double)r.sx * az;
+    ye[k] = ay - (long double)r.sy * az;
+    ze[k] = (long double)r.sz * az;
+  }
+  const float e[3] = {x[2] * y[1] - y[2] * x[1], x[0] * y[2] - y[0] * x[2], x[1] * y[0] - y[1] * x[0]};
+  const long double ee[3] = {xe[2] * ye[1] - ye[2] * xe[1], xe[0] * ye[2] - ye[0] * xe[2],
+                             xe[1] * ye[0] - ye[1] * xe[0]};
+  const bool all_positive = e[0] > 0 && e[1] > 0 && e[2] > 0, all_negative = e[0] < 0 && e[1] < 0 && e[2] < 0;
+  s.candidate = all_positive || all_negative;
+  const float det = e[0] + e[1] + e[2];
+  const float scaled_t = e[0] * z[0] + e[1] * z[1] + e[2] * z[2];
+  s.abs_det = std::fabs(det);
+  s.signed_t = det < 0 ? -scaled_t : scaled_t;
+  const long double exact_t = ee[0] * ze[0] + ee[1] * ze[1] + ee[2] * ze[2];
+  s.exact_signed_t = det < 0 ? -exact_t : exact_t;
+  double mx = 0, my = 0, mz = 0, me = 0;
+  for (int k = 0; k < 3; ++k) {
+    mx = std::max(mx, double(std::fabs(x[k])));
+    my = std::max(my, double(std::fabs(y[k])));
+    mz = std::max(mz, double(std::fabs(z[k])));
+    me = std::max(me, double(std::fabs(e[k])));
+  }
+  s.max_xy = float(std::max(mx, my));
+  s.max_z = float(mz);
+  const double g2 = gamma(2), g3 = gamma(3), g5 = gamma(5);
+  const double dz = g3 * mz, dx = g5 * (mx + mz), dy = g5 * (my + mz);
+  const double de = 2 * (g2 * mx * my + dy * mx + dx * my);
+  s.pbrt_bound = 3 * (g3 * me * mz + de * mz + dz * me);
+  return s;
+}
+
+// Rays that start on or near a random triangle (as rays leaving a surface do), at scales from
+// 1e-4 to 1e4 and up to a thousand triangle sizes from the origin: the cases near_start_error
+// decides.
+template <class Check>
+void for_rays_leaving_triangles(Check&& check) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f), sym(-1.0f, 1.0f);
+  for (int i = 0; i < 200000; ++i) {
+    const float scale = std::pow(10.0f, float(i % 9) - 4.0f);
+    const Vec3 centre = scale * std::pow(10.0f, 3.0f * unit(rng)) * Vec3(sym(rng), sym(rng), sym(rng));
+    const Vec3 p0 = centre + scale * Vec3(sym(rng), sym(rng), sym(rng));
+    const Vec3 p1 = centre + scale * Vec3(sym(rng), sym(rng), sym(rng));
+    const Vec3 p2 = centre + scale * Vec3(sym(rng), sym(rng), sym(rng));
+    const float a = unit(rng), b = unit(rng) * (1 - a);
+    const Vec3 on = p0 + a * (p1 - p0) + b * (p2 - p0);
+    const Vec3 org = on + scale * std::pow(10.0f, -6.0f * unit(rng)) * Vec3(sym(rng), sym(rng), sym(rng));
+    const Vec3 dir(sym(rng), sym(rng), sym(rng));
+    if (dir == Vec3(0.0f)) continue;
+    check(make_watertight_ray(org, dir), p0, p1, p2);
+  }
+}
+
+}  // namespace
+
+// near_start_error replaces pbrt's largest x, y and edge function by larger stand-ins; it must
+// never come out below pbrt's bound (evaluated here in double from the same float inputs).
+TEST(Triangle, NearStartErrorIsAtLeastPbrtsBound) {
+  int candidates = 0;
+  for_rays_leaving_triangles([&](const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+    const ScaledDistance s = scaled_distance(r, p0, p1, p2);
+    if (!s.candidate) return;
+    ++candidates;
+    ASSERT_GE(double(near_start_error(s.max_xy, s.max_z, s.abs_det)), s.pbrt_bound);
+  });
+  EXPECT_GT(candidates, 50000);
+}
+
+// The property the bound is for: the float scaled distance lies within it of the one computed
+// from the same inputs without rounding, so a hit it calls clear of tnear is.
+TEST(Triangle, NearStartErrorBoundsTheScaledDistancesRounding) {
+  int candidates = 0, near_zero = 0;
+  for_rays_leaving_triangles([&](const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+    const ScaledDistance s = scaled_distance(r, p0, p1, p2);
+    if (!s.candidate) return;
+    ++candidates;
+    const float error = near_start_error(s.max_xy, s.max_z, s.abs_det);
+    if (std::fabs(s.signed_t) <= error) ++near_zero;
+    ASSERT_LE(std::fabs((long double)s.signed_t - s.exact_signed_t), (long double)error);
+  });
+  EXPECT_GT(candidates, 50000);
+  EXPECT_GT(near_zero, 0);  // the set reaches the bound's edge
+}
