@@ -29,8 +29,16 @@ using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>
 // this raises MemoryError naming `name` instead, and TypeError for an array that holds no numbers.
 template <class T>
 py::array_t<T, py::array::c_style | py::array::forcecast> contiguous(py::handle a, const char* name) {
-  auto out = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
+  using Array = py::array_t<T, py::array::c_style | py::array::forcecast>;
+  Array out = Array::ensure(a);
   if (!out) throw_copy_failed(a, name);
+  // numpy calls a view C-contiguous at any address (np.frombuffer at an odd offset, a field of a
+  // packed record), and ensure() passes it through; the core reads T through T pointers, which
+  // must be aligned (a vectorised loop may assume it), so such a view is copied (numpy aligns it).
+  if (reinterpret_cast<uintptr_t>(out.data()) % alignof(T) != 0) {
+    out = Array::ensure(out.attr("copy")());
+    if (!out) throw_copy_failed(a, name);
+  }
   return out;
 }
 

@@ -1,10 +1,7 @@
 #include "python/py_scene.h"
 
 #include "python/convert.h"
-#include "render/renderer.h"
 
-#include <algorithm>
-#include <cstring>
 #include <mutex>
 #include <utility>
 #include <vector>
