@@ -146,7 +146,10 @@ template <bool AnyHit, class OnHit>
     }
     return false;
   };
-  if (lane_by_lane(near_start, near_start_in_double) || lane_by_lane(scalar, intersect_triangle)) return true;
+  // intersect_triangle through a lambda: as a function pointer it is an indirect call, which GCC
+  // cannot inline (always_inline) below -O2, and Debug and -O1 builds failed to compile.
+  const auto whole_test = [](auto&&... args) { return intersect_triangle(args...); };
+  if (lane_by_lane(near_start, near_start_in_double) || lane_by_lane(scalar, whole_test)) return true;
   return any;
 }
 
