@@ -14,6 +14,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -35,10 +36,7 @@ py::array_t<T, py::array::c_style | py::array::forcecast> contiguous(py::handle 
   // numpy calls a view C-contiguous at any address (np.frombuffer at an odd offset, a field of a
   // packed record), and ensure() passes it through; the core reads T through T pointers, which
   // must be aligned (a vectorised loop may assume it), so such a view is copied (numpy aligns it).
-  if (reinterpret_cast<uintptr_t>(out.data()) % alignof(T) != 0) {
-    out = Array::ensure(out.attr("copy")());
-    if (!out) throw_copy_failed(a, name);
-  }
+  if (reinterpret_cast<uintptr_t>(out.data()) % alignof(T) != 0) out = Array::ensure(out.attr("copy")());
   return out;
 }
 

@@ -136,8 +136,8 @@ ScaledDistance scaled_distance(const WatertightRay& r, const Vec3& p0, const Vec
 }
 
 // Rays that start on or near a random triangle (as rays leaving a surface do), at scales from
-// 1e-4 to 1e4 and up to a thousand triangle sizes from the origin: the cases near_start_error
-// decides.
+// 1e-4 to 1e4, up to a thousand triangle sizes from the origin, with directions of any length:
+// the cases near_start_error decides.
 template <class Check>
 void for_rays_leaving_triangles(Check&& check) {
   std::mt19937 rng(11);
@@ -151,7 +151,9 @@ void for_rays_leaving_triangles(Check&& check) {
     const float a = unit(rng), b = unit(rng) * (1 - a);
     const Vec3 on = p0 + a * (p1 - p0) + b * (p2 - p0);
     const Vec3 org = on + scale * std::pow(10.0f, -6.0f * unit(rng)) * Vec3(sym(rng), sym(rng), sym(rng));
-    const Vec3 dir(sym(rng), sym(rng), sym(rng));
+    // Directions are not normalised (a mesh traces the object-space direction an instance's
+    // matrix gives it): lengths from 1e-3 to 1e3.
+    const Vec3 dir = std::pow(10.0f, float(i % 7) - 3.0f) * Vec3(sym(rng), sym(rng), sym(rng));
     if (dir == Vec3(0.0f)) continue;
     check(make_watertight_ray(org, dir), p0, p1, p2);
   }
@@ -162,28 +164,32 @@ void for_rays_leaving_triangles(Check&& check) {
 // near_start_error replaces pbrt's largest x, y and edge function by larger stand-ins; it must
 // never come out below pbrt's bound (evaluated here in double from the same float inputs).
 TEST(Triangle, NearStartErrorIsAtLeastPbrtsBound) {
-  int candidates = 0;
+  int candidates = 0, below = 0;
   for_rays_leaving_triangles([&](const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2) {
     const ScaledDistance s = scaled_distance(r, p0, p1, p2);
     if (!s.candidate) return;
     ++candidates;
-    ASSERT_GE(double(near_start_error(s.max_xy, s.max_z, s.abs_det)), s.pbrt_bound);
+    if (double(near_start_error(s.max_xy, s.max_z, s.abs_det)) < s.pbrt_bound) ++below;
   });
   EXPECT_GT(candidates, 50000);
+  EXPECT_EQ(below, 0);
 }
 
 // The property the bound is for: the float scaled distance lies within it of the one computed
-// from the same inputs without rounding, so a hit it calls clear of tnear is.
+// from the same inputs without rounding, so at tnear = 0 a hit it calls clear of the start is.
+// (For tnear > 0 the test compares T with tnear |det|, whose rounding this bound does not cover;
+// the bound's measured slack, 20-100x here, does, unproven.)
 TEST(Triangle, NearStartErrorBoundsTheScaledDistancesRounding) {
-  int candidates = 0, near_zero = 0;
+  int candidates = 0, near_zero = 0, outside = 0;
   for_rays_leaving_triangles([&](const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2) {
     const ScaledDistance s = scaled_distance(r, p0, p1, p2);
     if (!s.candidate) return;
     ++candidates;
     const float error = near_start_error(s.max_xy, s.max_z, s.abs_det);
     if (std::fabs(s.signed_t) <= error) ++near_zero;
-    ASSERT_LE(std::fabs((long double)s.signed_t - s.exact_signed_t), (long double)error);
+    if (std::fabs((long double)s.signed_t - s.exact_signed_t) > (long double)error) ++outside;
   });
+  EXPECT_EQ(outside, 0);
   EXPECT_GT(candidates, 50000);
   EXPECT_GT(near_zero, 0);  // the set reaches the bound's edge
 }

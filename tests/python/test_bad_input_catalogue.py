@@ -174,8 +174,11 @@ def test_misaligned_arrays_give_the_answers_of_aligned_ones():
     # `make sanitize` stops at the first); the module copies them instead.
     v, t, org, dirs = random_soup(8, 60, 80, 500)
     t32 = t.astype(np.int32)
-    a = committed((v, t32)).intersect(org, dirs)
-    b = committed((misaligned(v), misaligned(t32))).intersect(misaligned(org), misaligned(dirs))
+    tnear = np.linspace(0.0, 0.5, len(org), dtype=np.float32)
+    tfar = np.linspace(2.0, 4.0, len(org), dtype=np.float32)
+    a = committed((v, t32)).intersect(org, dirs, tnear=tnear, tfar=tfar)
+    b = committed((misaligned(v), misaligned(t32))).intersect(misaligned(org), misaligned(dirs),
+                                                              tnear=misaligned(tnear), tfar=misaligned(tfar))
     assert np.any(a["prim"] >= 0)
     for key in a:
         np.testing.assert_array_equal(a[key], b[key])
