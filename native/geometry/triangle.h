@@ -46,13 +46,22 @@ inline WatertightRay make_watertight_ray(const Vec3& org, const Vec3& dir) {
 // (a candidate's edge functions share one sign, so their float sum is at least as large as each:
 // rounding is monotone). That is 3 Z (2 g3 |det| + 2 g2 M^2 + 4 g5 (M + Z) M). Its own float
 // evaluation (a dozen operations on non-negative values, each rounded by at most 2^-24) is
-// covered by rounding the factor 3 up by 2^-18. A T within the bound of tnear may really be behind
-// the ray's start; those few are decided in double. F is float or a vector of floats.
+// covered by rounding the factor 3 up by 2^-18.
+// pbrt's bound is for tnear = 0, where only the signs of T and det matter. The test compares T
+// with tnear |det|, so for tnear != 0 (never the renderer's rays, whose tnear is 0) det's own error
+// counts too: three edge functions, each within the edge error above, two sums and the product
+// with tnear: |tnear| (3 de + g4 |det|), with the same rounding up (which also covers the
+// subtraction's rounding of T - tnear |det|: one 2^-24 of a value near the bound). The term is
+// added whatever tnear (0 when it is 0; a branch on tnear cost as much). Where a product overflows
+// the bound is infinite or NaN, and every comparison with it sends the lane to double.
+// A T within the bound of tnear |det| may really be on the other side of the ray's start; those
+// few are decided in double. F is float or a vector of floats.
 template <class F>
-inline F near_start_error(F max_xy, F max_z, F abs_det) {
+inline F near_start_error(F max_xy, F max_z, F abs_det, float tnear) {
   constexpr float three = 3.0f * (1.0f + 0x1p-18f);
   const F edge_error = (2.0f * gamma(2)) * max_xy * max_xy + (4.0f * gamma(5)) * (max_xy + max_z) * max_xy;
-  return (three * max_z) * ((2.0f * gamma(3)) * abs_det + edge_error);
+  return (three * max_z) * ((2.0f * gamma(3)) * abs_det + edge_error) +
+         (three * std::fabs(tnear)) * (edge_error + (gamma(5) / 3.0f) * abs_det);
 }
 
 // The hit test for a candidate whose float distance is too close to tnear to trust: the plane
@@ -126,7 +135,7 @@ inline F near_start_error(F max_xy, F max_z, F abs_det) {
   const float max_xy =
       std::max({std::fabs(ax), std::fabs(bx), std::fabs(cx), std::fabs(ay), std::fabs(by), std::fabs(cy)});
   const float max_z = std::max({std::fabs(az), std::fabs(bz), std::fabs(cz)});
-  const float error = near_start_error(max_xy, max_z, abs_det);
+  const float error = near_start_error(max_xy, max_z, abs_det, tnear);
   if (!(past_start > error)) {
     // As far before tnear as the bound: surely behind the start (the same bound as the accept).
     if (past_start < -error) return false;

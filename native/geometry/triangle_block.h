@@ -107,7 +107,7 @@ template <bool AnyHit, class OnHit>
   // near_start_error of triangle.h, lane-wise.
   const vfloat max_z = max(max(abs(z[0]), abs(z[1])), abs(z[2]));
   const vfloat max_xy = max(max(max(abs(x[0]), abs(x[1])), abs(x[2])), max(max(abs(y[0]), abs(y[1])), abs(y[2])));
-  const vfloat error = near_start_error(max_xy, max_z, abs_det);
+  const vfloat error = near_start_error(max_xy, max_z, abs_det, tnear);
   const vfloat past_start = signed_t - splat(tnear) * abs_det;
   const vint clear_of_start = past_start > error;
   // As far before the start as clear_of_start is after it (the same bound, so as sure): a miss in
