@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -110,6 +111,7 @@ class Builder {
         subtree_nodes_(2 * count - 1) {
     cfg_.bins = std::clamp(cfg_.bins, 2, kMaxBins);
     cfg_.max_leaf = std::max(cfg_.max_leaf, 1u);
+    several_threads_ = tbb::this_task_arena::max_concurrency() > 1;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 16384), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t i = r.begin(); i != r.end(); ++i) refs_.emplace(i, PrimRef::of(bounds[i], uint32_t(i)));
     });
@@ -333,7 +335,7 @@ class Builder {
     uint32_t left_nodes = 0, right_nodes = 0;
     auto build_left = [&] { left_nodes = build(left, begin, mid, range_bounds(begin, mid), depth + 1); };
     auto build_right = [&] { right_nodes = build(left + 1, mid, end, range_bounds(mid, end), depth + 1); };
-    if (n >= cfg_.parallel_threshold) {
+    if (n >= cfg_.task_threshold && several_threads_) {
       tbb::parallel_invoke(build_left, build_right);
     } else {
       build_left();
@@ -397,6 +399,7 @@ class Builder {
   }
 
   BinnedSahConfig cfg_;
+  bool several_threads_ = false;  // the arena the build runs on has more than one thread
   size_t count_;
   UninitializedArray<PrimRef> refs_;  // written in parallel by the constructor
   // Written before read, node by node, so not zeroed: 2n - 1 nodes is the bound (64 MB at a
