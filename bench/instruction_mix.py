@@ -1,0 +1,147 @@
+"""What a traced ray executes, instruction by instruction, in TOYRT and in Embree: the per-ray
+instruction counts of one ray set by kind (general-purpose, 128-bit xmm, 256-bit ymm vector
+instructions) and mnemonic, from valgrind's callgrind (exact counts, unlike timings on a shared
+machine). Zen 1 and other CPUs with 128-bit vector units split every ymm instruction in two, so the
+mix says more about the time there than the instruction total does (docs/trace-speed.md).
+
+    python3 bench/instruction_mix.py build/bench/trace_only [diffuse|primary|shadow] [rings] [room]
+
+Needs valgrind (apt-get install valgrind) and objdump. Each engine runs the set once and three
+times; the difference over the extra rays is what a ray costs, without the scene's build and the
+ray generation. TOYRT is counted inside Mesh::trace and Scene's tracing functions, Embree inside
+libembree3.
+"""
+import argparse
+import collections
+import re
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+
+def costs_by_address(profile, keep):
+    """Instruction counts per (object, address) from a callgrind profile written with
+    --dump-instr=yes, for the functions and objects `keep(object, function)` accepts. Inclusive
+    cost lines of calls are skipped, so each address holds its own instructions only."""
+    names = {"ob": {}, "fn": {}}
+    obj = fn = ""
+    address = 0
+    after_calls = False
+    counts = collections.Counter()
+    for line in Path(profile).read_text().splitlines():
+        m = re.match(r"(c?)(ob|fn)=\((\d+)\)(?: (.*))?$", line)
+        if m:
+            table = names[m.group(2)]
+            if m.group(4):
+                table[m.group(3)] = m.group(4)
+            if not m.group(1):  # ob= / fn= set the current position; cob= / cfn= name a callee
+                if m.group(2) == "ob":
+                    obj = table[m.group(3)]
+                else:
+                    fn = table[m.group(3)]
+            continue
+        if line.startswith("calls="):
+            after_calls = True
+            continue
+        if not line or line[0] not in "+-*0123456789":
+            continue
+        fields = line.split()
+        token = fields[0]
+        if token[0] == "+":
+            address += int(token[1:], 0)
+        elif token[0] == "-":
+            address -= int(token[1:], 0)
+        elif token != "*":
+            address = int(token, 0)
+        if after_calls:
+            after_calls = False
+            continue
+        if len(fields) > 2 and keep(obj, fn):
+            counts[(obj, address)] += int(fields[-1])
+    return counts
+
+
+def disassemble(obj, addresses):
+    """objdump's text of the instructions at `addresses` of `obj` (file addresses, as callgrind
+    reports them for shared objects and position-independent executables)."""
+    text = {}
+    spans = []
+    for a in sorted(addresses):
+        if spans and a - spans[-1][1] < 4096:
+            spans[-1][1] = a
+        else:
+            spans.append([a, a])
+    for lo, hi in spans:
+        out = subprocess.run(["objdump", "-d", "--no-show-raw-insn", f"--start-address={lo:#x}",
+                              f"--stop-address={hi + 16:#x}", obj], capture_output=True, text=True, check=True).stdout
+        for line in out.splitlines():
+            m = re.match(r"\s*([0-9a-f]+):\s*(\S.*)$", line)
+            if m:
+                text[int(m.group(1), 16)] = m.group(2)
+    return text
+
+
+def kind_of(instruction):
+    mnemonic, _, operands = instruction.partition(" ")
+    if "%ymm" in operands or "%zmm" in operands:
+        return mnemonic, "ymm"
+    if "%xmm" in operands:
+        return mnemonic, "xmm"
+    return mnemonic, "general"
+
+
+def mix(trace_only, ray_set, rings, extra, engine):
+    keep_toyrt = lambda obj, fn: "trace_only" in obj and ("Mesh::trace" in fn or "Scene::" in fn)  # noqa: E731
+    keep_embree = lambda obj, fn: "libembree" in obj  # noqa: E731
+    keep = keep_embree if engine == "embree" else keep_toyrt
+    args = [str(trace_only), ray_set, str(rings)]
+    with tempfile.TemporaryDirectory() as tmp:
+        counts = []
+        for repeats in (1, 3):
+            profile = f"{tmp}/callgrind.{repeats}"
+            run = args + [str(repeats)] + ([engine] if engine == "embree" else extra)
+            valgrind = ["valgrind", "--tool=callgrind", "--dump-instr=yes", f"--callgrind-out-file={profile}"]
+            subprocess.run(valgrind + run, capture_output=True, check=True)
+            counts.append(costs_by_address(profile, keep))
+        report = subprocess.run(args + ["1"] + ([engine] if engine == "embree" else extra), capture_output=True,
+                                text=True, check=True).stdout
+    rays = int(re.search(r"(\d+) rays", report).group(1)) * 2  # the extra two repeats
+    per_ray = {k: (counts[1][k] - counts[0].get(k, 0)) / rays for k in counts[1]}
+    by_kind, by_mnemonic = collections.Counter(), collections.Counter()
+    for obj in {o for o, _ in per_ray}:
+        addresses = [a for o, a in per_ray if o == obj]
+        text = disassemble(obj, addresses)
+        for a in addresses:
+            if a in text:
+                mnemonic, kind = kind_of(text[a])
+                by_kind[kind] += per_ray[(obj, a)]
+                by_mnemonic[(mnemonic, kind)] += per_ray[(obj, a)]
+    return by_kind, by_mnemonic
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("trace_only", type=Path)
+    parser.add_argument("ray_set", nargs="?", default="diffuse", choices=["diffuse", "primary", "shadow"])
+    parser.add_argument("rings", nargs="?", type=int, default=71, help="71: the 10K-triangle sphere")
+    parser.add_argument("room", nargs="?", choices=["room"], help="TOYRT only: inside bench_trace's closed room")
+    args = parser.parse_args()
+    engines = ["toyrt"] + ([] if args.room else ["embree"])
+    print(f"{args.ray_set} rays, {args.rings} rings{' in the closed room' if args.room else ''}: instructions a ray")
+    print(f"{'engine':8} {'total':>7} {'general':>8} {'xmm':>6} {'ymm':>6} {'vector uops, 128-bit units':>27}")
+    mnemonics = {}
+    for engine in engines:
+        by_kind, mnemonics[engine] = mix(args.trace_only, args.ray_set, args.rings, [args.room] if args.room else [],
+                                         engine)
+        total = sum(by_kind.values())
+        print(f"{engine:8} {total:7.0f} {by_kind['general']:8.0f} {by_kind['xmm']:6.0f} {by_kind['ymm']:6.0f} "
+              f"{by_kind['xmm'] + 2 * by_kind['ymm']:27.0f}")
+    for engine in engines:
+        top = sorted(mnemonics[engine].items(), key=lambda kv: -kv[1])[:16]
+        print(f"\n{engine}, the most executed: " + ", ".join(f"{m} ({k}) {c:.1f}" for (m, k), c in top))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
