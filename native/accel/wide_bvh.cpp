@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <utility>
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/task_arena.h>
 
 namespace toyrt {
 
@@ -36,9 +38,11 @@ Ranges subtree_ranges(const Bvh& bvh) {
   return range;
 }
 
-// Subtrees of more primitives than this are collapsed as parallel tasks. Fixed, not derived from
-// the thread count, so the layout (and every traversal result) is the same on any machine.
-constexpr uint32_t kParallelPrimitives = 32768;
+// Subtrees of more primitives than this are collapsed as parallel tasks (on an arena of more than
+// one thread). Each node's plan and place depend on its subtree alone, so the layout is the same
+// whatever the tasks. 32768 left a 10K-triangle mesh's collapse on one thread: 1,024-2,048 made it
+// 0.29 -> 0.18 ms on two (docs/trace-speed.md, thirty-first session).
+constexpr uint32_t kParallelPrimitives = 2048;
 
 // The dynamic programme's decisions for one binary interior node. Budget b = 1..kWidth is index
 // b - 1: how the least cost of the subtree in at most b slots of a wide node is reached, as the
@@ -123,6 +127,7 @@ template <class Tree>
 struct CollapsedTree {
   const Tree& tree;
   uint32_t leaf_size;
+  uint32_t parallel_above;  // subtrees of more primitives are tasks (kParallelPrimitives, or never)
 
   bool is_leaf(const Ref& r) const { return !tree.interior(r.node) || r.range.count <= leaf_size; }
 };
@@ -132,6 +137,7 @@ struct Planner : CollapsedTree<Tree> {
   using CollapsedTree<Tree>::tree;
   using CollapsedTree<Tree>::leaf_size;
   using CollapsedTree<Tree>::is_leaf;
+  using CollapsedTree<Tree>::parallel_above;
   Plan* plan;       // by binary node; written for interior nodes that are not collapsed leaves
   uint32_t* heads;  // by binary node: the wide nodes of its subtree when it heads a wide node
 
@@ -158,7 +164,7 @@ struct Planner : CollapsedTree<Tree> {
     const float visit =
         float(kWideNodeCost) * area_i * (area_i >= 0.999f * parent_area ? float(kChainVisitWeight) : 1.0f);
     Solved left, right;
-    if (i.range.count > kParallelPrimitives) {
+    if (i.range.count > parallel_above) {
       tbb::parallel_invoke([&, l = l] { left = solve(l, area_i); }, [&, r = r] { right = solve(r, area_i); });
     } else {
       left = solve(l, area_i);
@@ -208,6 +214,7 @@ template <class Tree>
 struct Collapser : CollapsedTree<Tree> {
   using CollapsedTree<Tree>::tree;
   using CollapsedTree<Tree>::is_leaf;
+  using CollapsedTree<Tree>::parallel_above;
   const Plan* plan;       // null: the greedy collapse
   const uint32_t* heads;  // as Planner::heads (the greedy collapse's from count())
 
@@ -317,7 +324,7 @@ struct Collapser : CollapsedTree<Tree> {
     for (int j = 0; j < m; ++j) {
       start[j] = next;
       next += heads[interior[j].node] - 1u;
-      large_count += large[j] = interior[j].range.count > kParallelPrimitives;
+      large_count += large[j] = interior[j].range.count > parallel_above;
     }
     auto child = [&](int j) { place(interior[j], first + size_t(j), start[j], out); };
     const bool parallel = large_count > 1;
@@ -334,8 +341,11 @@ template <class Tree>
 WideBvh collapse_tree(const Tree& tree, uint32_t leaf_size, CollapseMethod method) {
   WideBvh wide;
   leaf_size = std::max(leaf_size, 1u);
+  // On one thread tasks only cost.
+  const uint32_t parallel_above = tbb::this_task_arena::max_concurrency() > 1 ? kParallelPrimitives : UINT32_MAX;
+  const CollapsedTree<Tree> collapsed{tree, leaf_size, parallel_above};
   const Ref root = tree.root();
-  if (CollapsedTree<Tree>{tree, leaf_size}.is_leaf(root)) {
+  if (collapsed.is_leaf(root)) {
     wide.root_leaf_first = root.range.first;
     wide.root_leaf_count = root.range.count;
     return wide;
@@ -345,9 +355,9 @@ WideBvh collapse_tree(const Tree& tree, uint32_t leaf_size, CollapseMethod metho
   std::unique_ptr<uint32_t[]> heads(new uint32_t[tree.plan_slots()]);
   if (method == CollapseMethod::Sah) {
     plans.reset(new Plan[tree.plan_slots()]);
-    Planner<Tree>{{tree, leaf_size}, plans.get(), heads.get()}.solve(root);
+    Planner<Tree>{collapsed, plans.get(), heads.get()}.solve(root);
   }
-  const Collapser<Tree> c{{tree, leaf_size}, plans.get(), heads.get()};
+  const Collapser<Tree> c{collapsed, plans.get(), heads.get()};
   if (!plans) c.count(root, heads.get());
   wide.nodes.resize(heads[root.node]);  // not zeroed (HugePageAllocator): place() writes every node
   c.place(root, 0, 1, wide.nodes.data());
