@@ -162,7 +162,9 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
     emit(wide_.root_leaf_first, wide_.root_leaf_count, 0);
     wide_.root_leaf_first = 0;
   }
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, wide_.nodes.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
+  // Grains of 64 nodes (about 2,500 triangles): with 512 a 10K-triangle mesh's ~280 nodes were one
+  // task, and this copy ran on one thread (0.28 -> 0.18 ms of the 10K commit on two threads).
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, wide_.nodes.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i != r.end(); ++i) {
       WideNode& n = wide_.nodes[i];
       uint32_t start = first_block[i];
