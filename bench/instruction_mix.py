@@ -8,8 +8,8 @@ mix says more about the time there than the instruction total does (docs/trace-s
 
 Needs valgrind (apt-get install valgrind) and objdump. Each engine runs the set once and three
 times; the difference over the extra rays is what a ray costs, without the scene's build and the
-ray generation. TOYRT is counted inside Mesh::trace and Scene's tracing functions, Embree inside
-libembree3.
+ray generation. TOYRT is counted in its own functions (all of namespace toyrt but the test
+harness's toyrt::testing), Embree inside libembree3.
 """
 import argparse
 import collections
@@ -30,6 +30,11 @@ def costs_by_address(profile, keep):
     after_calls = False
     counts = collections.Counter()
     for line in Path(profile).read_text().splitlines():
+        # The layout this parser reads: an instruction address and a line, then Ir alone.
+        if line.startswith("positions:") and line.split()[1:] != ["instr", "line"]:
+            raise SystemExit(f"{profile}: positions {line!r}, expected 'instr line'")
+        if line.startswith("events:") and line.split()[1:] != ["Ir"]:
+            raise SystemExit(f"{profile}: events {line!r}, expected 'Ir' alone")
         m = re.match(r"(c?)(ob|fn)=\((\d+)\)(?: (.*))?$", line)
         if m:
             table = names[m.group(2)]
@@ -92,7 +97,8 @@ def kind_of(instruction):
 
 
 def mix(trace_only, ray_set, rings, extra, engine):
-    keep_toyrt = lambda obj, fn: "trace_only" in obj and ("Mesh::trace" in fn or "Scene::" in fn)  # noqa: E731
+    # (A name may begin with its return type: "bool toyrt::Mesh::trace<false>(...)".)
+    keep_toyrt = lambda obj, fn: "trace_only" in obj and "toyrt::" in fn and "toyrt::testing::" not in fn  # noqa: E731
     keep_embree = lambda obj, fn: "libembree" in obj  # noqa: E731
     keep = keep_embree if engine == "embree" else keep_toyrt
     args = [str(trace_only), ray_set, str(rings)]
@@ -113,10 +119,9 @@ def mix(trace_only, ray_set, rings, extra, engine):
         addresses = [a for o, a in per_ray if o == obj]
         text = disassemble(obj, addresses)
         for a in addresses:
-            if a in text:
-                mnemonic, kind = kind_of(text[a])
-                by_kind[kind] += per_ray[(obj, a)]
-                by_mnemonic[(mnemonic, kind)] += per_ray[(obj, a)]
+            mnemonic, kind = kind_of(text[a]) if a in text else ("(not disassembled)", "general")
+            by_kind[kind] += per_ray[(obj, a)]
+            by_mnemonic[(mnemonic, kind)] += per_ray[(obj, a)]
     return by_kind, by_mnemonic
 
 

@@ -22,12 +22,13 @@ struct BinnedSahConfig {
   // measured on the 1M-triangle benchmark mesh, 3 beat 1 by 15-20 % and 6 by 5-10 %.
   float traversal_cost = 3.0f;
   float intersection_cost = 1.0f;
-  size_t parallel_threshold = 8192;  // ranges at least this large are binned and split in parallel
+  // Ranges at least this large are binned and bounded in parallel (and partitioned in place).
+  size_t parallel_threshold = 8192;
   // Ranges at least this large build their two subtrees as tasks that idle threads may take. With
   // parallel_threshold here, a 10K-triangle mesh made two tasks at its root, whose SAH split is
-  // rarely even, and the second thread idled: 512 made the whole 10K commit on two threads 4-6 %
-  // faster, and the 1M one the same (docs/trace-speed.md, thirty-first session). On one thread
-  // no tasks are made: there they only cost (+6 % at 10K).
+  // rarely even, and the second thread idled: 512 made the whole 10K commit on two threads about
+  // 8 % faster, and left the 1M one as it was (docs/trace-speed.md, thirty-first session). On one
+  // thread no tasks are made: there they only cost (+6 % at 10K).
   size_t task_threshold = 512;
   // Polled at every node: when it reads true the build stops by throwing BuildCancelled, so a
   // user's cancel does not wait for a million-triangle build to finish. Not owned; may be null.

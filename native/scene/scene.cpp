@@ -361,29 +361,31 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
     top_config.sah.max_leaf = 1;  // an instance test is a whole traversal: never group them
     top_ = build_bvh(BuilderKind::Sah, boxes.data(), boxes.size(), top_config);
     for (uint32_t& id : top_.prim_ids) id = placed[id];
+    single_identity_ = instances_.size() == 1 && instances_[0].identity;
+    all_cast_shadows_ =
+        std::all_of(instances_.begin(), instances_.end(), [](const Instance& i) { return i.visible_shadow; });
+    all_visible_ = std::all_of(instances_.begin(), instances_.end(),
+                               [](const Instance& i) { return i.visibility == kVisibleAll; });
+    // The lights' structures on the commit's threads too: the lamp BVH's builder makes tasks from
+    // 512 lamps (BinnedSahConfig::task_threshold), which a one-thread commit must not spread.
+    const auto gather_start = std::chrono::steady_clock::now();
+    gather_emitters();
+    stats_.emissive_triangles = emitters_.triangles.size();
+    stats_.emitter_tree_nodes = emitters_.tree.node_count();
+    stats_.emitters_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - gather_start).count();
+    if (!light_tree_current_) {
+      // Only when the lights changed: a viewport edit of a mesh does not rebuild it. A scene of
+      // few lights keeps no tree (the linear walk is cheaper there: kLightTreeFrom).
+      const auto tree_start = std::chrono::steady_clock::now();
+      light_tree_ = world_.lights.size() > kLightTreeFrom ? LightTree(world_.lights) : LightTree{};
+      if (light_tree_.node_count() > 0) light_tree_.set_receiver_sets(light_reach_);
+      lamp_bvh_ = world_.lights.size() >= kLampBvhFrom ? build_lamp_bvh(world_.lights) : LampBvh{};
+      light_tree_current_ = true;
+      stats_.light_tree_ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tree_start).count();
+    }
   });
-  single_identity_ = instances_.size() == 1 && instances_[0].identity;
-  all_cast_shadows_ =
-      std::all_of(instances_.begin(), instances_.end(), [](const Instance& i) { return i.visible_shadow; });
-  all_visible_ =
-      std::all_of(instances_.begin(), instances_.end(), [](const Instance& i) { return i.visibility == kVisibleAll; });
-  const auto gather_start = std::chrono::steady_clock::now();
-  gather_emitters();
-  stats_.emissive_triangles = emitters_.triangles.size();
-  stats_.emitter_tree_nodes = emitters_.tree.node_count();
-  stats_.emitters_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - gather_start).count();
-  if (!light_tree_current_) {
-    // Only when the lights changed: a viewport edit of a mesh does not rebuild it. A scene of
-    // few lights keeps no tree (the linear walk is cheaper there: kLightTreeFrom).
-    const auto tree_start = std::chrono::steady_clock::now();
-    light_tree_ = world_.lights.size() > kLightTreeFrom ? LightTree(world_.lights) : LightTree{};
-    if (light_tree_.node_count() > 0) light_tree_.set_receiver_sets(light_reach_);
-    lamp_bvh_ = world_.lights.size() >= kLampBvhFrom ? build_lamp_bvh(world_.lights) : LampBvh{};
-    light_tree_current_ = true;
-    stats_.light_tree_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tree_start).count();
-  }
   stats_.light_tree_nodes = light_tree_.node_count();
   committed_ = true;
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
