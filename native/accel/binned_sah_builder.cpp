@@ -3,13 +3,13 @@
 // parallel once they are large. Large ranges are also binned in parallel (a TBB reduction).
 #include "accel/binned_sah_builder.h"
 
+#include "core/parallel.h"
 #include "core/uninitialized_array.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -111,7 +111,7 @@ class Builder {
         subtree_nodes_(2 * count - 1) {
     cfg_.bins = std::clamp(cfg_.bins, 2, kMaxBins);
     cfg_.max_leaf = std::max(cfg_.max_leaf, 1u);
-    several_threads_ = tbb::this_task_arena::max_concurrency() > 1;
+    several_threads_ = several_threads();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 16384), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t i = r.begin(); i != r.end(); ++i) refs_.emplace(i, PrimRef::of(bounds[i], uint32_t(i)));
     });

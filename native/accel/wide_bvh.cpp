@@ -1,5 +1,7 @@
 #include "accel/wide_bvh.h"
 
+#include "core/parallel.h"
+
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -8,7 +10,6 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
-#include <tbb/task_arena.h>
 
 namespace toyrt {
 
@@ -342,7 +343,7 @@ WideBvh collapse_tree(const Tree& tree, uint32_t leaf_size, CollapseMethod metho
   WideBvh wide;
   leaf_size = std::max(leaf_size, 1u);
   // On one thread tasks only cost.
-  const uint32_t parallel_above = tbb::this_task_arena::max_concurrency() > 1 ? kParallelPrimitives : UINT32_MAX;
+  const uint32_t parallel_above = several_threads() ? kParallelPrimitives : UINT32_MAX;
   const CollapsedTree<Tree> collapsed{tree, leaf_size, parallel_above};
   const Ref root = tree.root();
   if (collapsed.is_leaf(root)) {

@@ -20,6 +20,10 @@ inline int check_threads(int threads) {
   return threads;
 }
 
+// Whether the arena the caller runs on has more than one thread: the builders make no tasks
+// where there is none to take them (a fork-join on one thread only costs).
+inline bool several_threads() { return tbb::this_task_arena::max_concurrency() > 1; }
+
 template <class F>
 void run_with_threads(int threads, F&& work) {
   if (threads <= 0) {
