@@ -101,17 +101,16 @@ def mix(trace_only, ray_set, rings, extra, engine):
     keep_toyrt = lambda obj, fn: "trace_only" in obj and "toyrt::" in fn and "toyrt::testing::" not in fn  # noqa: E731
     keep_embree = lambda obj, fn: "libembree" in obj  # noqa: E731
     keep = keep_embree if engine == "embree" else keep_toyrt
-    args = [str(trace_only), ray_set, str(rings)]
+    last = [engine] if engine == "embree" else extra  # trace_only's fourth argument
     with tempfile.TemporaryDirectory() as tmp:
         counts = []
         for repeats in (1, 3):
             profile = f"{tmp}/callgrind.{repeats}"
-            run = args + [str(repeats)] + ([engine] if engine == "embree" else extra)
+            run = [str(trace_only), ray_set, str(rings), str(repeats)] + last
             valgrind = ["valgrind", "--tool=callgrind", "--dump-instr=yes", f"--callgrind-out-file={profile}"]
-            subprocess.run(valgrind + run, capture_output=True, check=True)
+            # trace_only's own report ("diffuse: 15819 rays x 3, ...") gives the rays of one repeat.
+            report = subprocess.run(valgrind + run, capture_output=True, text=True, check=True).stdout
             counts.append(costs_by_address(profile, keep))
-        report = subprocess.run(args + ["1"] + ([engine] if engine == "embree" else extra), capture_output=True,
-                                text=True, check=True).stdout
     rays = int(re.search(r"(\d+) rays", report).group(1)) * 2  # the extra two repeats
     per_ray = {k: (counts[1][k] - counts[0].get(k, 0)) / rays for k in counts[1]}
     by_kind, by_mnemonic = collections.Counter(), collections.Counter()
