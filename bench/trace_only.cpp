@@ -219,9 +219,11 @@ int main(int argc, char** argv) {
   }
   const BBox box = bounds_of(mesh);
   const Vec3 light = box.center() + glm::length(box.extent()) * Vec3(-0.4f, -0.9f, 1.3f);
-  const std::vector<Ray> rays = kind == "primary"  ? primary
-                                : kind == "shadow" ? shadow_rays(mesh, primary, hits, light)
-                                                   : diffuse_rays(mesh, primary, hits, 17);
+  // Rays leaving the surface name the triangle they leave, as bench_trace's (Ray::self).
+  const std::vector<Ray> rays = kind == "primary" ? primary
+                                : kind == "shadow"
+                                    ? leaving_their_triangles(mesh, shadow_rays(mesh, primary, hits, light), hits)
+                                    : leaving_their_triangles(mesh, diffuse_rays(mesh, primary, hits, 17), hits);
   // "embree" as the fourth argument: the same rays through Embree 3 in its default mode, for
   // instruction counts side by side (under valgrind Embree runs its AVX2 kernels).
   const bool embree = argc > 4 && std::string(argv[4]) == "embree";

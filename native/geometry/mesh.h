@@ -3,6 +3,7 @@
 
 #include "accel/builder.h"
 #include "accel/wide_bvh.h"
+#include "core/ray.h"
 #include "core/uninitialized_array.h"
 #include "geometry/triangle_block.h"
 
@@ -29,10 +30,12 @@ class Mesh {
   // Closest hit within [tnear, tfar): shrinks tfar and writes u, v, prim on a hit. ray_checked:
   // the caller has already refused a ray with a non-finite or zero component (Scene does for the
   // world ray, which an identity instance passes on unchanged), so the check is not made twice.
+  // skip: a triangle never hit (the one the ray leaves: Ray::self), or kInvalidId.
   bool intersect(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim,
-                 bool ray_checked = false) const;
+                 bool ray_checked = false, int32_t skip = kInvalidId) const;
   // Any hit within [tnear, tfar).
-  bool occluded(const Vec3& org, const Vec3& dir, float tnear, float tfar, bool ray_checked = false) const;
+  bool occluded(const Vec3& org, const Vec3& dir, float tnear, float tfar, bool ray_checked = false,
+                int32_t skip = kInvalidId) const;
 
   const std::vector<Vec3>& vertices() const { return vertices_; }
   const std::vector<Triangle>& triangles() const { return triangles_; }
@@ -57,9 +60,9 @@ class Mesh {
   // to triangle indices by `valid`) and point the wide leaves at them.
   void finish(WideBuild built, const UninitializedArray<uint32_t>& valid);
 
-  template <bool AnyHit>
+  template <bool AnyHit, bool kSkip>
   bool trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim,
-             bool ray_checked) const;
+             bool ray_checked, int32_t skip) const;
 
   std::vector<Vec3> vertices_;
   std::vector<Triangle> triangles_;

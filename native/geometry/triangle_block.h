@@ -6,6 +6,7 @@
 #pragma once
 
 #include "accel/wide_traverse.h"
+#include "core/ray.h"
 #include "geometry/triangle.h"
 
 #include <cstring>
@@ -67,10 +68,11 @@ inline BlockRay make_block_ray(const WatertightRay& r) {
 
 // Tests the block's triangles against [tnear, tfar). For each lane hit, hit(lane, t) is called
 // (nearest lanes are not sorted; the caller keeps the minimum); with AnyHit the first ends it.
-// Returns whether any lane was hit.
-template <bool AnyHit, class OnHit>
+// With kSkip, the triangle `skip` (the one the ray leaves) is never hit. Returns whether any lane
+// was hit.
+template <bool AnyHit, bool kSkip, class OnHit>
 [[gnu::always_inline]] inline bool intersect_block(const WatertightRay& r, const BlockRay& br, const TriangleBlock& b,
-                                                   float tnear, float tfar, OnHit&& hit) {
+                                                   float tnear, float tfar, int32_t skip, OnHit&& hit) {
   using namespace simdb;
   const vfloat ox = br.ox, oy = br.oy, oz = br.oz, sx = br.sx, sy = br.sy, sz = br.sz;
   // Translated and sheared vertices, exactly as intersect_triangle computes them.
@@ -101,8 +103,12 @@ template <bool AnyHit, class OnHit>
   const vfloat signed_t = det < zero ? -scaled_t : scaled_t;
   const vint in_range = (det != zero) & (signed_t < splat(tfar) * abs_det);
   const vint candidate = used & ~mixed & in_range;
+  uint32_t live = mask_of(candidate | (used & exact_zero));
+  // The triangle the ray leaves is dropped here, where a block still has a candidate, and before
+  // the error bound, which it would otherwise reach only to be rejected (Ray::self).
+  if constexpr (kSkip) live &= ~mask_of(*reinterpret_cast<const vint_in_memory*>(b.prim) == skip);
   // Or misses by distance: stop before the error bound.
-  if (!mask_of(candidate | (used & exact_zero))) return false;
+  if (!live) return false;
 
   // near_start_error of triangle.h, lane-wise.
   const vfloat max_z = max(max(abs(z[0]), abs(z[1])), abs(z[2]));
@@ -119,9 +125,9 @@ template <bool AnyHit, class OnHit>
   // for float (mostly the surface a ray leaves), whose crossing is decided in double directly,
   // as the scalar test would after repeating the same float arithmetic; and lanes with an exact
   // zero edge function, which take the whole scalar test.
-  const uint32_t accepted = mask_of(candidate & ~exact_zero & clear_of_start);
-  const uint32_t near_start = mask_of(candidate & ~exact_zero & ~clear_of_start & ~clear_before_start);
-  const uint32_t scalar = mask_of(used & exact_zero);
+  const uint32_t accepted = mask_of(candidate & ~exact_zero & clear_of_start) & live;
+  const uint32_t near_start = mask_of(candidate & ~exact_zero & ~clear_of_start & ~clear_before_start) & live;
+  const uint32_t scalar = mask_of(used & exact_zero) & live;
   bool any = false;
   if (accepted) {
     const vfloat t = scaled_t * (splat(1.0f) / det);  // as the scalar test: times the reciprocal

@@ -9,13 +9,13 @@
 
 namespace toyrt {
 
-DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& ng, const DielectricLobe& lobe,
-                                 uint32_t pixel, uint32_t sample, uint32_t light_dim, uint32_t lobe_dim,
-                                 uint32_t side_dim, uint32_t emitter_dim, const IntegratorSettings& settings,
-                                 uint8_t receiver_set) {
+DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& ng, PrimRef self,
+                                 const DielectricLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t light_dim,
+                                 uint32_t lobe_dim, uint32_t side_dim, uint32_t emitter_dim,
+                                 const IntegratorSettings& settings, uint8_t receiver_set) {
   DielectricStep step;
   const Vec3 above = offset_ray_origin(p, ng), below = offset_ray_origin(p, -ng);
-  const LobeVertex lv{nullptr, &lobe, p, ng, above, below};
+  const LobeVertex lv{nullptr, &lobe, p, ng, above, below, self};
   step.radiance = lobe_vertex_lighting(scene, lv, pixel, sample, light_dim, emitter_dim, settings, receiver_set);
   const BsdfSample g = dielectric_sample(lobe, sobol_owen_2d(pixel, sample, lobe_dim, settings.seed),
                                          sobol_owen_1d(pixel, sample, side_dim, settings.seed));

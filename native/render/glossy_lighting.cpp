@@ -58,8 +58,8 @@ Vec3 lobe_lamp_lighting(const Scene& scene, const LobeVertex& v, uint32_t pixel,
     Vec3 tr(1.0f);  // what cut-outs on the way let through
     if (lamp.shadow) {
       // A light at infinity (the sun) is left along wi; the others end where the sample is.
-      const Ray shadow = std::isinf(ls.distance) ? Ray{a.origin, 0.0f, ls.wi, kInfinity}
-                                                 : Ray{a.origin, 0.0f, ls.point - a.origin, 1.0f};
+      const Ray shadow = std::isinf(ls.distance) ? Ray{a.origin, 0.0f, ls.wi, kInfinity, v.self}
+                                                 : Ray{a.origin, 0.0f, ls.point - a.origin, 1.0f, v.self};
       if (!shadow_passes(scene, shadow, settings.transparent_max_bounces, tr, lamp.blocker_sets)) return;
     }
     // A delta lamp cannot be hit by the continuation ray: its sample is the only strategy.
@@ -93,7 +93,8 @@ Vec3 lobe_emitter_lighting(const Scene& scene, const LobeVertex& v, const Vec2& 
   const Instance& inst = scene.instance(uint32_t(key >> 32));
   if (!(inst.visibility & a.seen_by) || !in_light_sets(inst.light_receivers, receiver_set)) return Vec3(0.0f);
   Vec3 tr(1.0f);
-  if (!shadow_passes(scene, Ray{a.origin, 0.0f, ls.point - a.origin, 1.0f}, settings.transparent_max_bounces, tr))
+  if (!shadow_passes(scene, Ray{a.origin, 0.0f, ls.point - a.origin, 1.0f, v.self}, settings.transparent_max_bounces,
+                     tr))
     return Vec3(0.0f);
   const Vec3 radiance = emitters.triangles[where.index].textured ? scene.emitted_at(key, where.b) : ls.radiance;
   return a.e.f * radiance * tr * (a.cos * power_heuristic(ls.pdf, a.e.pdf) / ls.pdf);
@@ -111,7 +112,7 @@ Vec3 lobe_environment_lighting(const Scene& scene, const LobeVertex& v, const Ve
   if (!background_visible(world, a.seen_by == kVisibleGlossy ? RayKind::Glossy : RayKind::Transmission))
     return Vec3(0.0f);
   Vec3 tr(1.0f);
-  if (!shadow_passes(scene, Ray{a.origin, 0.0f, es.wi, kInfinity}, settings.transparent_max_bounces, tr))
+  if (!shadow_passes(scene, Ray{a.origin, 0.0f, es.wi, kInfinity, v.self}, settings.transparent_max_bounces, tr))
     return Vec3(0.0f);
   return a.e.f * es.radiance * tr * (a.cos * power_heuristic(es.pdf, a.e.pdf) / es.pdf);
 }
@@ -140,11 +141,11 @@ Vec3 lobe_vertex_lighting(const Scene& scene, const LobeVertex& v, uint32_t pixe
   return sum;
 }
 
-GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng, const GlossyLobe& lobe,
-                         uint32_t pixel, uint32_t sample, uint32_t light_dim, uint32_t lobe_dim, uint32_t emitter_dim,
-                         const IntegratorSettings& settings, uint8_t receiver_set) {
+GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng, PrimRef self,
+                         const GlossyLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t light_dim, uint32_t lobe_dim,
+                         uint32_t emitter_dim, const IntegratorSettings& settings, uint8_t receiver_set) {
   GlossyStep step;
-  const LobeVertex v{&lobe, nullptr, p, ng, origin, origin};
+  const LobeVertex v{&lobe, nullptr, p, ng, origin, origin, self};
   step.radiance = lobe_vertex_lighting(scene, v, pixel, sample, light_dim, emitter_dim, settings, receiver_set);
   const BsdfSample g = sample_lobe(lobe, sobol_owen_2d(pixel, sample, lobe_dim, settings.seed));
   if (!(g.pdf > 0.0f) || glm::dot(g.wi, ng) <= 0.0f) return step;
@@ -154,11 +155,12 @@ GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, 
   return step;
 }
 
-GlossyStep mixture_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng, const Scatter& mixture,
-                          uint32_t pixel, uint32_t sample, uint32_t light_dim, uint32_t lobe_dim, uint32_t pick_dim,
-                          uint32_t emitter_dim, const IntegratorSettings& settings, uint8_t receiver_set) {
+GlossyStep mixture_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng, PrimRef self,
+                          const Scatter& mixture, uint32_t pixel, uint32_t sample, uint32_t light_dim,
+                          uint32_t lobe_dim, uint32_t pick_dim, uint32_t emitter_dim,
+                          const IntegratorSettings& settings, uint8_t receiver_set) {
   GlossyStep step;
-  LobeVertex v{nullptr, nullptr, p, ng, origin, origin};
+  LobeVertex v{nullptr, nullptr, p, ng, origin, origin, self};
   v.mixture = &mixture;
   step.radiance = lobe_vertex_lighting(scene, v, pixel, sample, light_dim, emitter_dim, settings, receiver_set);
   bool diffuse = false;

@@ -33,6 +33,7 @@ struct SurfaceHit {
   int32_t material = -1;
   uint8_t receiver_set = 0;                  // the instance's light-linking receiver set (lights/light_linking.h)
   uint64_t light_receivers = kAllLightSets;  // the sets its emission lights, if it emits (Instance)
+  PrimRef self;                              // the triangle hit: the self of the rays that leave it
 };
 
 // Out of line on purpose: inlined into trace_from (as GCC chose once nothing else called it) it
@@ -61,6 +62,7 @@ struct SurfaceHit {
   if (!sh.material_ids.empty()) s.material = sh.material_ids[size_t(hit.prim)];
   s.receiver_set = inst.receiver_set;
   s.light_receivers = inst.light_receivers;
+  s.self = PrimRef{hit.prim, hit.instance};
   return s;
 }
 
@@ -76,6 +78,7 @@ int32_t material_of(const Scene& scene, const Hit& hit) {
 struct DiffusePoint {
   Vec3 origin, ng, ns, f;
   int depth;
+  PrimRef self;  // the triangle the point lies on: its shadow and cosine rays leave it
 };
 
 // The diffuse BRDF value towards wi: the point's f (Lambert), or f times Burley's factor (Blender
@@ -123,7 +126,7 @@ template <bool kBurley>
     const float cos_s = glm::dot(at.ns, es.wi);
     Vec3 tr(1.0f);
     if (cos_s > 0.0f && glm::dot(at.ng, es.wi) > 0.0f &&
-        shadow_passes(scene, Ray{at.origin, 0.0f, es.wi, kInfinity}, settings.transparent_max_bounces, tr)) {
+        shadow_passes(scene, Ray{at.origin, 0.0f, es.wi, kInfinity, at.self}, settings.transparent_max_bounces, tr)) {
       sum += diffuse_f<kBurley>(at, retro, es.wi) * es.radiance * tr * mis_cos_over_pdf(cos_s, es.pdf, cos_s * kInvPi);
     }
   }
@@ -132,7 +135,8 @@ template <bool kBurley>
   const CosineDirection c = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings);
   Vec3 tr(1.0f);
   if (glm::dot(at.ng, c.wi) > 0.0f && c.cos > 0.0f &&
-      path_passes(scene, Ray{at.origin, 0.0f, c.wi, kInfinity}, settings.transparent_max_bounces, tr, kVisibleDiffuse))
+      path_passes(scene, Ray{at.origin, 0.0f, c.wi, kInfinity, at.self}, settings.transparent_max_bounces, tr,
+                  kVisibleDiffuse))
     sum += diffuse_f<kBurley>(at, retro, c.wi) * environment_radiance(env, image, c.wi) * tr *
            mis_cos_over_pdf(c.cos, c.cos * kInvPi, environment_pdf(env, c.wi));
   return sum;
@@ -165,8 +169,8 @@ template <bool kBurley>
       const float cos_s = glm::dot(at.ns, ls.wi);
       Vec3 tr(1.0f);
       if (cos_s > 0.0f && glm::dot(at.ng, ls.wi) > 0.0f &&
-          shadow_passes(scene, Ray{at.origin, 0.0f, ls.point - at.origin, 1.0f}, settings.transparent_max_bounces,
-                        tr)) {
+          shadow_passes(scene, Ray{at.origin, 0.0f, ls.point - at.origin, 1.0f, at.self},
+                        settings.transparent_max_bounces, tr)) {
         sum +=
             diffuse_f<kBurley>(at, retro, ls.wi) * ls.radiance * tr * mis_cos_over_pdf(cos_s, ls.pdf, cos_s * kInvPi);
       }
@@ -176,8 +180,8 @@ template <bool kBurley>
   const Vec3 wi = c.wi;
   if (glm::dot(at.ng, wi) <= 0.0f || c.cos <= 0.0f) return sum;
   Vec3 tr(1.0f);  // a cosine ray is a path ray: it passes cut-outs (render/transparent_walk.h)
-  const Hit hit = nearest_past_cut_outs(scene, Ray{at.origin, 0.0f, wi, kInfinity}, settings.transparent_max_bounces,
-                                        tr, kVisibleDiffuse);
+  const Hit hit = nearest_past_cut_outs(scene, Ray{at.origin, 0.0f, wi, kInfinity, at.self},
+                                        settings.transparent_max_bounces, tr, kVisibleDiffuse);
   const int32_t m = hit.found() ? material_of(scene, hit) : -1;
   if (m < 0 || size_t(m) >= scene.emission().size() || !scene.emission()[size_t(m)].emits()) return sum;
   if (!in_light_sets(scene.instance(uint32_t(hit.instance)).light_receivers, receiver)) return sum;
@@ -205,7 +209,7 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
                      const IntegratorSettings& settings) {
   const World& world = scene.world();
   const Vec3 origin = offset_ray_origin(s.p, ng);
-  const DiffusePoint at{origin, ng, ns, f, depth};
+  const DiffusePoint at{origin, ng, ns, f, depth, s.self};
   Vec3 sum(0.0f);
   auto add = [&](size_t index, float select_probability, uint32_t dim) {
     const LightVisibility v = world.light_visibility[index];
@@ -223,8 +227,8 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     if (v.shadow) {
       // The shadow ray ends where the light sample is: t = 1 with an unnormalised direction; a
       // light at infinity (the sun) leaves the scene along wi.
-      const Ray shadow =
-          std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity} : Ray{origin, 0.0f, ls.point - origin, 1.0f};
+      const Ray shadow = std::isinf(ls.distance) ? Ray{origin, 0.0f, ls.wi, kInfinity, s.self}
+                                                 : Ray{origin, 0.0f, ls.point - origin, 1.0f, s.self};
       if (kCutOuts ? !shadow_passes(scene, shadow, settings.transparent_max_bounces, tr, v.blocker_sets)
                    : scene.shadowed(shadow, v.blocker_sets))
         return;
@@ -240,9 +244,10 @@ Vec3 direct_lighting(const Scene& scene, const SurfaceHit& s, const Vec3& ng, co
     // albedo L when nothing blocks it, exactly. A BSDF-sampled ray: every object stops it.
     const Vec3 wi = cosine_direction(at, pixel, sample, kDimsPerVertex - 1, settings).wi;
     Vec3 tr(1.0f);
-    if (glm::dot(ng, wi) > 0.0f && (kCutOuts ? path_passes(scene, Ray{origin, 0.0f, wi, kInfinity},
-                                                           settings.transparent_max_bounces, tr, kVisibleDiffuse)
-                                             : !scene.occluded(Ray{origin, 0.0f, wi, kInfinity}, kVisibleDiffuse)))
+    if (glm::dot(ng, wi) > 0.0f &&
+        (kCutOuts ? path_passes(scene, Ray{origin, 0.0f, wi, kInfinity, s.self}, settings.transparent_max_bounces, tr,
+                                kVisibleDiffuse)
+                  : !scene.occluded(Ray{origin, 0.0f, wi, kInfinity, s.self}, kVisibleDiffuse)))
       sum += diffuse_f<kBurley>(at, retro, wi) * world.background * tr * kPi;  // f = albedo / pi
   }
   if (scene.any_emission())
@@ -396,7 +401,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
     if constexpr (kCutOuts) {
       if (cut.ends_here()) break;
       const float u = sobol_owen_1d(pixel, sample, vertex_dimension(depth, kDimsPerVertex - 7), settings.seed);
-      if (cut.pass(scene, s.material, s.p, s.ng, s.uv, u, throughput, ray)) {
+      if (cut.pass(scene, s.material, s.p, s.ng, s.self, s.uv, u, throughput, ray)) {
         if (first) *first = FirstHit{};  // passes see the first surface the path shades
         continue;
       }
@@ -459,7 +464,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
                                                   : direct_lighting<false, kCutOuts>(scene, s, ng, ns, sc.f, nullptr,
                                                                                      depth, pixel, sample, settings));
             const Vec3 origin = offset_ray_origin(s.p, ng);
-            const GlossyStep g = glossy_vertex(scene, s.p, origin, ng, sc.glossy, pixel, sample,
+            const GlossyStep g = glossy_vertex(scene, s.p, origin, ng, s.self, sc.glossy, pixel, sample,
                                                vertex_dimension(depth, 1), vertex_dimension(depth, kDimsPerVertex - 5),
                                                vertex_dimension(depth, kDimsPerVertex - 10), settings, s.receiver_set);
             radiance += throughput * g.radiance;
@@ -477,7 +482,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             light_only = bounce >= settings.max_specular_depth;
             kind = RayKind::Glossy;
             receiver = s.receiver_set;
-            ray = Ray{origin, 0.0f, g.wi, kInfinity};
+            ray = Ray{origin, 0.0f, g.wi, kInfinity, s.self};
             return true;
           }
           if (sc.kind == Scatter::Kind::Mixture) {
@@ -489,7 +494,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             }
             const Vec3 origin = offset_ray_origin(s.p, ng);
             const GlossyStep g =
-                mixture_vertex(scene, s.p, origin, ng, sc, pixel, sample, vertex_dimension(depth, 1),
+                mixture_vertex(scene, s.p, origin, ng, s.self, sc, pixel, sample, vertex_dimension(depth, 1),
                                vertex_dimension(depth, kDimsPerVertex - 5), vertex_dimension(depth, kDimsPerVertex - 6),
                                vertex_dimension(depth, kDimsPerVertex - 10), settings, s.receiver_set);
             radiance += throughput * g.radiance;
@@ -500,14 +505,14 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             light_only = g.diffuse || bounce >= settings.max_specular_depth;
             kind = g.diffuse ? RayKind::Diffuse : RayKind::Glossy;
             receiver = s.receiver_set;
-            ray = Ray{origin, 0.0f, g.wi, kInfinity};
+            ray = Ray{origin, 0.0f, g.wi, kInfinity, s.self};
             return true;
           }
           if (sc.kind == Scatter::Kind::Dielectric) {
             // Lamps on both sides, then a reflection or a transmission: as a glossy vertex, with
             // the side chosen on the lobe-choice dimension.
             const DielectricStep g = dielectric_vertex(
-                scene, s.p, ng, sc.dielectric, pixel, sample, vertex_dimension(depth, 1),
+                scene, s.p, ng, s.self, sc.dielectric, pixel, sample, vertex_dimension(depth, 1),
                 vertex_dimension(depth, kDimsPerVertex - 5), vertex_dimension(depth, kDimsPerVertex - 6),
                 vertex_dimension(depth, kDimsPerVertex - 10), settings, s.receiver_set);
             radiance += throughput * g.radiance;
@@ -518,7 +523,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
             light_only = bounce >= settings.max_specular_depth;
             kind = kind_towards(g.wi, ng);
             receiver = s.receiver_set;
-            ray = Ray{g.origin, 0.0f, g.wi, kInfinity};
+            ray = Ray{g.origin, 0.0f, g.wi, kInfinity, s.self};
             return true;
           }
           bsdf_pdf = 0.0f;  // a delta branch: no lamp was sampled here
@@ -526,7 +531,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
           if (sc.kind == Scatter::Kind::Split) {
             for (int b = 0; b < sc.count; ++b) {
               const SpecularSample& branch = sc.branches[b];
-              const Ray next{offset_ray_origin(s.p, branch.offset_normal), 0.0f, branch.wi, kInfinity};
+              const Ray next{offset_ray_origin(s.p, branch.offset_normal), 0.0f, branch.wi, kInfinity, s.self};
               radiance +=
                   throughput * branch.weight * branch.probability *
                   trace_from<kCutOuts, kNormalMaps>(scene, next, depth + 1, pixel, sample, settings, nullptr,
@@ -537,7 +542,7 @@ Vec3 trace_from(const Scene& scene, Ray ray, int first_depth, uint32_t pixel, ui
           throughput *= sc.branches[0].weight;
           kind = kind_towards(sc.branches[0].wi, ng);
           receiver = s.receiver_set;
-          ray = Ray{offset_ray_origin(s.p, sc.branches[0].offset_normal), 0.0f, sc.branches[0].wi, kInfinity};
+          ray = Ray{offset_ray_origin(s.p, sc.branches[0].offset_normal), 0.0f, sc.branches[0].wi, kInfinity, s.self};
           return true;
         },
         *m);

@@ -24,13 +24,13 @@ CrossedSurface crossed_surface(const Scene& scene, const Hit& hit) {
   return s;
 }
 
-Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng) {
+Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng, PrimRef crossed) {
   const Vec3 origin = offset_ray_origin(at, glm::dot(ng, ray.dir) > 0.0f ? ng : -ng);
-  if (std::isinf(ray.tfar)) return Ray{origin, 0.0f, ray.dir, kInfinity};
+  if (std::isinf(ray.tfar)) return Ray{origin, 0.0f, ray.dir, kInfinity, crossed};
   const Vec3 to_end = ray.org + ray.dir * ray.tfar - origin;
   // Past the end (the surface lay at the ray's very end): nothing is left to trace.
-  if (glm::dot(to_end, ray.dir) <= 0.0f) return Ray{origin, 1.0f, ray.dir, 0.0f};
-  return Ray{origin, 0.0f, to_end, 1.0f};
+  if (glm::dot(to_end, ray.dir) <= 0.0f) return Ray{origin, 1.0f, ray.dir, 0.0f, crossed};
+  return Ray{origin, 0.0f, to_end, 1.0f, crossed};
 }
 
 Vec3 transmittance_walk(const Scene& scene, const Ray& ray, int budget, bool casters_only, uint64_t blockers,
@@ -58,7 +58,7 @@ Hit walk_to_opaque(const Scene& scene, Ray ray, int budget, Vec3& tr, bool caste
     }
     tr *= (1.0f - t.opacity_at(scene.textures(), s.uv)) * t.color;
     if (tr == Vec3(0.0f)) return hit;
-    ray = continue_through(ray, s.p, s.ng);
+    ray = continue_through(ray, s.p, s.ng, PrimRef{hit.prim, hit.instance});
   }
 }
 

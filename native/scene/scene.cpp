@@ -11,6 +11,7 @@
 #include <glm/gtc/matrix_inverse.hpp>
 
 #include <chrono>
+#include <cstddef>
 #include <cstring>
 #include <future>
 #include <stdexcept>
@@ -108,7 +109,7 @@ namespace {
 // tfar) are checked as one vector: every ray pays this, and one test per component was about 35
 // instructions a ray.
 bool is_traceable(const Ray& ray) {
-  static_assert(sizeof(Ray) == 8 * sizeof(float) && kWidth == 8, "Ray: origin, tnear, direction, tfar");
+  static_assert(offsetof(Ray, self) == 8 * sizeof(float) && kWidth == 8, "Ray: origin, tnear, direction, tfar");
   // Copied, not loaded through simd::load: a ray is 16-byte aligned at best, and clang (unlike
   // GCC) keeps a vector type's 32-byte alignment whatever the typedef asks (UBSan: a misaligned
   // load; found by tests/fuzz).
@@ -407,10 +408,11 @@ template <bool AnyHit, bool ShadowCastersOnly, bool Visibility>
     org = Vec3(inst.to_object * glm::vec4(org, 1.0f));
     dir = glm::mat3(inst.to_object) * dir;
   }
+  const int32_t skip = ray.self.instance == int32_t(id) ? ray.self.prim : kInvalidId;
   if constexpr (AnyHit) {
-    return mesh.occluded(org, dir, ray.tnear, t_max, inst.identity);
+    return mesh.occluded(org, dir, ray.tnear, t_max, inst.identity, skip);
   } else {
-    if (!mesh.intersect(org, dir, ray.tnear, t_max, hit.u, hit.v, hit.prim, inst.identity)) return false;
+    if (!mesh.intersect(org, dir, ray.tnear, t_max, hit.u, hit.v, hit.prim, inst.identity, skip)) return false;
     hit.instance = int32_t(id);
     return true;
   }

@@ -68,6 +68,8 @@ struct RayBatch {
   const float* tfar = nullptr;
   size_t tfar_stride = 0;
   size_t count = 0;
+  // The triangle each ray leaves (Ray::self), one per ray; none where not given.
+  const PrimRef* self = nullptr;
 
   // Ray i of the batch (tnear 0 and tfar infinite where their arrays are not given).
   Ray at(size_t i) const {
@@ -76,6 +78,7 @@ struct RayBatch {
     r.dir = Vec3(directions[3 * i], directions[3 * i + 1], directions[3 * i + 2]);
     r.tnear = tnear ? tnear[i * tnear_stride] : 0.0f;
     r.tfar = tfar ? tfar[i * tfar_stride] : kInfinity;
+    if (self) r.self = self[i];
     return r;
   }
 };

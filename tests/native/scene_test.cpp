@@ -99,6 +99,101 @@ TEST(Scene, OccludedAgreesWithIntersect) {
   }
 }
 
+// Ray::self, closed forms: a ray starting exactly on a triangle and going through it crosses it at
+// t = 0, a hit, unless the ray names that triangle as the one it leaves; then the same triangle of
+// another instance, or another triangle, is what it finds.
+TEST(Scene, ARayNeverHitsTheTriangleItLeavesAndStillHitsItsTwinInAnotherInstance) {
+  const std::vector<Vec3> v = {{-4, -4, 0}, {4, -4, 0}, {0, 4, 0}};
+  const std::vector<Triangle> one = {{0, 1, 2}};
+  // Two instances of one triangle, a unit apart (the top-level walk), and the same two triangles
+  // as one mesh (the one-mesh path).
+  Scene twins, flat;
+  const uint32_t id = twins.add_mesh(v, one);
+  twins.add_instance(id, Mat4(1.0f));
+  twins.add_instance(id, glm::translate(Mat4(1.0f), Vec3(0, 0, -1)));
+  twins.commit();
+  std::vector<Vec3> both = v;
+  for (const Vec3& p : v) both.push_back(p - Vec3(0, 0, 1));
+  flat.add_instance(flat.add_mesh(both, {{0, 1, 2}, {3, 4, 5}}), Mat4(1.0f));
+  flat.commit();
+  const Ray down(Vec3(0.25f, 0.5f, 0.0f), 0.0f, Vec3(0, 0, -1), kInfinity);
+  auto leaving = [&](PrimRef self, float tfar) { return Ray(down.org, 0.0f, down.dir, tfar, self); };
+
+  Hit h = twins.intersect(down);
+  EXPECT_EQ(h.t, 0.0f);
+  EXPECT_EQ(h.instance, 0);
+  h = twins.intersect(leaving({0, 0}, kInfinity));
+  EXPECT_EQ(h.t, 1.0f);
+  EXPECT_EQ(h.instance, 1);
+  EXPECT_EQ(h.prim, 0);
+  h = twins.intersect(leaving({0, 1}, kInfinity));  // another instance's triangle: not this one
+  EXPECT_EQ(h.t, 0.0f);
+  EXPECT_EQ(h.instance, 0);
+  EXPECT_TRUE(twins.occluded(leaving({}, 0.5f)));
+  EXPECT_FALSE(twins.occluded(leaving({0, 0}, 0.5f)));
+  EXPECT_TRUE(twins.occluded(leaving({0, 0}, 1.5f)));
+
+  h = flat.intersect(down);
+  EXPECT_EQ(h.t, 0.0f);
+  EXPECT_EQ(h.prim, 0);
+  h = flat.intersect(leaving({0, 0}, kInfinity));
+  EXPECT_EQ(h.t, 1.0f);
+  EXPECT_EQ(h.prim, 1);
+  EXPECT_EQ(flat.intersect(leaving({1, 0}, kInfinity)).prim, 0);
+  EXPECT_FALSE(flat.occluded(leaving({0, 0}, 0.5f)));
+  EXPECT_TRUE(flat.occluded(leaving({0, 0}, 1.5f)));
+  // The batch API passes each ray's self on.
+  const float org[6] = {0.25f, 0.5f, 0.0f, 0.25f, 0.5f, 0.0f}, dir[6] = {0, 0, -1, 0, 0, -1};
+  const PrimRef selves[2] = {{}, {0, 0}};
+  RayBatch batch{org, dir, nullptr, 0, nullptr, 0, 2};
+  batch.self = selves;
+  float t[2], u[2], w[2];
+  int32_t prim[2], inst[2];
+  flat.intersect(batch, {t, u, w, prim, inst}, 1);
+  EXPECT_EQ(prim[0], 0);
+  EXPECT_EQ(prim[1], 1);
+  EXPECT_EQ(t[1], 1.0f);
+}
+
+// Why the renderer may name the triangle a ray leaves: a ray leaving on the side its origin was
+// moved to (offset_ray_origin) meets that triangle's plane only behind its start, so naming it
+// changes no hit, bit for bit, of rays leaving a bumpy (non-convex) mesh outwards and inwards,
+// closest and any hit.
+TEST(Scene, NamingTheTriangleARayLeavesChangesNoHitOfRaysLeavingOnTheirOffsetSide) {
+  const MeshData m = uv_sphere(80, 160, 1.0f, 0.25f);
+  Scene scene;
+  scene.add_instance(scene.add_mesh(m.vertices, m.triangles), Mat4(1.0f));
+  scene.commit();
+  std::vector<Ray> primary;
+  std::vector<Hit> hits;
+  for (const Ray& r : primary_rays(bounds_of(m), 160, 120)) {
+    primary.push_back(r);
+    hits.push_back(scene.intersect(r));
+  }
+  const Vec3 light(-2.0f, -3.0f, 4.0f);
+  size_t named = 0, rays = 0, found = 0;
+  for (const std::vector<Ray>& set : {diffuse_rays(m, primary, hits, 5), diffuse_rays(m, primary, hits, 6, true),
+                                      shadow_rays(m, primary, hits, light)}) {
+    const std::vector<Ray> leaving = leaving_their_triangles(m, set, hits);
+    for (size_t i = 0; i < set.size(); ++i) {
+      ++rays;
+      if (leaving[i].self.prim == kInvalidId) continue;
+      ++named;
+      const Hit a = scene.intersect(set[i]), b = scene.intersect(leaving[i]);
+      found += a.found();
+      ASSERT_EQ(a.prim, b.prim) << "ray " << i;
+      ASSERT_EQ(a.t, b.t);
+      ASSERT_EQ(a.u, b.u);
+      ASSERT_EQ(a.v, b.v);
+      ASSERT_EQ(scene.occluded(set[i]), scene.occluded(leaving[i]));
+    }
+  }
+  // Not vacuous: most rays name their triangle (a shadow ray whose light is behind its surface
+  // does not), and many of them hit the bumps.
+  EXPECT_GT(named, rays * 3 / 4);
+  EXPECT_GT(found, named / 10);
+}
+
 TEST(Scene, ShadowRaysPassInstancesWithoutShadowsThatEveryOtherQuerySees) {
   // Two instances of one triangle on the ray's path, at z = 1 and z = 2; the one at z = 1
   // casts no shadow.

@@ -219,6 +219,20 @@ std::vector<Ray> shadow_rays(const MeshData& mesh, const std::vector<Ray>& incom
   return rays;
 }
 
+std::vector<Ray> leaving_their_triangles(const MeshData& mesh, std::vector<Ray> rays, const std::vector<Hit>& hits) {
+  size_t k = 0;
+  for (const Hit& hit : hits) {
+    if (!hit.found()) continue;
+    Ray& r = rays.at(k++);
+    // The side the origin was moved to, and the side the ray goes to, of the triangle's plane.
+    const Vec3 n = geometric_normal(mesh, hit.prim);
+    const float origin_side = glm::dot(n, r.org - hit_point(mesh, hit)), going = glm::dot(n, r.dir);
+    if ((origin_side > 0.0f && going > 0.0f) || (origin_side < 0.0f && going < 0.0f))
+      r.self = PrimRef{hit.prim, hit.instance};
+  }
+  return rays;
+}
+
 std::vector<Ray> rays_at_vertices_and_edges(const MeshData& mesh, const Vec3& inside, int per_edge, uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);

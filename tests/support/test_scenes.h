@@ -58,6 +58,10 @@ std::vector<Ray> diffuse_rays(const MeshData& mesh, const std::vector<Ray>& inco
 // Rays from the same surface points to a light position, tfar ending at the light.
 std::vector<Ray> shadow_rays(const MeshData& mesh, const std::vector<Ray>& incoming, const std::vector<Hit>& hits,
                              const Vec3& light);
+// The rays diffuse_rays or shadow_rays made from `hits` (one for each hit found, in order), each
+// with `self` set to the triangle it leaves where it leaves to the side its origin was moved to, as
+// a renderer's rays do (Ray::self): every diffuse ray; a shadow ray whose light is on that side.
+std::vector<Ray> leaving_their_triangles(const MeshData& mesh, std::vector<Ray> rays, const std::vector<Hit>& hits);
 // Rays from `inside` aimed exactly at every vertex, every edge midpoint and `per_edge` random
 // points on every edge of the mesh (points computed in float, as a renderer would).
 std::vector<Ray> rays_at_vertices_and_edges(const MeshData& mesh, const Vec3& inside, int per_edge, uint64_t seed);
