@@ -35,7 +35,7 @@ namespace {
 
 struct Flat {  // a ray set as the batch API takes it
   std::vector<float> org, dir, tfar;
-  std::vector<PrimRef> self;
+  std::vector<TriangleRef> self;
   size_t count = 0;
 };
 

@@ -8,8 +8,8 @@ namespace toyrt {
 
 inline constexpr int32_t kInvalidId = -1;
 
-// One triangle of one instance.
-struct PrimRef {
+// One triangle of one instance (named apart from the SAH builder's PrimRef, its primitive record).
+struct TriangleRef {
   int32_t prim = kInvalidId;
   int32_t instance = kInvalidId;
 };
@@ -18,7 +18,7 @@ struct Ray {
   Ray() = default;
   // A constructor, not aggregate initialisation: -Wextra warns at every Ray{org, tnear, dir, tfar}
   // that leaves `self` to its default, which is what most rays want.
-  Ray(const Vec3& o, float near, const Vec3& d, float far, PrimRef leaves = {})
+  Ray(const Vec3& o, float near, const Vec3& d, float far, TriangleRef leaves = {})
       : org(o), tnear(near), dir(d), tfar(far), self(leaves) {}
 
   Vec3 org;
@@ -30,9 +30,11 @@ struct Ray {
   // line meets that triangle's plane only behind the origin, so the exact test rejects it anyway,
   // but only after working out that the crossing is behind the start within rounding: the most
   // expensive step of a block test, reached on nearly every such ray (docs/trace-speed.md,
-  // thirty-second session). Not for a ray going back through the triangle it starts on, which
-  // really crosses it.
-  PrimRef self;
+  // thirty-second session). Where the offset does not clear the triangle after all (an instance's
+  // transform rounding the plane, a grazing direction rounded back below it), naming it removes that
+  // self-hit, as in Cycles. Not for a ray meant to go back through the triangle it starts on,
+  // which really crosses it.
+  TriangleRef self;
 };
 
 struct Hit {

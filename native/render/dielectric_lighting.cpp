@@ -9,7 +9,7 @@
 
 namespace toyrt {
 
-DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& ng, PrimRef self,
+DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& ng, TriangleRef self,
                                  const DielectricLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t light_dim,
                                  uint32_t lobe_dim, uint32_t side_dim, uint32_t emitter_dim,
                                  const IntegratorSettings& settings, uint8_t receiver_set) {

@@ -28,7 +28,7 @@ struct DielectricStep {
 
 // ng: the geometric normal on wo's side. Lamp j draws from Sobol-Owen dimension light_dim + j;
 // the lobe's normal from lobe_dim (2D) and its side from side_dim (1D).
-[[gnu::noinline]] DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& ng, PrimRef self,
+[[gnu::noinline]] DielectricStep dielectric_vertex(const Scene& scene, const Vec3& p, const Vec3& ng, TriangleRef self,
                                                    const DielectricLobe& lobe, uint32_t pixel, uint32_t sample,
                                                    uint32_t light_dim, uint32_t lobe_dim, uint32_t side_dim,
                                                    uint32_t emitter_dim, const IntegratorSettings& settings,

@@ -141,7 +141,7 @@ Vec3 lobe_vertex_lighting(const Scene& scene, const LobeVertex& v, uint32_t pixe
   return sum;
 }
 
-GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng, PrimRef self,
+GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng, TriangleRef self,
                          const GlossyLobe& lobe, uint32_t pixel, uint32_t sample, uint32_t light_dim, uint32_t lobe_dim,
                          uint32_t emitter_dim, const IntegratorSettings& settings, uint8_t receiver_set) {
   GlossyStep step;
@@ -155,7 +155,7 @@ GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, 
   return step;
 }
 
-GlossyStep mixture_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng, PrimRef self,
+GlossyStep mixture_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng, TriangleRef self,
                           const Scatter& mixture, uint32_t pixel, uint32_t sample, uint32_t light_dim,
                           uint32_t lobe_dim, uint32_t pick_dim, uint32_t emitter_dim,
                           const IntegratorSettings& settings, uint8_t receiver_set) {

@@ -44,7 +44,7 @@ struct LobeVertex {
   Vec3 p{0.0f};                                // the hit point
   Vec3 ng{0.0f};                               // the geometric normal on wo's side
   Vec3 above{0.0f}, below{0.0f};               // the shadow rays' origins on each side
-  PrimRef self;                                // the triangle hit: the shadow rays leave it
+  TriangleRef self;                            // the triangle hit: the shadow rays leave it
   const Scatter* mixture = nullptr;
   // The normal the light tree weighs emitters by: the glossy lobe's (the mixture's shading
   // normal); 0 (none) for a dielectric, which takes light from both sides.
@@ -116,7 +116,7 @@ struct GlossyStep {
   bool diffuse = false;  // mixture_vertex: the diffuse closure drew wi (the ray only looks for light)
 };
 [[gnu::noinline]] GlossyStep glossy_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng,
-                                           PrimRef self, const GlossyLobe& lobe, uint32_t pixel, uint32_t sample,
+                                           TriangleRef self, const GlossyLobe& lobe, uint32_t pixel, uint32_t sample,
                                            uint32_t light_dim, uint32_t lobe_dim, uint32_t emitter_dim,
                                            const IntegratorSettings& settings, uint8_t receiver_set = 0);
 
@@ -124,7 +124,7 @@ struct GlossyStep {
 // the light samples evaluate the whole mixture, and the continuation's closure is picked on
 // dimension pick_dim (1D) before its direction is drawn from lobe_dim.
 [[gnu::noinline]] GlossyStep mixture_vertex(const Scene& scene, const Vec3& p, const Vec3& origin, const Vec3& ng,
-                                            PrimRef self, const Scatter& mixture, uint32_t pixel, uint32_t sample,
+                                            TriangleRef self, const Scatter& mixture, uint32_t pixel, uint32_t sample,
                                             uint32_t light_dim, uint32_t lobe_dim, uint32_t pick_dim,
                                             uint32_t emitter_dim, const IntegratorSettings& settings,
                                             uint8_t receiver_set = 0);

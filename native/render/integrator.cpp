@@ -33,7 +33,7 @@ struct SurfaceHit {
   int32_t material = -1;
   uint8_t receiver_set = 0;                  // the instance's light-linking receiver set (lights/light_linking.h)
   uint64_t light_receivers = kAllLightSets;  // the sets its emission lights, if it emits (Instance)
-  PrimRef self;                              // the triangle hit: the self of the rays that leave it
+  TriangleRef self;                          // the triangle hit: the self of the rays that leave it
 };
 
 // Out of line on purpose: inlined into trace_from (as GCC chose once nothing else called it) it
@@ -62,7 +62,7 @@ struct SurfaceHit {
   if (!sh.material_ids.empty()) s.material = sh.material_ids[size_t(hit.prim)];
   s.receiver_set = inst.receiver_set;
   s.light_receivers = inst.light_receivers;
-  s.self = PrimRef{hit.prim, hit.instance};
+  s.self = TriangleRef{hit.prim, hit.instance};
   return s;
 }
 
@@ -78,7 +78,7 @@ int32_t material_of(const Scene& scene, const Hit& hit) {
 struct DiffusePoint {
   Vec3 origin, ng, ns, f;
   int depth;
-  PrimRef self;  // the triangle the point lies on: its shadow and cosine rays leave it
+  TriangleRef self;  // the triangle the point lies on: its shadow and cosine rays leave it
 };
 
 // The diffuse BRDF value towards wi: the point's f (Lambert), or f times Burley's factor (Blender

@@ -24,7 +24,7 @@ CrossedSurface crossed_surface(const Scene& scene, const Hit& hit) {
   return s;
 }
 
-Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng, PrimRef crossed) {
+Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng, TriangleRef crossed) {
   const Vec3 origin = offset_ray_origin(at, glm::dot(ng, ray.dir) > 0.0f ? ng : -ng);
   if (std::isinf(ray.tfar)) return Ray{origin, 0.0f, ray.dir, kInfinity, crossed};
   const Vec3 to_end = ray.org + ray.dir * ray.tfar - origin;
@@ -58,7 +58,7 @@ Hit walk_to_opaque(const Scene& scene, Ray ray, int budget, Vec3& tr, bool caste
     }
     tr *= (1.0f - t.opacity_at(scene.textures(), s.uv)) * t.color;
     if (tr == Vec3(0.0f)) return hit;
-    ray = continue_through(ray, s.p, s.ng, PrimRef{hit.prim, hit.instance});
+    ray = continue_through(ray, s.p, s.ng, TriangleRef{hit.prim, hit.instance});
   }
 }
 

@@ -31,7 +31,7 @@ CrossedSurface crossed_surface(const Scene& scene, const Hit& hit);
 // The ray that goes on from `at` (on the surface `crossed`, with normal ng) to where `ray` ends:
 // the same direction for a ray to infinity, else towards its end point with tfar 1. tnear > tfar
 // when the end is already behind. It leaves `crossed` (its self).
-Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng, PrimRef crossed);
+Ray continue_through(const Ray& ray, const Vec3& at, const Vec3& ng, TriangleRef crossed);
 
 // The product of the transparent weights along `ray`, or 0 when it is blocked; at most `budget`
 // transparent surfaces pass. casters_only: a shadow ray (instances that cast shadows, among the
@@ -70,8 +70,8 @@ class CutOutPath {
   bool ends_here() const { return end_at_next_surface_; }
   // At a surface of material `material` (p, unit geometric normal ng, uv): whether the path passes
   // through (passes_through on u), then `ray` goes on beyond it and the crossing is counted.
-  bool pass(const Scene& scene, int32_t material, const Vec3& p, const Vec3& ng, PrimRef at, const Vec2& uv, float u,
-            Vec3& throughput, Ray& ray) {
+  bool pass(const Scene& scene, int32_t material, const Vec3& p, const Vec3& ng, TriangleRef at, const Vec2& uv,
+            float u, Vec3& throughput, Ray& ray) {
     if (material < 0 || size_t(material) >= scene.transparency().size()) return false;
     const MaterialTransparency& t = scene.transparency()[size_t(material)];
     if (!t.transparent() || !passes_through(scene, t, uv, u, throughput)) return false;

@@ -68,8 +68,9 @@ struct RayBatch {
   const float* tfar = nullptr;
   size_t tfar_stride = 0;
   size_t count = 0;
-  // The triangle each ray leaves (Ray::self), one per ray; none where not given.
-  const PrimRef* self = nullptr;
+  // The triangle each ray leaves (Ray::self), one per ray; none where not given. intersect and
+  // occluded read it; the geometric queries (queries/) do not.
+  const TriangleRef* self = nullptr;
 
   // Ray i of the batch (tnear 0 and tfar infinite where their arrays are not given).
   Ray at(size_t i) const {

@@ -117,7 +117,7 @@ TEST(Scene, ARayNeverHitsTheTriangleItLeavesAndStillHitsItsTwinInAnotherInstance
   flat.add_instance(flat.add_mesh(both, {{0, 1, 2}, {3, 4, 5}}), Mat4(1.0f));
   flat.commit();
   const Ray down(Vec3(0.25f, 0.5f, 0.0f), 0.0f, Vec3(0, 0, -1), kInfinity);
-  auto leaving = [&](PrimRef self, float tfar) { return Ray(down.org, 0.0f, down.dir, tfar, self); };
+  auto leaving = [&](TriangleRef self, float tfar) { return Ray(down.org, 0.0f, down.dir, tfar, self); };
 
   Hit h = twins.intersect(down);
   EXPECT_EQ(h.t, 0.0f);
@@ -144,7 +144,7 @@ TEST(Scene, ARayNeverHitsTheTriangleItLeavesAndStillHitsItsTwinInAnotherInstance
   EXPECT_TRUE(flat.occluded(leaving({0, 0}, 1.5f)));
   // The batch API passes each ray's self on.
   const float org[6] = {0.25f, 0.5f, 0.0f, 0.25f, 0.5f, 0.0f}, dir[6] = {0, 0, -1, 0, 0, -1};
-  const PrimRef selves[2] = {{}, {0, 0}};
+  const TriangleRef selves[2] = {{}, {0, 0}};
   RayBatch batch{org, dir, nullptr, 0, nullptr, 0, 2};
   batch.self = selves;
   float t[2], u[2], w[2];

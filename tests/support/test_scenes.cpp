@@ -228,7 +228,7 @@ std::vector<Ray> leaving_their_triangles(const MeshData& mesh, std::vector<Ray> 
     const Vec3 n = geometric_normal(mesh, hit.prim);
     const float origin_side = glm::dot(n, r.org - hit_point(mesh, hit)), going = glm::dot(n, r.dir);
     if ((origin_side > 0.0f && going > 0.0f) || (origin_side < 0.0f && going < 0.0f))
-      r.self = PrimRef{hit.prim, hit.instance};
+      r.self = TriangleRef{hit.prim, hit.instance};
   }
   return rays;
 }
