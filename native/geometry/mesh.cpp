@@ -197,6 +197,7 @@ bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, flo
   const TriangleBlock* blocks = blocks_.data();
   uint32_t found_block = 0;
   int found_lane = 0;
+  bool recorded = false;
   const bool found = traverse_wide<AnyHit>(
       wide_, box_ray, tnear, tfar,
       [&](uint32_t first, uint32_t count, float& t_max) __attribute__((always_inline)) {
@@ -205,10 +206,17 @@ bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, flo
         for (uint32_t k = first; k < end; ++k) {
           hit |=
               intersect_block<AnyHit, kSkip>(tri_ray, block_ray, blocks[k], tnear, t_max, skip, [&](int lane, float t) {
-                if (t < t_max) {
-                  t_max = t;
+                // The nearest so far; and the first this walk finds even where its float distance
+                // only ties t_max (the block test put it before t_max in the scaled domain; t_max
+                // stays, and the end below keeps t < tfar). Without that, a mesh reported such a
+                // lane as hit without naming it, and the walk's answer was block 0's first
+                // triangle (found by tests/fuzz: two coincident instances, the second one's
+                // crossing tying the first's).
+                if (t < t_max || !recorded) {
+                  t_max = std::min(t, t_max);
                   found_block = k;
                   found_lane = lane;
+                  recorded = true;
                 }
               });
           if (AnyHit && hit) return true;

@@ -3,7 +3,8 @@
 // the camera, light and texture constructors and their lookups. Built with ASan + UBSan, so any
 // memory error or undefined behaviour is a crash, and the properties below are checked on top:
 //   - add_mesh / add_instance refuse exactly the inputs the API documents as invalid;
-//   - intersect and occluded agree, and a hit lies on [tnear, tfar) on a real triangle;
+//   - intersect and occluded agree, and a hit lies on [tnear, tfar) on a real triangle; the same
+//     ray naming that triangle (Ray::self) never hits it, and its two queries agree too;
 //   - on moderately sized inputs the scene finds a hit exactly when a brute-force loop over every
 //     triangle of every instance does (the BVH's boxes are conservative);
 //   - batch queries equal single-ray queries;
@@ -228,6 +229,15 @@ void fuzz_scene(FuzzedDataProvider& in) {
       FUZZ_CHECK(h.t >= r.tnear && h.t < r.tfar);
     } else {
       FUZZ_CHECK(h.t == kInfinity && h.instance == kInvalidId);
+    }
+    // Ray::self: the same ray naming the triangle it hit never hits that one (it finds another,
+    // or none), and its two queries still agree (the walks compiled for a named triangle).
+    if (h.found()) {
+      Ray named = r;
+      named.self = TriangleRef{h.prim, h.instance};
+      const Hit n = scene.intersect(named);
+      FUZZ_CHECK(!(n.prim == h.prim && n.instance == h.instance));
+      FUZZ_CHECK(n.found() == scene.occluded(named));
     }
     if (all_moderate && moderate(r.org) && moderate(r.dir) && moderate(r.tnear) &&
         (moderate(r.tfar) || r.tfar == kInfinity)) {
