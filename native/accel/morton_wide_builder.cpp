@@ -247,6 +247,12 @@ struct TopDown {
   BBox build(Range r, size_t at, TaskTree& out) const {
     Range kids[kWidth];
     const int n = open(r, kids);
+    // The leaves' boxes are read at random (by sorted code, from boxes in mesh order): every leaf
+    // child's reads are requested at once, before the first box is needed. The LBVH commit 2 %
+    // faster at 200K-4M triangles (docs/trace-speed.md, thirty-third session).
+    for (int i = 0; i < n; ++i)
+      if (kids[i].size() <= leaf_size)
+        for (uint32_t k = kids[i].begin; k < kids[i].end; ++k) __builtin_prefetch(&bounds[prim_of(keys[k])]);
     WideNode node;
     for (int a = 0; a < 3; ++a)
       for (int i = 0; i < kWidth; ++i) {

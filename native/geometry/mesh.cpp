@@ -18,11 +18,12 @@
 namespace toyrt {
 namespace {
 
-// Writes a finished block to the blocks array past the caches (non-temporal stores): the array
-// (40 MB at a million triangles) is written once and not read again during the commit, and
-// ordinary stores first read every line they fill. The block is made in a local copy and then
-// streamed whole. The LBVH commit 4 % faster at 10K, 200K, 1M and 4M triangles (32-byte stores;
-// 16-byte ones 1-3 %), the SAH commit unchanged (docs/trace-speed.md, thirty-third session).
+// Writes a finished block to the blocks array past the caches (non-temporal stores), for arrays
+// too large to stay cached (40-48 MB at a million triangles): written once and not read again by
+// the commit, whose ordinary stores first read every line they fill. The block is made in a local
+// copy so that each of its lines is written whole in one go, which is what lets the write-combining
+// buffers send full lines. The 1M and 4M LBVH commits 4 % faster (32-byte stores; 16-byte ones
+// 1-3 %), the SAH commit unchanged (docs/trace-speed.md, thirty-third session).
 void store_streaming(TriangleBlock& to, const TriangleBlock& from) {
 #if defined(__AVX__)
   using Row = __m256;
@@ -39,8 +40,9 @@ void store_streaming(TriangleBlock& to, const TriangleBlock& from) {
 #endif
 }
 
-// Orders this thread's streamed stores before what follows it (the end of a parallel task, after
-// which other threads read the blocks): non-temporal stores are not ordered by ordinary fences.
+// Orders this thread's streamed stores before what follows (the end of a parallel task, after
+// which other threads read the blocks): the release and acquire of C++ atomics are plain moves on
+// x86, which do not order non-temporal stores.
 void end_streaming() {
 #if defined(__SSE__)
   _mm_sfence();
@@ -173,6 +175,8 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
   blocks_.clear();
   blocks_.shrink_to_fit();
   blocks_.resize(block_count);  // exactly, and not zeroed (HugePageAllocator): every field is written below
+  // Blocks that fit in the caches are written there, for the rays that follow the commit.
+  const bool stream = blocks_.size() * sizeof(TriangleBlock) > kPrefetchBlockBytes;
   auto emit = [&](uint32_t first, uint32_t count, uint32_t start) {
     for (uint32_t k = 0; k < count; k += kBlockWidth) {
       TriangleBlock b;
@@ -189,12 +193,15 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
         for (int v = 0; v < 3; ++v)
           for (int a = 0; a < 3; ++a) b.p[v][a][lane] = vertices_[triangles_[tri][v]][a];
       }
-      store_streaming(blocks_[start + k / kBlockWidth], b);
+      if (stream)
+        store_streaming(blocks_[start + k / kBlockWidth], b);
+      else
+        blocks_[start + k / kBlockWidth] = b;
     }
   };
   if (wide_.root_leaf_count) {
     emit(wide_.root_leaf_first, wide_.root_leaf_count, 0);
-    end_streaming();
+    if (stream) end_streaming();
     wide_.root_leaf_first = 0;
   }
   // Grains of 64 nodes (about 2,500 triangles): with 512 a 10K-triangle mesh's ~280 nodes were one
@@ -210,7 +217,7 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
         start += blocks_of(n.count[k]);
       }
     }
-    end_streaming();
+    if (stream) end_streaming();
   });
   // Blocks beyond the caches are fetched ahead by the closest-hit walk; where they fit, the
   // prefetches were pure cost (1-3 % slower at 10K and 100K triangles, 3-8 % faster at 1M).

@@ -73,7 +73,8 @@ class Mesh {
   BBox bounds_;
   bool built_ = false;
   // Whether the closest-hit walk prefetches each leaf's block (finish(): the blocks exceed
-  // kPrefetchBlockBytes, about twice the last-level cache of the machines measured).
+  // kPrefetchBlockBytes, about twice the last-level cache of the machines measured). finish()
+  // also writes such blocks past the caches.
   static constexpr size_t kPrefetchBlockBytes = size_t(16) << 20;
   bool prefetch_blocks_ = false;
 };
