@@ -198,6 +198,9 @@ struct TopDown {
   const Key* keys;
   uint32_t leaf_size;
   uint32_t task_size;  // task_primitives() of the mesh
+  // Whether the boxes outgrow a core's L2 cache (512 KB-1 MB on the machines measured), so that
+  // their random reads miss it; below that the prefetches are instructions for nothing.
+  bool prefetch_boxes;
 
   // Where the range splits: the first slot whose code has the highest bit in which the range's
   // first and last codes differ (the codes are sorted, so every code in the range shares the bits
@@ -250,9 +253,10 @@ struct TopDown {
     // The leaves' boxes are read at random (by sorted code, from boxes in mesh order): every leaf
     // child's reads are requested at once, before the first box is needed. The LBVH commit 2 %
     // faster at 200K-4M triangles (docs/trace-speed.md, thirty-third session).
-    for (int i = 0; i < n; ++i)
-      if (kids[i].size() <= leaf_size)
-        for (uint32_t k = kids[i].begin; k < kids[i].end; ++k) __builtin_prefetch(&bounds[prim_of(keys[k])]);
+    if (prefetch_boxes)
+      for (int i = 0; i < n; ++i)
+        if (kids[i].size() <= leaf_size)
+          for (uint32_t k = kids[i].begin; k < kids[i].end; ++k) __builtin_prefetch(&bounds[prim_of(keys[k])]);
     WideNode node;
     for (int a = 0; a < 3; ++a)
       for (int i = 0; i < kWidth; ++i) {
@@ -358,7 +362,8 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
   // Tasks level by level: each builds its subtree but for the children it hands on, which become
   // the next level's tasks in the order they were met, so task numbers (and the layout) do not
   // depend on which thread ran what.
-  const TopDown top_down{prim_bounds, keys, leaf_size, task_primitives(count)};
+  const TopDown top_down{prim_bounds, keys, leaf_size, task_primitives(count),
+                         count * sizeof(BBox) > (size_t(1) << 20)};
   std::vector<Range> ranges{{0u, uint32_t(count)}};
   std::vector<TaskTree> tasks;
   for (size_t level = 0; level < ranges.size();) {
