@@ -175,8 +175,9 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
   blocks_.clear();
   blocks_.shrink_to_fit();
   blocks_.resize(block_count);  // exactly, and not zeroed (HugePageAllocator): every field is written below
-  // Blocks that fit in the caches are written there, for the rays that follow the commit.
-  const bool stream = blocks_.size() * sizeof(TriangleBlock) > kPrefetchBlockBytes;
+  // Blocks beyond the caches are streamed past them; blocks that fit are written there, for the
+  // rays that follow the commit.
+  const bool beyond_caches = blocks_.size() * sizeof(TriangleBlock) > kPrefetchBlockBytes;
   auto emit = [&](uint32_t first, uint32_t count, uint32_t start) {
     for (uint32_t k = 0; k < count; k += kBlockWidth) {
       TriangleBlock b;
@@ -193,7 +194,7 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
         for (int v = 0; v < 3; ++v)
           for (int a = 0; a < 3; ++a) b.p[v][a][lane] = vertices_[triangles_[tri][v]][a];
       }
-      if (stream)
+      if (beyond_caches)
         store_streaming(blocks_[start + k / kBlockWidth], b);
       else
         blocks_[start + k / kBlockWidth] = b;
@@ -201,7 +202,7 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
   };
   if (wide_.root_leaf_count) {
     emit(wide_.root_leaf_first, wide_.root_leaf_count, 0);
-    if (stream) end_streaming();
+    if (beyond_caches) end_streaming();
     wide_.root_leaf_first = 0;
   }
   // Grains of 64 nodes (about 2,500 triangles): with 512 a 10K-triangle mesh's ~280 nodes were one
@@ -217,11 +218,11 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
         start += blocks_of(n.count[k]);
       }
     }
-    if (stream) end_streaming();
+    if (beyond_caches) end_streaming();
   });
   // Blocks beyond the caches are fetched ahead by the closest-hit walk; where they fit, the
   // prefetches were pure cost (1-3 % slower at 10K and 100K triangles, 3-8 % faster at 1M).
-  prefetch_blocks_ = blocks_.size() * sizeof(TriangleBlock) > kPrefetchBlockBytes;
+  prefetch_blocks_ = beyond_caches;
   built_ = true;
 }
 
