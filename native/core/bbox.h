@@ -40,9 +40,15 @@ struct RayBoxData {
   Vec3 inv_dir;  // 1/dir; +-inf where a component is +-0 (IEEE division keeps the sign of zero)
   int near[3];   // index of the near plane per axis in a {lo.x, lo.y, lo.z, hi.x, hi.y, hi.z} array
   int far[3];    // index of the far plane: near[a] +- 3
+  // intersect_box's origins for the near and far planes: org moved by the pad towards or away
+  // from the planes, which tests every box as if grown by the pad on all sides ((lo - pad - o) /
+  // d = (lo - (o + pad)) / d). Equal to org without a pad.
+  Vec3 near_org, far_org;
 };
 
-inline RayBoxData make_ray_box_data(const Vec3& org, const Vec3& dir) {
+// pad >= 0 grows every box intersect_box tests by that much (the top level's instance boxes:
+// scene/instance_bounds.h); the wide walks ignore it.
+inline RayBoxData make_ray_box_data(const Vec3& org, const Vec3& dir, float pad = 0.0f) {
   RayBoxData r;
   r.org = org;
   r.inv_dir = Vec3(1.0f / dir.x, 1.0f / dir.y, 1.0f / dir.z);
@@ -50,6 +56,8 @@ inline RayBoxData make_ray_box_data(const Vec3& org, const Vec3& dir) {
     const bool negative = std::signbit(r.inv_dir[a]);
     r.near[a] = negative ? a + 3 : a;
     r.far[a] = negative ? a : a + 3;
+    r.near_org[a] = negative ? org[a] - pad : org[a] + pad;
+    r.far_org[a] = negative ? org[a] + pad : org[a] - pad;
   }
   return r;
 }
@@ -69,8 +77,8 @@ inline RayBoxData make_ray_box_data(const Vec3& org, const Vec3& dir) {
 inline float intersect_box(const RayBoxData& r, const float* bounds, float tnear, float tfar) {
   float tmin = tnear, tmax = kInfinity;
   for (int a = 0; a < 3; ++a) {
-    tmin = safe_max(tmin, (bounds[r.near[a]] - r.org[a]) * r.inv_dir[a]);
-    tmax = safe_min(tmax, (bounds[r.far[a]] - r.org[a]) * r.inv_dir[a]);
+    tmin = safe_max(tmin, (bounds[r.near[a]] - r.near_org[a]) * r.inv_dir[a]);
+    tmax = safe_min(tmax, (bounds[r.far[a]] - r.far_org[a]) * r.inv_dir[a]);
   }
   if (tmin < 0.0f) tmin *= 1.0f + 2.0f * gamma(3);
   tmax = std::min(tmax * (tmax < 0.0f ? 1.0f - 2.0f * gamma(3) : 1.0f + 2.0f * gamma(3)), tfar);

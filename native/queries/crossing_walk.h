@@ -81,7 +81,7 @@ void for_each_crossing(const Scene& scene, const Ray& ray, Visit&& visit) {
   if (!is_valid_ray(ray)) return;
   const Bvh& top = scene.top_level();
   float t_max = ray.tfar;
-  traverse<false>(top, make_ray_box_data(ray.org, ray.dir), ray.tnear, t_max,
+  traverse<false>(top, make_ray_box_data(ray.org, ray.dir, scene.instance_box_pad(ray.org)), ray.tnear, t_max,
                   [&](uint32_t first, uint32_t count, float&) {
                     for (uint32_t k = first; k < first + count; ++k) {
                       const uint32_t id = top.prim_ids[k];
@@ -136,7 +136,7 @@ void for_each_crossing_of_rays(const Scene& scene, const RayBatch& rays, size_t 
     const Ray ray = rays.at(i);
     if (!is_valid_ray(ray)) continue;
     float t_max = ray.tfar;
-    traverse<false>(top, make_ray_box_data(ray.org, ray.dir), ray.tnear, t_max,
+    traverse<false>(top, make_ray_box_data(ray.org, ray.dir, scene.instance_box_pad(ray.org)), ray.tnear, t_max,
                     [&](uint32_t first, uint32_t count, float&) {
                       for (uint32_t k = first; k < first + count; ++k) jobs.push_back({uint32_t(i), top.prim_ids[k]});
                       return false;

@@ -5,6 +5,7 @@
 #include "accel/traverse.h"
 #include "accel/wide_traverse.h"
 #include "core/parallel.h"
+#include "scene/instance_bounds.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -48,6 +49,14 @@ Mat4 Scene::checked_inverse(const Mat4& to_world) {
     for (int r = 0; r < 4; ++r) finite_inverse &= bool(std::isfinite(to_object[c][r]));
   if (det == 0.0 || !finite_inverse)
     throw std::invalid_argument("instance transform is singular (zero scale): it cannot be inverted");
+  // A determinant of rounded products can be non-zero for rows that are exactly dependent; what
+  // matters is whether the float inverse carries rays into object space with a bounded error
+  // (instance_bounds.h).
+  const TransformError error = transform_error(to_world, to_object);
+  if (!error.invertible())
+    throw std::invalid_argument("instance transform is nearly singular: its single-precision inverse is off by " +
+                                std::to_string(error.inverse) +
+                                " (|to_world * to_object - I|); apply the transform to the vertices instead");
   return to_object;
 }
 
@@ -339,20 +348,18 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
     }
     std::vector<uint32_t> placed;
     std::vector<BBox> boxes;
+    origin_pad_factor_ = 0.0f;
     for (uint32_t i = 0; i < instances_.size(); ++i) {
       Instance& inst = instances_[i];
       const BBox& b = meshes_[inst.mesh]->bounds();
       inst.world_bounds = BBox{};
       if (meshes_[inst.mesh]->wide_bvh().empty()) continue;  // nothing to hit
-      for (int corner = 0; corner < 8; ++corner) {
-        const Vec3 p((corner & 1) ? b.hi.x : b.lo.x, (corner & 2) ? b.hi.y : b.lo.y, (corner & 4) ? b.hi.z : b.lo.z);
-        inst.world_bounds.extend(Vec3(inst.to_world * glm::vec4(p, 1.0f)));
-      }
-      if (!inst.identity) {
-        // The transformed corners are rounded; widen by a few ulps so the box stays conservative.
-        const Vec3 pad = (glm::abs(inst.world_bounds.lo) + glm::abs(inst.world_bounds.hi)) * (4.0f * gamma(4));
-        inst.world_bounds.lo -= pad;
-        inst.world_bounds.hi += pad;
+      if (inst.identity) {
+        inst.world_bounds = b;  // the walk's ray is the world ray: the mesh box is exact
+      } else {
+        const TransformError error = transform_error(inst.to_world, inst.to_object);
+        inst.world_bounds = instance_world_bounds(b, inst.to_world, error);
+        origin_pad_factor_ = std::max(origin_pad_factor_, origin_pad_factor(error));
       }
       placed.push_back(i);
       boxes.push_back(inst.world_bounds);
@@ -434,7 +441,7 @@ bool Scene::trace(const Ray& ray, Hit& hit, uint64_t blockers, uint8_t seen_by) 
 template <bool AnyHit, bool ShadowCastersOnly, bool Visibility>
 [[gnu::noinline]] bool Scene::trace_instances(const Ray& ray, Hit& hit, uint64_t blockers, uint8_t seen_by) const {
   float tfar = ray.tfar;
-  const RayBoxData box_ray = make_ray_box_data(ray.org, ray.dir);
+  const RayBoxData box_ray = make_ray_box_data(ray.org, ray.dir, instance_box_pad(ray.org));
   const bool found =
       traverse<AnyHit>(top_, box_ray, ray.tnear, tfar, [&](uint32_t first, uint32_t count, float& t_max) {
         bool any = false;

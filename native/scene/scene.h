@@ -196,6 +196,13 @@ class Scene {
   const Mesh& mesh(uint32_t id) const { return *meshes_.at(id); }
   const Instance& instance(uint32_t id) const { return instances_.at(id); }
   const Bvh& top_level() const { return top_; }
+  // The pad by which a walk of top_level() must widen its boxes for a ray from org: the instance
+  // boxes are conservative for the rays the meshes see only with it (instance_bounds.h).
+  float instance_box_pad(const Vec3& org) const {
+    if (origin_pad_factor_ == 0.0f) return 0.0f;
+    const Vec3 m = glm::abs(org);
+    return origin_pad_factor_ * std::max(m.x, std::max(m.y, m.z));
+  }
   const MeshShading& shading(uint32_t mesh) const { return shading_[mesh]; }  // one per mesh, always
   const std::vector<Material>& materials() const { return materials_; }       // empty: all default grey
   const std::vector<Texture>& textures() const { return textures_; }
@@ -298,7 +305,10 @@ class Scene {
   bool light_tree_current_ = false;    // add_light and clear_lights reset it, commit() rebuilds
   std::vector<uint64_t> light_reach_;  // light_receiver_sets(), parallel to world_.lights, or empty
   std::vector<Instance> instances_;
-  Bvh top_;                       // over instances with a non-empty world box
+  Bvh top_;  // over instances with a non-empty world box
+  // The top-level walk widens every instance box by this times the ray origin's largest
+  // coordinate: the rounding of rays sent into object space grows with it (instance_bounds.h).
+  float origin_pad_factor_ = 0.0f;
   bool single_identity_ = false;  // one untransformed instance: skip the top level
   bool all_cast_shadows_ = true;  // no instance with visible_shadow off: shadowed() is occluded()
   bool all_visible_ = true;       // every instance seen by every path ray: intersect(ray, kinds) is intersect(ray)
