@@ -59,6 +59,7 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
+  keep_freed_memory();
   const std::optional<Args> args = parse_args(argc, argv, "[--out FILE.md] [--csv FILE.csv] [--runs N] [--quick]", 3);
   if (!args) return 2;
   const int width = args->quick ? 256 : 512, height = args->quick ? 192 : 384;

@@ -100,6 +100,7 @@ std::string triangles_label(size_t n) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  keep_freed_memory();
   const std::optional<Args> args = parse_args(argc, argv, "[--out FILE] [--runs N] [--quick]", 5);
   if (!args) return 2;
   const std::string& out_path = args->out;

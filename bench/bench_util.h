@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <malloc.h>
 #include <memory>
 #include <optional>
 #include <string>
@@ -39,6 +40,19 @@ using Clock = std::chrono::steady_clock;
 inline double ms_since(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
+// Warm builds for every engine, on purpose: glibc returns large freed blocks to the kernel
+// (mmap'd ones at once, the heap's top past 128 KB), so an engine that takes its build memory
+// through malloc pays the kernel's zeroing of fresh pages on every build, or not, depending on
+// what the process freed before (docs/trace-speed.md, thirty-third session: Embree's Morton build
+// at 1M took 35-46 ms inside bench_trace's sequence and 42-72 ms elsewhere). Blocks up to 32 MB
+// (glibc's largest mmap threshold) come from the heap and freed memory stays in it, so each timed
+// build reuses what the warm-up build touched, as TOYRT's own pool (core/huge_page_pool.h) does.
+// Called first thing by the programs that time builds.
+inline void keep_freed_memory() {
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+}
+
 inline double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);

@@ -24,6 +24,7 @@
 #include "accel/lbvh_builder.h"
 #include "accel/morton_wide_builder.h"
 #include "accel/wide_bvh.h"
+#include "bench_util.h"
 #include "embree_oracle.h"
 #include "geometry/triangle_block.h"
 #include "scene/scene.h"
@@ -40,6 +41,7 @@ using namespace toyrt;
 using namespace toyrt::testing;
 
 int main(int argc, char** argv) {
+  bench::keep_freed_memory();
   const std::string kind = argc > 1 ? argv[1] : "diffuse";
   const int rings = argc > 2 ? std::atoi(argv[2]) : 224;
   const int repeats = argc > 3 ? std::atoi(argv[3]) : 1;
