@@ -64,7 +64,7 @@ WideBuild build_linear_wide(const BBox* bounds, size_t count, uint32_t leaf_size
                             BuildStats& st) {
   if (!lbvh_on_device(config.lbvh)) {
     st.used = BuilderKind::Lbvh;
-    return build_morton_wide(bounds, count, leaf_size);
+    return build_morton_wide(bounds, count, leaf_size, !config.leaf_boxes_by_caller);
   }
   return lbvh_or_sah(
       st, [&](LbvhStats* stats) { return build_lbvh_wide(bounds, count, leaf_size, config.lbvh, stats); },

@@ -61,6 +61,11 @@ struct BuildConfig : BuilderSettings {
   // Rays the caller expects to trace through these primitives, for Auto; < 0: unknown (Auto
   // keeps the SAH builder).
   double expected_rays = -1.0;
+  // The caller bounds each leaf as it lays the leaves out (Mesh::finish reads every triangle's
+  // vertices then anyway), so a builder that would read the primitives' boxes again, at random,
+  // only for the leaves (the host LBVH) may leave the boxes and the slot order to
+  // complete_wide_boxes(): WideBuild::boxes_pending says it did.
+  bool leaf_boxes_by_caller = false;
 };
 
 struct BuildStats {

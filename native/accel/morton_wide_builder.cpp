@@ -201,6 +201,9 @@ struct TopDown {
   // Whether the boxes outgrow a core's L2 cache (512 KB-1 MB on the machines measured), so that
   // their random reads miss it; below that the prefetches are instructions for nothing.
   bool prefetch_boxes;
+  // False: the caller bounds the leaves (WideBuild::boxes_pending), and every box here is a
+  // stand-in point that only marks its slot used.
+  bool leaf_boxes;
 
   // Where the range splits: the first slot whose code has the highest bit in which the range's
   // first and last codes differ (the codes are sorted, so every code in the range shares the bits
@@ -253,7 +256,7 @@ struct TopDown {
     // The leaves' boxes are read at random (by sorted code, from boxes in mesh order): every leaf
     // child's reads are requested at once, before the first box is needed. The LBVH commit 2 %
     // faster at 200K-4M triangles (docs/trace-speed.md, thirty-third session).
-    if (prefetch_boxes)
+    if (prefetch_boxes && leaf_boxes)
       for (int i = 0; i < n; ++i)
         if (kids[i].size() <= leaf_size)
           for (uint32_t k = kids[i].begin; k < kids[i].end; ++k) __builtin_prefetch(&bounds[prim_of(keys[k])]);
@@ -272,7 +275,7 @@ struct TopDown {
     for (int i = 0; i < n; ++i) {
       BBox b;
       if (kids[i].size() <= leaf_size) {
-        b = leaf_box(kids[i]);
+        b = leaf_boxes ? leaf_box(kids[i]) : BBox{Vec3(0.0f), Vec3(0.0f)};
         node.child[i] = kids[i].begin;
         node.count[i] = kids[i].size();
       } else if (kids[i].size() > task_size) {
@@ -293,31 +296,9 @@ struct TopDown {
   }
 };
 
-// The node's used slots moved into any_hit_order (wide_bvh.h), the order collapse() gives them.
-void sort_slots(WideNode& node) {
-  int used[kWidth], order[kWidth];
-  BBox boxes[kWidth];
-  int n = 0;
-  for (int i = 0; i < kWidth; ++i)
-    if (node.used(i)) {
-      used[n] = i;
-      boxes[n++] = node.box(i);
-    }
-  any_hit_order(boxes, n, order);
-  for (int i = 0; i < n; ++i) order[i] = used[order[i]];
-  const WideNode in = node;
-  for (int i = 0; i < kWidth; ++i) {
-    const bool from = i < n;
-    const int s = from ? order[i] : 0;
-    for (int b = 0; b < 6; ++b) node.bounds[b][i] = from ? in.bounds[b][s] : (b < 3 ? kInfinity : -kInfinity);
-    node.child[i] = from ? in.child[s] : 0;
-    node.count[i] = from ? in.count[s] : 0;
-  }
-}
-
 }  // namespace
 
-WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf_size) {
+WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf_size, bool leaf_boxes) {
   WideBuild built;
   if (count == 0) return built;
   // Slots and indices are 32-bit (an index rides in the low half of each sort key).
@@ -362,8 +343,13 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
   // Tasks level by level: each builds its subtree but for the children it hands on, which become
   // the next level's tasks in the order they were met, so task numbers (and the layout) do not
   // depend on which thread ran what.
-  const TopDown top_down{prim_bounds, keys, leaf_size, task_primitives(count),
-                         count * sizeof(BBox) > (size_t(1) << 20)};
+  // The boxes' random reads cost only where they outgrow a core's L2 cache (512 KB-1 MB on the
+  // machines measured): the leaves are left to the caller only there (at 10K triangles the
+  // caller's bottom-up pass cost more than the reads: 0.352-0.358 -> 0.370-0.383 ms).
+  const bool beyond_l2 = count * sizeof(BBox) > (size_t(1) << 20);
+  leaf_boxes = leaf_boxes || !beyond_l2;
+  const TopDown top_down{prim_bounds, keys, leaf_size, task_primitives(count), beyond_l2, leaf_boxes};
+  built.boxes_pending = !leaf_boxes;
   std::vector<Range> ranges{{0u, uint32_t(count)}};
   std::vector<TaskTree> tasks;
   for (size_t level = 0; level < ranges.size();) {
@@ -413,7 +399,7 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
         if (i == 0)
           for (size_t j = 0; j < task.handed_on.size(); ++j)
             node.child[task.handed_on[j].first] = uint32_t(offset[task.handed_to[j]]);
-        sort_slots(node);
+        if (leaf_boxes) sort_slots(node);  // else complete_wide_boxes() sorts them with their boxes
         built.wide.nodes[offset[t] + i] = node;
       }
     }

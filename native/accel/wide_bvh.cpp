@@ -397,6 +397,72 @@ void any_hit_order(const BBox* boxes, int n, int order[kWidth]) {
     }
 }
 
+void sort_slots(WideNode& node) {
+  int used[kWidth], order[kWidth];
+  BBox boxes[kWidth];
+  int n = 0;
+  for (int i = 0; i < kWidth; ++i)
+    if (node.used(i)) {
+      used[n] = i;
+      boxes[n++] = node.box(i);
+    }
+  any_hit_order(boxes, n, order);
+  for (int i = 0; i < n; ++i) order[i] = used[order[i]];
+  const WideNode in = node;
+  for (int i = 0; i < kWidth; ++i) {
+    const bool from = i < n;
+    const int s = from ? order[i] : 0;
+    for (int b = 0; b < 6; ++b) node.bounds[b][i] = from ? in.bounds[b][s] : (b < 3 ? kInfinity : -kInfinity);
+    node.child[i] = from ? in.child[s] : 0;
+    node.count[i] = from ? in.count[s] : 0;
+  }
+}
+
+namespace {
+
+struct BottomUp {
+  std::vector<WideNode, HugePageAllocator<WideNode>>& nodes;
+  const std::function<void(uint32_t)>& leaves;
+  const std::function<void()>& task_end;
+
+  void operator()(uint32_t i, int depth) const {
+    WideNode& n = nodes[i];
+    uint32_t interior[kWidth];
+    int m = 0;
+    for (int k = 0; k < kWidth; ++k)
+      if (n.count[k] == 0 && n.used(k)) interior[m++] = uint32_t(k);
+    // Tasks for the subtrees of the top three levels: up to 512 of them, each of thousands of
+    // primitives on the meshes where this matters.
+    if (depth < 3 && m > 1) {
+      tbb::parallel_for(0, m, [&](int j) {
+        (*this)(n.child[interior[j]], depth + 1);
+        task_end();
+      });
+    } else {
+      for (int j = 0; j < m; ++j) (*this)(n.child[interior[j]], depth + 1);
+    }
+    leaves(i);
+    for (int j = 0; j < m; ++j) {
+      const WideNode& child = nodes[n.child[interior[j]]];
+      BBox b;
+      for (int k = 0; k < kWidth; ++k)
+        if (child.used(k)) b.extend(child.box(k));
+      for (int a = 0; a < 3; ++a) {
+        n.bounds[a][interior[j]] = b.lo[a];
+        n.bounds[a + 3][interior[j]] = b.hi[a];
+      }
+    }
+    sort_slots(n);
+  }
+};
+
+}  // namespace
+
+void complete_wide_boxes(WideBvh& bvh, const std::function<void(uint32_t node)>& leaves,
+                         const std::function<void()>& task_end) {
+  if (!bvh.nodes.empty()) BottomUp{bvh.nodes, leaves, task_end}(0, 0);
+}
+
 WideStats wide_stats(const WideBvh& wide, uint32_t block_width) {
   WideStats s;
   block_width = std::max(block_width, 1u);

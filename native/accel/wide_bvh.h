@@ -8,6 +8,7 @@
 #include "accel/lbvh_layout.h"
 #include "core/huge_page_allocator.h"
 
+#include <functional>
 #include <vector>
 
 namespace toyrt {
@@ -49,7 +50,23 @@ struct WideBvh {
 struct WideBuild {
   WideBvh wide;
   std::vector<uint32_t> prim_ids;
+  // The builder left the boxes to the caller (BuildConfig::leaf_boxes_by_caller): every used slot
+  // holds a stand-in box (a point, so that used() holds), and the slots are in build order. The
+  // caller writes each leaf slot's box, then calls complete_wide_boxes().
+  bool boxes_pending = false;
 };
+
+// Finishes a build with boxes_pending: every subtree before its parent, leaves(i) writing node
+// i's leaf slots' boxes (Mesh::finish copies their triangles into blocks there), then node i's
+// interior slots bounded by their children, just finished and still in cache, and its slots put
+// in any_hit_order. The top levels' subtrees run as parallel tasks, each ending with task_end()
+// on its thread (Mesh::finish fences its streamed stores there). Writes the same boxes and order
+// on any thread count.
+void complete_wide_boxes(
+    WideBvh& bvh, const std::function<void(uint32_t node)>& leaves, const std::function<void()>& task_end = [] {});
+
+// A node's used slots moved into any_hit_order (below), the order collapse() gives them.
+void sort_slots(WideNode& node);
 
 // How collapse() chooses which binary nodes a wide node opens.
 enum class CollapseMethod {

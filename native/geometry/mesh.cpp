@@ -149,6 +149,7 @@ void Mesh::build(BuilderKind kind, const BuildConfig& config, BuildStats* stats)
   Prepared prepared = prepare();
   BuildConfig mine = config;
   mine.sah.leaf_without_search = kBlockWidth;  // the collapse makes leaves of one block
+  mine.leaf_boxes_by_caller = true;            // finish() reads every leaf's vertices anyway
   WideBuild built = build_wide_bvh(kind, prepared.boxes.data(), prepared.count, kBlockWidth, mine, stats);
   // The boxes are freed only after finish(): freeing them before it (24 MB less at the peak at 1M)
   // made the 4M commit on two threads 845 -> 1600 ms in bench_trace, its collapse and blocks
@@ -178,7 +179,10 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
   // Blocks beyond the caches are streamed past them; blocks that fit are written there, for the
   // rays that follow the commit.
   const bool beyond_caches = blocks_.size() * sizeof(TriangleBlock) > kPrefetchBlockBytes;
+  // Copies a leaf's triangles into its blocks; returns their box (the leaf's, where the builder
+  // left it to this copy: boxes_pending).
   auto emit = [&](uint32_t first, uint32_t count, uint32_t start) {
+    BBox box;
     for (uint32_t k = 0; k < count; k += kBlockWidth) {
       TriangleBlock b;
       for (int lane = 0; lane < kBlockWidth; ++lane) {
@@ -191,35 +195,60 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
         const uint32_t slot = prim_ids[first + k + lane];
         const uint32_t tri = triangle_of ? triangle_of[slot] : slot;
         b.prim[lane] = tri;
-        for (int v = 0; v < 3; ++v)
-          for (int a = 0; a < 3; ++a) b.p[v][a][lane] = vertices_[triangles_[tri][v]][a];
+        for (int v = 0; v < 3; ++v) {
+          const Vec3& p = vertices_[triangles_[tri][v]];
+          box.extend(p);
+          for (int a = 0; a < 3; ++a) b.p[v][a][lane] = p[a];
+        }
       }
       if (beyond_caches)
         store_streaming(blocks_[start + k / kBlockWidth], b);
       else
         blocks_[start + k / kBlockWidth] = b;
     }
+    return box;
   };
+  const bool bound_leaves = built.boxes_pending;
   if (wide_.root_leaf_count) {
     emit(wide_.root_leaf_first, wide_.root_leaf_count, 0);
     if (beyond_caches) end_streaming();
     wide_.root_leaf_first = 0;
   }
-  // Grains of 64 nodes (about 2,500 triangles): with 512 a 10K-triangle mesh's ~280 nodes were one
-  // task, and this copy ran on one thread (0.28 -> 0.18 ms of the 10K commit on two threads).
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, wide_.nodes.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i != r.end(); ++i) {
-      WideNode& n = wide_.nodes[i];
-      uint32_t start = first_block[i];
-      for (int k = 0; k < kWidth; ++k) {
-        if (!n.count[k]) continue;
-        emit(n.child[k], n.count[k], start);
-        n.child[k] = start;
-        start += blocks_of(n.count[k]);
-      }
+  // Copies node i's leaves into their blocks and points its leaf slots at them.
+  auto emit_node = [&](size_t i) {
+    WideNode& n = wide_.nodes[i];
+    uint32_t start = first_block[i];
+    for (int k = 0; k < kWidth; ++k) {
+      if (!n.count[k]) continue;
+      const BBox box = emit(n.child[k], n.count[k], start);
+      if (bound_leaves)
+        for (int a = 0; a < 3; ++a) {
+          n.bounds[a][k] = box.lo[a];
+          n.bounds[a + 3][k] = box.hi[a];
+        }
+      n.child[k] = start;
+      start += blocks_of(n.count[k]);
     }
+  };
+  if (!bound_leaves) {
+    // Grains of 64 nodes (about 2,500 triangles): with 512 a 10K-triangle mesh's ~280 nodes were
+    // one task, and this copy ran on one thread (0.28 -> 0.18 ms of the 10K commit on two threads).
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, wide_.nodes.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i != r.end(); ++i) emit_node(i);
+      if (beyond_caches) end_streaming();
+    });
+  } else {
+    // The builder left the boxes to this copy: each subtree is finished before its parent, which
+    // then bounds its interior slots from the children just written (still in cache). A serial
+    // sweep over the nodes after the copy took 4.5 ms at 1M, more than it saved the builder. The
+    // blocks' places were fixed above, so the layout does not depend on the thread count.
+    complete_wide_boxes(
+        wide_, [&](uint32_t i) { emit_node(i); },
+        [&] {
+          if (beyond_caches) end_streaming();
+        });
     if (beyond_caches) end_streaming();
-  });
+  }
   // Blocks beyond the caches are fetched ahead by the closest-hit walk; where they fit, the
   // prefetches were pure cost (1-3 % slower at 10K and 100K triangles, 3-8 % faster at 1M).
   prefetch_blocks_ = beyond_caches;

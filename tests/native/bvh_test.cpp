@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <functional>
 #include <memory>
 
 using namespace toyrt;
@@ -100,6 +101,55 @@ TEST(Mesh, TracedLayoutSameForAnyThreadCount) {
       EXPECT_EQ(
           0, std::memcmp(one->blocks().data(), other->blocks().data(), one->blocks().size() * sizeof(TriangleBlock)));
     }
+  }
+}
+
+TEST(Mesh, EverySlotBoxIsItsTrianglesExactBoundsAndSlotsAreInAnyHitOrder) {
+  // The host LBVH leaves its boxes to Mesh::finish (180K triangles: beyond a core's L2), which
+  // bounds each leaf as it copies its triangles and each interior slot from its child
+  // (complete_wide_boxes); the SAH collapse makes its own. Either way: a slot's box is exactly the bounds of the
+  // triangles under it (min and max are exact, so equality), and a node's used slots come first, by non-increasing
+  // area.
+  const MeshData m = uv_sphere(300, 600, 1.0f, 0.1f);
+  for (const BuilderKind kind : {BuilderKind::Lbvh, BuilderKind::Sah}) {
+    SCOPED_TRACE(builder_name(kind));
+    BuildConfig config;
+    config.lbvh.device = LbvhDevice::Host;
+    Mesh mesh(m.vertices, m.triangles);
+    mesh.build(kind, config);
+    const auto& nodes = mesh.wide_bvh().nodes;
+    ASSERT_FALSE(nodes.empty());
+    size_t wrong_boxes = 0, wrong_order = 0;
+    std::function<BBox(uint32_t)> bounds_of = [&](uint32_t i) {
+      BBox all;
+      const WideNode& n = nodes[i];
+      for (int k = 0; k < kWidth; ++k) {
+        if (!n.used(k)) {
+          for (int j = k; j < kWidth; ++j) wrong_order += n.used(j);
+          break;
+        }
+        if (k > 0 && n.box(k).half_area() > n.box(k - 1).half_area()) ++wrong_order;
+        BBox b;
+        if (n.count[k] == 0) {
+          b = bounds_of(n.child[k]);
+        } else {
+          const uint32_t blocks = (n.count[k] + kBlockWidth - 1) / kBlockWidth;
+          for (uint32_t q = n.child[k]; q < n.child[k] + blocks; ++q)
+            for (int lane = 0; lane < kBlockWidth; ++lane)
+              if (mesh.blocks()[q].prim[lane] != kNoTriangle)
+                for (int v = 0; v < 3; ++v) b.extend(mesh.blocks()[q].vertex(lane, v));
+        }
+        const BBox slot = n.box(k);
+        wrong_boxes += !(slot.lo == b.lo && slot.hi == b.hi);
+        all.extend(b);
+      }
+      return all;
+    };
+    const BBox root = bounds_of(0);
+    EXPECT_EQ(wrong_boxes, 0u);
+    EXPECT_EQ(wrong_order, 0u);
+    EXPECT_EQ(root.lo, mesh.bounds().lo);
+    EXPECT_EQ(root.hi, mesh.bounds().hi);
   }
 }
 

@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cstring>
 
 using namespace toyrt;
@@ -165,4 +167,39 @@ TEST(MortonWide, NoPrimitivesNoTree) {
   const WideBuild built = build_morton_wide(nullptr, 0, kLeaf);
   EXPECT_TRUE(built.wide.empty());
   EXPECT_TRUE(built.prim_ids.empty());
+}
+
+TEST(MortonWide, LeavesBoundedByTheCallerGiveTheSameTree) {
+  // Mesh::finish bounds the leaves as it copies their triangles (BuildConfig::leaf_boxes_by_caller)
+  // and complete_wide_boxes() makes the rest, subtrees as parallel tasks: node for node, the tree
+  // the builder makes itself, boxes, slot order and children alike. 718,800 triangles: boxes
+  // through two levels of the builder's tasks.
+  for (const int rings : {600, 71, 8}) {  // 71 and 8: small enough to be bounded by the builder
+    const MeshData m = uv_sphere(rings, rings, 1.0f, 0.15f);
+    SCOPED_TRACE(std::to_string(m.triangles.size()) + " triangles");
+    const PrimitiveBounds p = triangle_bounds(m);
+    const WideBuild eager = build_morton_wide(p.boxes.data(), p.boxes.size(), kLeaf);
+    WideBuild deferred = build_morton_wide(p.boxes.data(), p.boxes.size(), kLeaf, false);
+    EXPECT_FALSE(eager.boxes_pending);
+    ASSERT_EQ(deferred.boxes_pending, rings == 600);
+    std::vector<int> visits(deferred.wide.nodes.size(), 0);
+    complete_wide_boxes(deferred.wide, [&](uint32_t i) {
+      ++visits[i];
+      WideNode& n = deferred.wide.nodes[i];
+      for (int k = 0; k < kWidth; ++k) {
+        if (n.count[k] == 0) continue;
+        BBox b;
+        for (uint32_t j = n.child[k]; j < n.child[k] + n.count[k]; ++j) b.extend(p.boxes[deferred.prim_ids[j]]);
+        for (int a = 0; a < 3; ++a) {
+          n.bounds[a][k] = b.lo[a];
+          n.bounds[a + 3][k] = b.hi[a];
+        }
+      }
+    });
+    EXPECT_EQ(std::count(visits.begin(), visits.end(), 1), std::ptrdiff_t(visits.size()));  // each node once
+    EXPECT_EQ(eager.prim_ids, deferred.prim_ids);
+    ASSERT_EQ(eager.wide.nodes.size(), deferred.wide.nodes.size());
+    EXPECT_EQ(0, std::memcmp(eager.wide.nodes.data(), deferred.wide.nodes.data(),
+                             eager.wide.nodes.size() * sizeof(WideNode)));
+  }
 }
