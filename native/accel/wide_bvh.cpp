@@ -386,15 +386,17 @@ WideBvh collapse(const LbvhTree& tree, uint32_t leaf_size, CollapseMethod method
 void any_hit_order(const BBox* boxes, int n, int order[kWidth]) {
   float area[kWidth];
   for (int i = 0; i < n; ++i) {
-    order[i] = i;
-    area[i] = boxes[i].half_area();
+    const float a = boxes[i].half_area();
+    area[i] = a == a ? a : 0.0f;  // a NaN would compare with nothing and leave two slots one place
   }
-  // An insertion sort: stable, and no allocation.
-  for (int i = 1; i < n; ++i)
-    for (int k = i; k > 0 && area[k - 1] < area[k]; --k) {
-      std::swap(area[k - 1], area[k]);
-      std::swap(order[k - 1], order[k]);
-    }
+  // Each slot's place counted without branches: the slots of larger area, and those of equal area
+  // that come earlier (a stable sort). An insertion sort's swaps, on areas in no order, were
+  // mispredicted as often as not: 5 % of the 1M-triangle LBVH commit.
+  for (int i = 0; i < n; ++i) {
+    int place = 0;
+    for (int j = 0; j < n; ++j) place += int(area[j] > area[i]) | int(area[j] == area[i] && j < i);
+    order[place] = i;
+  }
 }
 
 void sort_slots(WideNode& node) {
