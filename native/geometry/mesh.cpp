@@ -185,21 +185,26 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
     BBox box;
     for (uint32_t k = 0; k < count; k += kBlockWidth) {
       TriangleBlock b;
-      for (int lane = 0; lane < kBlockWidth; ++lane) {
-        if (k + lane >= count) {  // an unused lane: no triangle, and coordinates that are not NaN garbage
-          b.prim[lane] = kNoTriangle;
-          for (int v = 0; v < 3; ++v)
-            for (int a = 0; a < 3; ++a) b.p[v][a][lane] = 0.0f;
-          continue;
-        }
+      const int lanes = int(std::min<uint32_t>(kBlockWidth, count - k));
+      // A leaf's triangles lie anywhere in the mesh's arrays: their vertex indices are all
+      // requested before the first is read, so the block's misses overlap (in one process with
+      // both forms alternating: the 200K soup's LBVH commit 0.95-0.96 of its time, 1M 0.985-0.997;
+      // reading all indices into a local array first: the soup 0.94-0.97, but 1M 1.01).
+      for (int lane = 0; lane < lanes; ++lane) {
         const uint32_t slot = prim_ids[first + k + lane];
-        const uint32_t tri = triangle_of ? triangle_of[slot] : slot;
-        b.prim[lane] = tri;
+        b.prim[lane] = triangle_of ? triangle_of[slot] : slot;
+        __builtin_prefetch(&triangles_[b.prim[lane]]);
+      }
+      for (int lane = 0; lane < lanes; ++lane)
         for (int v = 0; v < 3; ++v) {
-          const Vec3& p = vertices_[triangles_[tri][v]];
+          const Vec3& p = vertices_[triangles_[b.prim[lane]][v]];
           box.extend(p);
           for (int a = 0; a < 3; ++a) b.p[v][a][lane] = p[a];
         }
+      for (int lane = lanes; lane < kBlockWidth; ++lane) {  // unused: no triangle, and no NaN garbage
+        b.prim[lane] = kNoTriangle;
+        for (int v = 0; v < 3; ++v)
+          for (int a = 0; a < 3; ++a) b.p[v][a][lane] = 0.0f;
       }
       if (beyond_caches)
         store_streaming(blocks_[start + k / kBlockWidth], b);
