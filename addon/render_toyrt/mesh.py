@@ -89,21 +89,27 @@ def instance_arguments(flags: tuple) -> dict:
 def singular(matrix: np.ndarray) -> bool:
     """True when the core would refuse an instance's matrix: not finite, or (nearly) no volume,
     as an object scaled to zero along an axis has (a common way to hide an object in an
-    animation, or to flatten one), or axes so nearly dependent that its single-precision inverse
-    is no inverse (the core's test: scene/instance_bounds.h). The margin is generous: such an
-    object is baked (see evaluated_geometry's `bake`), which is always correct, only not shared.
-    The second test is the determinant against the product of the axes' lengths (1 for any
-    rotation and scale, whatever the scales: their inverses are accurate): the core refuses
-    only below about 1e-6 (tests/python/test_instances.py). In Python floats: numpy's det costs
-    20 us a call here, this 2."""
+    animation, or to flatten one), or a matrix whose single-precision inverse would carry rays
+    into object space with too large an error (the core's test: scene/instance_bounds.h). The
+    margin is generous: such an object is baked (see evaluated_geometry's `bake`), which is
+    always correct, only not shared. The tests here, each a superset of a refusal
+    (tests/python/test_instance_transforms.py checks the whole): the determinant against the
+    product of the axes' lengths (1 for location, rotation and scale, whatever the scales; a
+    parent's non-uniform scale over a rotated child lowers it, to about 2/r for a ratio r of
+    scales, and the core refuses from r of about 1e5, so these bake from r of about 2e4), and
+    axes or a translation so far beyond float's range that the inverse would overflow. In
+    Python floats: numpy's det costs 20 us a call here, this 2."""
     v = matrix.ravel().tolist()
     if not all(map(math.isfinite, v)):
         return True
     det = v[0] * (v[5] * v[10] - v[6] * v[9]) - v[1] * (v[4] * v[10] - v[6] * v[8]) + v[2] * (v[4] * v[9] - v[5] * v[8])
     if abs(det) < 1e-18:
         return True
-    axes = math.hypot(v[0], v[4], v[8]) * math.hypot(v[1], v[5], v[9]) * math.hypot(v[2], v[6], v[10])
-    return abs(det) < 1e-4 * axes
+    axes = (math.hypot(v[0], v[4], v[8]), math.hypot(v[1], v[5], v[9]), math.hypot(v[2], v[6], v[10]))
+    shortest, longest = min(axes), max(axes)
+    if shortest < 1e-30 or longest > 1e30 or max(abs(v[3]), abs(v[7]), abs(v[11])) > 1e30 * shortest:
+        return True
+    return abs(det) < 1e-4 * axes[0] * axes[1] * axes[2]
 
 
 def mesh_key(obj) -> tuple:

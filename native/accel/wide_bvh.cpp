@@ -433,15 +433,16 @@ struct BottomUp {
     int m = 0;
     for (int k = 0; k < kWidth; ++k)
       if (n.count[k] == 0 && n.used(k)) interior[m++] = uint32_t(k);
-    // Tasks for the subtrees of the top three levels: up to 512 of them, each of thousands of
-    // primitives on the meshes where this matters.
+    // Tasks for the subtrees of the top three branching levels (a node with one interior child
+    // does not count): up to 512 of them, each of thousands of primitives on the meshes where
+    // this matters.
     if (depth < 3 && m > 1) {
       tbb::parallel_for(0, m, [&](int j) {
         (*this)(n.child[interior[j]], depth + 1);
         task_end();
       });
     } else {
-      for (int j = 0; j < m; ++j) (*this)(n.child[interior[j]], depth + 1);
+      for (int j = 0; j < m; ++j) (*this)(n.child[interior[j]], depth + (m > 1));
     }
     leaves(i);
     for (int j = 0; j < m; ++j) {

@@ -59,9 +59,10 @@ struct WideBuild {
 // Finishes a build with boxes_pending: every subtree before its parent, leaves(i) writing node
 // i's leaf slots' boxes (Mesh::finish copies their triangles into blocks there), then node i's
 // interior slots bounded by their children, just finished and still in cache, and its slots put
-// in any_hit_order. The top levels' subtrees run as parallel tasks, each ending with task_end()
-// on its thread (Mesh::finish fences its streamed stores there). Writes the same boxes and order
-// on any thread count.
+// in any_hit_order. The subtrees below the top three branching levels run as parallel tasks, each
+// ending with task_end() on its thread (Mesh::finish fences its streamed stores there); what runs
+// on the calling thread outside them (the top nodes' own leaves) is the caller's to finish after
+// the call. Writes the same boxes and order on any thread count.
 void complete_wide_boxes(
     WideBvh& bvh, const std::function<void(uint32_t node)>& leaves, const std::function<void()>& task_end = [] {});
 
@@ -109,7 +110,8 @@ WideBvh collapse(const LbvhTree& tree, uint32_t leaf_size = 1, CollapseMethod me
 // The order every builder gives a wide node's children: by decreasing surface area, stably. The
 // any-hit walk visits them in slot order, and a large box is the likelier to block a shadow ray
 // (a wall beside a dense model: found at once instead of after the model's subtrees); the
-// closest-hit walk sorts by distance and ignores it. Fills order[0..n) with 0..n-1 so ordered.
+// closest-hit walk sorts by distance and ignores it. Fills order[0..n) with 0..n-1 so ordered
+// (a NaN area, which no finite box has, ranks as 0).
 void any_hit_order(const BBox* boxes, int n, int order[kWidth]);
 
 struct WideStats {

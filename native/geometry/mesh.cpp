@@ -179,8 +179,9 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
   // Blocks beyond the caches are streamed past them; blocks that fit are written there, for the
   // rays that follow the commit.
   const bool beyond_caches = blocks_.size() * sizeof(TriangleBlock) > kPrefetchBlockBytes;
-  // Copies a leaf's triangles into its blocks; returns their box (the leaf's, where the builder
-  // left it to this copy: boxes_pending).
+  const bool bound_leaves = built.boxes_pending;
+  // Copies a leaf's triangles into its blocks; returns their box where the builder left the
+  // leaves' boxes to this copy (boxes_pending), else an empty one.
   auto emit = [&](uint32_t first, uint32_t count, uint32_t start) {
     BBox box;
     for (uint32_t k = 0; k < count; k += kBlockWidth) {
@@ -198,7 +199,7 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
       for (int lane = 0; lane < lanes; ++lane)
         for (int v = 0; v < 3; ++v) {
           const Vec3& p = vertices_[triangles_[b.prim[lane]][v]];
-          box.extend(p);
+          if (bound_leaves) box.extend(p);
           for (int a = 0; a < 3; ++a) b.p[v][a][lane] = p[a];
         }
       for (int lane = lanes; lane < kBlockWidth; ++lane) {  // unused: no triangle, and no NaN garbage
@@ -213,7 +214,6 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
     }
     return box;
   };
-  const bool bound_leaves = built.boxes_pending;
   if (wide_.root_leaf_count) {
     emit(wide_.root_leaf_first, wide_.root_leaf_count, 0);
     if (beyond_caches) end_streaming();

@@ -13,7 +13,10 @@
 // (infinity norms: f = |F|, k = gamma(8) ||A| |B||, M the world box's largest coordinate,
 // c = |g| + gamma(8) (||A| |b|| + |A| m) with m the mesh box's largest coordinate; the gamma
 // terms are the rounding of the ray's transform and of the watertight test's translation by o').
-// With f + k <= 1/4, dev <= 2 ((f + k) M + c) + 4 k |o|: a pad per instance, applied to its box,
+// With f + k <= 1/4, dev <= 2 ((f + k) M + c) + 4 k |o| (the first term with room to spare, for
+// the rounding of the box's own corners and of lo - pad; the second has its room in gamma(8),
+// where the ray's transform and the test's translation round by about 13 units of 2^-24, which
+// also covers o + pad rounded to nearest in make_ray_box_data): a pad per instance, applied to its box,
 // plus a pad per ray that grows with the origin's distance, applied by the top-level walk
 // (make_ray_box_data's pad). A transform with f + k > 1/4 has no float inverse worth the name
 // (its rows nearly dependent): add_instance refuses it.

@@ -13,6 +13,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <cstdio>
 #include <cstring>
 #include <future>
 #include <stdexcept>
@@ -43,7 +44,10 @@ Mat4 Scene::checked_inverse(const Mat4& to_world) {
   if (to_world[0][3] != 0.0f || to_world[1][3] != 0.0f || to_world[2][3] != 0.0f || to_world[3][3] != 1.0f)
     throw std::invalid_argument("instance transform must be affine: its last row must be 0 0 0 1");
   const double det = glm::determinant(glm::dmat3(glm::mat3(to_world)));
-  const Mat4 to_object = glm::affineInverse(to_world);
+  // Inverted in double and rounded once: glm's float inverse forms the determinant and cofactors
+  // in float, which overflow or underflow for scales a double holds (a uniform scale of 1e13 gave
+  // an inverse of zeros), and rounds each entry several times.
+  const Mat4 to_object(glm::affineInverse(glm::dmat4(to_world)));
   bool finite_inverse = true;
   for (int c = 0; c < 4; ++c)
     for (int r = 0; r < 4; ++r) finite_inverse &= bool(std::isfinite(to_object[c][r]));
@@ -53,10 +57,14 @@ Mat4 Scene::checked_inverse(const Mat4& to_world) {
   // matters is whether the float inverse carries rays into object space with a bounded error
   // (instance_bounds.h).
   const TransformError error = transform_error(to_world, to_object);
-  if (!error.invertible())
-    throw std::invalid_argument("instance transform is nearly singular: its single-precision inverse is off by " +
-                                std::to_string(error.inverse) +
-                                " (|to_world * to_object - I|); apply the transform to the vertices instead");
+  if (!error.invertible()) {
+    char what[96];
+    std::snprintf(what, sizeof what, "%.3g (|to_world * to_object - I| + rounding %.3g)", error.inverse + error.spread,
+                  error.spread);
+    throw std::invalid_argument(std::string("instance transform is nearly singular: rays carried into its object "
+                                            "space in single precision would be off by ") +
+                                what + "; apply the transform to the vertices instead");
+  }
   return to_object;
 }
 

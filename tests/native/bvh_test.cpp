@@ -105,18 +105,20 @@ TEST(Mesh, TracedLayoutSameForAnyThreadCount) {
 }
 
 TEST(Mesh, EverySlotBoxIsItsTrianglesExactBoundsAndSlotsAreInAnyHitOrder) {
-  // The host LBVH leaves its boxes to Mesh::finish (180K triangles: beyond a core's L2), which
-  // bounds each leaf as it copies its triangles and each interior slot from its child
-  // (complete_wide_boxes); the SAH collapse makes its own. Either way: a slot's box is exactly the bounds of the
-  // triangles under it (min and max are exact, so equality), and a node's used slots come first, by non-increasing
-  // area.
-  const MeshData m = uv_sphere(300, 600, 1.0f, 0.1f);
+  // The host LBVH leaves its boxes to Mesh::finish, which bounds each leaf as it copies its
+  // triangles and each interior slot from its child (complete_wide_boxes); the SAH collapse makes
+  // its own. Either way: a slot's box is exactly the bounds of the triangles under it (min and
+  // max are exact, so equality), and a node's used slots come first, by non-increasing area.
+  // 559,800 triangles: beyond a core's L2 (the boxes deferred) and beyond kPrefetchBlockBytes
+  // (the blocks streamed, fenced at the end of each of the bottom-up pass's tasks).
+  const MeshData m = uv_sphere(400, 700, 1.0f, 0.1f);
   for (const BuilderKind kind : {BuilderKind::Lbvh, BuilderKind::Sah}) {
     SCOPED_TRACE(builder_name(kind));
     BuildConfig config;
     config.lbvh.device = LbvhDevice::Host;
     Mesh mesh(m.vertices, m.triangles);
     mesh.build(kind, config);
+    EXPECT_GT(mesh.blocks().size() * sizeof(TriangleBlock), size_t(16) << 20);  // streamed
     const auto& nodes = mesh.wide_bvh().nodes;
     ASSERT_FALSE(nodes.empty());
     size_t wrong_boxes = 0, wrong_order = 0;
