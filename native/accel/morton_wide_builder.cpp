@@ -285,10 +285,7 @@ struct TopDown {
         node.child[i] = uint32_t(next);
         b = build(kids[i], next++, out);
       }
-      for (int a = 0; a < 3; ++a) {
-        node.bounds[a][i] = b.lo[a];
-        node.bounds[a + 3][i] = b.hi[a];
-      }
+      node.set_box(i, b);
       total.extend(b);
     }
     out.nodes[at] = node;  // by index: the array may have grown while the children were built
@@ -380,10 +377,7 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
     for (size_t j = 0; j < task.handed_on.size(); ++j) {
       const BBox& b = tasks[task.handed_to[j]].box;
       const int slot = task.handed_on[j].first;
-      for (int a = 0; a < 3; ++a) {
-        task.nodes[0].bounds[a][slot] = b.lo[a];
-        task.nodes[0].bounds[a + 3][slot] = b.hi[a];
-      }
+      task.nodes[0].set_box(slot, b);
       task.box.extend(b);
     }
   }

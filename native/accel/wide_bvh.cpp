@@ -279,10 +279,7 @@ struct Collapser : CollapsedTree<Tree> {
       }
     for (int i = 0; i < kWidth; ++i) node.child[i] = node.count[i] = 0;
     for (int i = 0; i < n; ++i) {
-      for (int a = 0; a < 3; ++a) {
-        node.bounds[a][i] = boxes[i].lo[a];
-        node.bounds[a + 3][i] = boxes[i].hi[a];
-      }
+      node.set_box(i, boxes[i]);
       if (is_leaf(kids[i])) {
         node.child[i] = kids[i].range.first;
         node.count[i] = kids[i].range.count;
@@ -450,10 +447,7 @@ struct BottomUp {
       BBox b;
       for (int k = 0; k < kWidth; ++k)
         if (child.used(k)) b.extend(child.box(k));
-      for (int a = 0; a < 3; ++a) {
-        n.bounds[a][interior[j]] = b.lo[a];
-        n.bounds[a + 3][interior[j]] = b.hi[a];
-      }
+      n.set_box(int(interior[j]), b);
     }
     sort_slots(n);
   }

@@ -34,6 +34,12 @@ struct alignas(64) WideNode {
     b.hi = {bounds[3][i], bounds[4][i], bounds[5][i]};
     return b;
   }
+  void set_box(int i, const BBox& b) {
+    for (int a = 0; a < 3; ++a) {
+      bounds[a][i] = b.lo[a];
+      bounds[a + 3][i] = b.hi[a];
+    }
+  }
 };
 static_assert(sizeof(WideNode) == 256, "WideNode: 4 cache lines for 8 children");
 

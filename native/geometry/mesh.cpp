@@ -226,11 +226,7 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
     for (int k = 0; k < kWidth; ++k) {
       if (!n.count[k]) continue;
       const BBox box = emit(n.child[k], n.count[k], start);
-      if (bound_leaves)
-        for (int a = 0; a < 3; ++a) {
-          n.bounds[a][k] = box.lo[a];
-          n.bounds[a + 3][k] = box.hi[a];
-        }
+      if (bound_leaves) n.set_box(k, box);
       n.child[k] = start;
       start += blocks_of(n.count[k]);
     }

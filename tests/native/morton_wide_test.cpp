@@ -190,10 +190,7 @@ TEST(MortonWide, LeavesBoundedByTheCallerGiveTheSameTree) {
         if (n.count[k] == 0) continue;
         BBox b;
         for (uint32_t j = n.child[k]; j < n.child[k] + n.count[k]; ++j) b.extend(p.boxes[deferred.prim_ids[j]]);
-        for (int a = 0; a < 3; ++a) {
-          n.bounds[a][k] = b.lo[a];
-          n.bounds[a + 3][k] = b.hi[a];
-        }
+        n.set_box(k, b);
       }
     });
     EXPECT_EQ(std::count(visits.begin(), visits.end(), 1), std::ptrdiff_t(visits.size()));  // each node once
