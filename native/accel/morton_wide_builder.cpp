@@ -198,12 +198,13 @@ struct TopDown {
   const Key* keys;
   uint32_t leaf_size;
   uint32_t task_size;  // task_primitives() of the mesh
-  // Whether the boxes outgrow a core's L2 cache (512 KB-1 MB on the machines measured), so that
-  // their random reads miss it; below that the prefetches are instructions for nothing.
-  bool prefetch_boxes;
   // False: the caller bounds the leaves (WideBuild::boxes_pending), and every box here is a
   // stand-in point that only marks its slot used.
   bool leaf_boxes;
+  // Leaf boxes read here from boxes beyond a core's L2 cache (512 KB-1 MB on the machines
+  // measured), where their random reads miss it: only when a caller asks for the boxes of a large
+  // mesh (tests, benchmarks); below L2 the prefetches would be instructions for nothing.
+  bool prefetch_leaf_boxes;
 
   // Where the range splits: the first slot whose code has the highest bit in which the range's
   // first and last codes differ (the codes are sorted, so every code in the range shares the bits
@@ -256,7 +257,7 @@ struct TopDown {
     // The leaves' boxes are read at random (by sorted code, from boxes in mesh order): every leaf
     // child's reads are requested at once, before the first box is needed. The LBVH commit 2 %
     // faster at 200K-4M triangles (docs/trace-speed.md, thirty-third session).
-    if (prefetch_boxes && leaf_boxes)
+    if (prefetch_leaf_boxes)
       for (int i = 0; i < n; ++i)
         if (kids[i].size() <= leaf_size)
           for (uint32_t k = kids[i].begin; k < kids[i].end; ++k) __builtin_prefetch(&bounds[prim_of(keys[k])]);
@@ -345,7 +346,7 @@ WideBuild build_morton_wide(const BBox* prim_bounds, size_t count, uint32_t leaf
   // caller's bottom-up pass cost more than the reads: 0.352-0.358 -> 0.370-0.383 ms).
   const bool beyond_l2 = count * sizeof(BBox) > (size_t(1) << 20);
   leaf_boxes = leaf_boxes || !beyond_l2;
-  const TopDown top_down{prim_bounds, keys, leaf_size, task_primitives(count), beyond_l2, leaf_boxes};
+  const TopDown top_down{prim_bounds, keys, leaf_size, task_primitives(count), leaf_boxes, leaf_boxes && beyond_l2};
   built.boxes_pending = !leaf_boxes;
   std::vector<Range> ranges{{0u, uint32_t(count)}};
   std::vector<TaskTree> tasks;

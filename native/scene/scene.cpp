@@ -37,7 +37,7 @@ uint32_t Scene::add_mesh(std::vector<Vec3> vertices, std::vector<Triangle> trian
   return uint32_t(meshes_.size() - 1);
 }
 
-Mat4 Scene::checked_inverse(const Mat4& to_world) {
+Scene::CheckedInverse Scene::checked_inverse(const Mat4& to_world) {
   for (int c = 0; c < 4; ++c)
     for (int r = 0; r < 4; ++r)
       if (!std::isfinite(to_world[c][r])) throw std::invalid_argument("instance transform is not finite");
@@ -65,7 +65,7 @@ Mat4 Scene::checked_inverse(const Mat4& to_world) {
                                             "space in single precision would be off by ") +
                                 what + "; apply the transform to the vertices instead");
   }
-  return to_object;
+  return {to_object, error};
 }
 
 uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world, bool visible_shadow, int receiver_set, int blocker_set,
@@ -74,11 +74,12 @@ uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world, bool visible_sh
   if (receiver_set < 0 || receiver_set >= kLightSets || blocker_set < 0 || blocker_set >= kLightSets)
     throw std::invalid_argument("light-linking set must be in [0, 64): receiver_set " + std::to_string(receiver_set) +
                                 ", blocker_set " + std::to_string(blocker_set));
-  const Mat4 to_object = checked_inverse(to_world);
+  const CheckedInverse inverse = checked_inverse(to_world);
   Instance inst;
   inst.mesh = uint32_t(mesh);
   inst.to_world = to_world;
-  inst.to_object = to_object;
+  inst.to_object = inverse.to_object;
+  inst.error = inverse.error;
   inst.identity = to_world == Mat4(1.0f);
   inst.visible_shadow = visible_shadow;
   inst.receiver_set = uint8_t(receiver_set);
@@ -106,10 +107,11 @@ void Scene::set_instance_transform(int64_t instance, const Mat4& to_world) {
   if (instance < 0 || size_t(instance) >= instances_.size())
     throw std::invalid_argument("unknown instance id " + std::to_string(instance) + " (the scene has " +
                                 std::to_string(instances_.size()) + " instances)");
-  const Mat4 to_object = checked_inverse(to_world);
+  const CheckedInverse inverse = checked_inverse(to_world);
   Instance& inst = instances_[size_t(instance)];
   inst.to_world = to_world;
-  inst.to_object = to_object;
+  inst.to_object = inverse.to_object;
+  inst.error = inverse.error;
   inst.identity = to_world == Mat4(1.0f);
   committed_ = false;
 }
@@ -365,9 +367,8 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
       if (inst.identity) {
         inst.world_bounds = b;  // the walk's ray is the world ray: the mesh box is exact
       } else {
-        const TransformError error = transform_error(inst.to_world, inst.to_object);
-        inst.world_bounds = instance_world_bounds(b, inst.to_world, error);
-        origin_pad_factor_ = std::max(origin_pad_factor_, origin_pad_factor(error));
+        inst.world_bounds = instance_world_bounds(b, inst.to_world, inst.error);
+        origin_pad_factor_ = std::max(origin_pad_factor_, origin_pad_factor(inst.error));
       }
       placed.push_back(i);
       boxes.push_back(inst.world_bounds);

@@ -118,8 +118,12 @@ class Scene {
                     MeshShading shading = {});
   void set_instance_transform(int64_t instance, const Mat4& to_world);
   void clear_instances();
-  // The transform checks of add_instance alone; returns the inverse.
-  static Mat4 checked_inverse(const Mat4& to_world);
+  // The transform checks of add_instance alone; returns the inverse and its error bound.
+  struct CheckedInverse {
+    Mat4 to_object;
+    TransformError error;
+  };
+  static CheckedInverse checked_inverse(const Mat4& to_world);
 
   // ---- materials, textures, world. Edits in place, so meshes keep their material ids; they
   // do not touch the geometry (no commit needed).
