@@ -26,10 +26,7 @@ struct Instance {
   Mat4 to_world{1.0f};   // object -> world, affine
   Mat4 to_object{1.0f};  // its inverse: rays are carried into object space, t is unchanged
   bool identity = true;  // skips the ray transform for the common untransformed case
-  // How far rays carried by to_object may stray (instance_bounds.h): computed with the inverse,
-  // which every transform change makes anew, and read by each commit for the instance's box.
-  TransformError error;
-  BBox world_bounds;  // of the mesh's box corners, transformed
+  BBox world_bounds;     // of the mesh's box corners, transformed
   // Blender's Object.visible_shadow: whether the instance blocks the render's shadow rays
   // (Scene::shadowed). Camera, glossy and glass rays and the ray API's queries see it regardless.
   bool visible_shadow = true;
@@ -43,6 +40,10 @@ struct Instance {
   // As an emitter (its materials emit): the receiver sets it lights (light linking of an
   // emissive object, Blender 4.0+); all by default.
   uint64_t light_receivers = kAllLightSets;
+  // How far rays carried by to_object may stray (instance_bounds.h): computed with the inverse,
+  // which every transform change makes anew, and read by each commit for the instance's box
+  // (last: no ray reads it).
+  TransformError error;
 };
 
 }  // namespace toyrt
