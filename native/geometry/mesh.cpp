@@ -283,7 +283,7 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
   built_ = true;
 }
 
-template <bool AnyHit, bool kSkip>
+template <bool AnyHit, bool kSkip, bool kOverlapLeaves>
 bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim,
                  bool ray_checked, int32_t skip) const {
   // A valid world ray can overflow in an instance's object space (a huge inverse scale): with a
@@ -299,7 +299,8 @@ bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, flo
   uint32_t found_block = 0;
   int found_lane = 0;
   bool recorded = false;
-  const bool found = traverse_wide<AnyHit>(
+  // kOverlapLeaves: see Mesh::intersect.
+  const bool found = traverse_wide<AnyHit, kOverlapLeaves>(
       wide_, box_ray, tnear, tfar,
       [&](uint32_t first, uint32_t count, float& t_max) __attribute__((always_inline)) {
         bool hit = false;
@@ -348,16 +349,22 @@ bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, flo
 bool Mesh::intersect(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim,
                      bool ray_checked, int32_t skip) const {
   // Two walks, one for rays that name the triangle they leave and one for those that do not:
-  // with one, camera rays paid 1-2 % for the test they never need.
-  return skip == kInvalidId ? trace<false, false>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip)
-                            : trace<false, true>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip);
+  // with one, camera rays paid 1-2 % for the test they never need. And each twice: where the
+  // blocks are beyond the caches, the walk visits a stacked node while the nearest leaf's block
+  // arrives (closest_hit_wide's kOverlapLeaves); meshes in cache keep the plain walk, which lost
+  // 3 % of its speed at 10K triangles when both were compiled into one function.
+  if (prefetch_blocks_)
+    return skip == kInvalidId ? trace<false, false, true>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip)
+                              : trace<false, true, true>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip);
+  return skip == kInvalidId ? trace<false, false, false>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip)
+                            : trace<false, true, false>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip);
 }
 
 bool Mesh::occluded(const Vec3& org, const Vec3& dir, float tnear, float tfar, bool ray_checked, int32_t skip) const {
   float u, v;
   int32_t prim;
-  return skip == kInvalidId ? trace<true, false>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip)
-                            : trace<true, true>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip);
+  return skip == kInvalidId ? trace<true, false, false>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip)
+                            : trace<true, true, false>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip);
 }
 
 size_t Mesh::memory_bytes() const {

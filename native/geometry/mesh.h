@@ -60,7 +60,7 @@ class Mesh {
   // to triangle indices by `valid`) and point the wide leaves at them.
   void finish(WideBuild built, const UninitializedArray<uint32_t>& valid);
 
-  template <bool AnyHit, bool kSkip>
+  template <bool AnyHit, bool kSkip, bool kOverlapLeaves>
   bool trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, float& u, float& v, int32_t& prim,
              bool ray_checked, int32_t skip) const;
 

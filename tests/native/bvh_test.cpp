@@ -4,6 +4,7 @@
 #include "accel/builder.h"
 #include "core/parallel.h"
 #include "geometry/mesh.h"
+#include "geometry/triangle.h"
 #include "test_scenes.h"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 #include <cstring>
 #include <functional>
 #include <memory>
+#include <random>
 
 using namespace toyrt;
 using namespace toyrt::testing;
@@ -153,6 +155,43 @@ TEST(Mesh, EverySlotBoxIsItsTrianglesExactBoundsAndSlotsAreInAnyHitOrder) {
     EXPECT_EQ(root.lo, mesh.bounds().lo);
     EXPECT_EQ(root.hi, mesh.bounds().hi);
   }
+}
+
+TEST(Mesh, RaysFindTheNearestTriangleWhereTheBlocksAreBeyondTheCaches) {
+  // Blocks beyond kPrefetchBlockBytes take the closest-hit walk that visits a stacked node while
+  // the nearest leaf's block arrives (closest_hit_wide<true>): every ray must still find a nearest
+  // triangle, the one a loop over all triangles finds (or one at the same distance, where the ray
+  // meets an edge or vertex).
+  const MeshData m = uv_sphere(400, 700, 1.0f, 0.1f);
+  Mesh mesh(m.vertices, m.triangles);
+  mesh.build(BuilderKind::Sah, BuildConfig{});
+  ASSERT_GT(mesh.blocks().size() * sizeof(TriangleBlock), size_t(16) << 20);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  int hits = 0;
+  for (int k = 0; k < 60; ++k) {
+    const Vec3 org = 3.0f * glm::normalize(Vec3(unit(rng), unit(rng), unit(rng)));
+    const Vec3 dir = 0.8f * Vec3(unit(rng), unit(rng), unit(rng)) - org;
+    const WatertightRay ray = make_watertight_ray(org, dir);
+    float nearest = kInfinity;
+    for (const Triangle& tri : m.triangles) {
+      float t, u, v;
+      if (intersect_triangle(ray, m.vertices[tri[0]], m.vertices[tri[1]], m.vertices[tri[2]], 0.0f, nearest, t, u, v))
+        nearest = t;
+    }
+    float tfar = kInfinity, u, v;
+    int32_t prim = -1;
+    const bool found = mesh.intersect(org, dir, 0.0f, tfar, u, v, prim);
+    ASSERT_EQ(found, nearest < kInfinity) << "ray " << k;
+    if (!found) continue;
+    ++hits;
+    const Triangle& tri = m.triangles[size_t(prim)];
+    float t, tu, tv;
+    ASSERT_TRUE(intersect_triangle(ray, m.vertices[tri[0]], m.vertices[tri[1]], m.vertices[tri[2]], 0.0f, kInfinity, t,
+                                   tu, tv));
+    EXPECT_EQ(t, nearest) << "ray " << k;
+  }
+  EXPECT_GT(hits, 30);
 }
 
 TEST(BinnedSahBuilder, CoincidentCentroidsStayShallow) {

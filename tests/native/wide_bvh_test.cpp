@@ -1,16 +1,21 @@
 // collapse(): the 8-wide layout derived from a binary tree, greedy and by the SAH dynamic
 // programme. Structural invariants with known answers (every primitive in exactly one leaf, no
 // node narrower than two children), the programme's optimality against the greedy collapse under
-// the same cost, and a layout that does not depend on the thread count.
+// the same cost, and a layout that does not depend on the thread count. And the closest-hit walk
+// over it with and without overlapped leaf fetches.
 #include "accel/wide_bvh.h"
 #include "accel/binned_sah_builder.h"
 #include "accel/lbvh_builder.h"
+#include "accel/wide_traverse.h"
 #include "core/parallel.h"
+#include "geometry/triangle.h"
 #include "test_scenes.h"
 
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <random>
+#include <type_traits>
 
 using namespace toyrt;
 using namespace toyrt::testing;
@@ -175,4 +180,60 @@ TEST(WideBvh, RootsLargestChildIsALeafOfWallsInAClosedRoom) {
     ASSERT_GT(root.count[0], 0u) << "the root's largest child is an interior node";
     for (uint32_t k = 0; k < root.count[0]; ++k) EXPECT_GE(bvh.prim_ids[root.child[0] + k], first_wall);
   }
+}
+
+// closest_hit_wide<true> visits the node on top of the stack before testing a leaf it has just
+// chosen (so that the leaf's lines arrive meanwhile): the leaves must still be tested in the same
+// order, and every ray must find the same nearest triangle at the same distance.
+TEST(WideTraverse, OverlappedLeafFetchesTestTheSameLeavesInTheSameOrder) {
+  size_t rays = 0, rays_through_several_leaves = 0, hits = 0;
+  for (const MeshData& m : varied_meshes()) {
+    const Bvh bvh = sah_tree(m);
+    const WideBvh wide = collapse(bvh, kLeaf, CollapseMethod::Sah);
+    const BBox box = bounds_of(m);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    auto point_in = [&](float spread) {
+      const Vec3 r(unit(rng), unit(rng), unit(rng));
+      return box.center() + (r - 0.5f) * box.extent() * spread;
+    };
+    for (int k = 0; k < 2000; ++k) {
+      const Vec3 org = point_in(3.0f), dir = point_in(1.0f) - org;
+      const WatertightRay tri_ray = make_watertight_ray(org, dir);
+      auto walk = [&](auto overlap, std::vector<uint32_t>& order, int64_t& prim) {
+        float tfar = kInfinity;
+        prim = -1;
+        const bool found = closest_hit_wide<decltype(overlap)::value>(
+            wide, make_ray_box_data(org, dir), 0.0f, tfar, [&](uint32_t first, uint32_t count, float& t_max) {
+              order.push_back(first);
+              bool hit = false;
+              for (uint32_t j = first; j < first + count; ++j) {
+                const Triangle& tri = m.triangles[bvh.prim_ids[j]];
+                float t, u, v;
+                if (intersect_triangle(tri_ray, m.vertices[tri[0]], m.vertices[tri[1]], m.vertices[tri[2]], 0.0f, t_max,
+                                       t, u, v)) {
+                  t_max = t;
+                  prim = bvh.prim_ids[j];
+                  hit = true;
+                }
+              }
+              return hit;
+            });
+        return found ? tfar : -1.0f;
+      };
+      std::vector<uint32_t> plain_order, overlapped_order;
+      int64_t plain_prim, overlapped_prim;
+      const float plain_t = walk(std::false_type{}, plain_order, plain_prim);
+      const float overlapped_t = walk(std::true_type{}, overlapped_order, overlapped_prim);
+      ASSERT_EQ(plain_order, overlapped_order) << "ray " << k;
+      ASSERT_EQ(plain_t, overlapped_t) << "ray " << k;
+      ASSERT_EQ(plain_prim, overlapped_prim) << "ray " << k;
+      ++rays;
+      rays_through_several_leaves += plain_order.size() > 1;
+      hits += plain_prim >= 0;
+    }
+  }
+  // The overlap happens only where a ray meets more than one leaf: most rays here must.
+  EXPECT_GT(rays_through_several_leaves, rays / 2);
+  EXPECT_GT(hits, rays / 4);
 }
