@@ -255,8 +255,9 @@ struct TopDown {
     Range kids[kWidth];
     const int n = open(r, kids);
     // The leaves' boxes are read at random (by sorted code, from boxes in mesh order): every leaf
-    // child's reads are requested at once, before the first box is needed. The LBVH commit 2 %
-    // faster at 200K-4M triangles (docs/trace-speed.md, thirty-third session).
+    // child's reads are requested at once, before the first box is needed (the LBVH commit 2 %
+    // faster at 200K-4M triangles when it still bounded its leaves here: docs/trace-speed.md,
+    // thirty-third session; a mesh's commit now leaves them to Mesh::finish).
     if (prefetch_leaf_boxes)
       for (int i = 0; i < n; ++i)
         if (kids[i].size() <= leaf_size)

@@ -352,7 +352,7 @@ bool Mesh::intersect(const Vec3& org, const Vec3& dir, float tnear, float& tfar,
   // with one, camera rays paid 1-2 % for the test they never need. And each twice: where the
   // blocks are beyond the caches, the walk visits a stacked node while the nearest leaf's block
   // arrives (closest_hit_wide's kOverlapLeaves); meshes in cache keep the plain walk, which lost
-  // 3 % of its speed at 10K triangles when both were compiled into one function.
+  // 1-3 % of its speed at 10K triangles when both were compiled into one function.
   if (prefetch_blocks_)
     return skip == kInvalidId ? trace<false, false, true>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip)
                               : trace<false, true, true>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip);

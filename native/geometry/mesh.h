@@ -72,15 +72,19 @@ class Mesh {
   std::vector<TriangleBlock, HugePageAllocator<TriangleBlock>> blocks_;  // huge pages: read at random
   BBox bounds_;
   bool built_ = false;
-  // Whether the closest-hit walk prefetches each leaf's block (finish(): the blocks exceed
-  // kPrefetchBlockBytes, about twice the last-level cache of the machines measured). finish()
-  // also writes such blocks past the caches.
-  static constexpr size_t kPrefetchBlockBytes = size_t(16) << 20;
   // The vertex and index arrays' size from which finish() requests a node's vertices before
   // copying them (mesh.cpp): between the 3.2 MB of a 180K-triangle sphere, which lost 3-5 % to it,
   // and the 5.8 MB of a 320K one, which gained 3 %.
   static constexpr size_t kScatteredReadBytes = size_t(4) << 20;
-  bool prefetch_blocks_ = false;
+
+ public:
+  // The blocks' size beyond which (about twice the last-level cache of the machines measured)
+  // finish() writes them past the caches, the closest-hit walk prefetches each leaf's block, and
+  // intersect() takes the walk that visits a stacked node while the nearest leaf's block arrives.
+  static constexpr size_t kPrefetchBlockBytes = size_t(16) << 20;
+
+ private:
+  bool prefetch_blocks_ = false;  // the blocks exceed kPrefetchBlockBytes (finish())
 };
 
 }  // namespace toyrt

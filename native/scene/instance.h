@@ -4,7 +4,6 @@
 
 #include "core/bbox.h"
 #include "lights/light_linking.h"
-#include "scene/instance_bounds.h"
 
 #include <cstdint>
 
@@ -40,10 +39,6 @@ struct Instance {
   // As an emitter (its materials emit): the receiver sets it lights (light linking of an
   // emissive object, Blender 4.0+); all by default.
   uint64_t light_receivers = kAllLightSets;
-  // How far rays carried by to_object may stray (instance_bounds.h): computed with the inverse,
-  // which every transform change makes anew, and read by each commit for the instance's box
-  // (last: no ray reads it).
-  TransformError error;
 };
 
 }  // namespace toyrt

@@ -79,7 +79,6 @@ uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world, bool visible_sh
   inst.mesh = uint32_t(mesh);
   inst.to_world = to_world;
   inst.to_object = inverse.to_object;
-  inst.error = inverse.error;
   inst.identity = to_world == Mat4(1.0f);
   inst.visible_shadow = visible_shadow;
   inst.receiver_set = uint8_t(receiver_set);
@@ -87,6 +86,7 @@ uint32_t Scene::add_instance(int64_t mesh, const Mat4& to_world, bool visible_sh
   inst.visibility = visibility & kVisibleAll;
   inst.light_receivers = light_receivers;
   instances_.push_back(inst);
+  transform_errors_.push_back(inverse.error);
   committed_ = false;
   return uint32_t(instances_.size() - 1);
 }
@@ -111,13 +111,14 @@ void Scene::set_instance_transform(int64_t instance, const Mat4& to_world) {
   Instance& inst = instances_[size_t(instance)];
   inst.to_world = to_world;
   inst.to_object = inverse.to_object;
-  inst.error = inverse.error;
+  transform_errors_[size_t(instance)] = inverse.error;
   inst.identity = to_world == Mat4(1.0f);
   committed_ = false;
 }
 
 void Scene::clear_instances() {
   instances_.clear();  // keeps the capacity: a re-sync adds about as many again
+  transform_errors_.clear();
   committed_ = false;
 }
 
@@ -367,8 +368,9 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
       if (inst.identity) {
         inst.world_bounds = b;  // the walk's ray is the world ray: the mesh box is exact
       } else {
-        inst.world_bounds = instance_world_bounds(b, inst.to_world, inst.error);
-        origin_pad_factor_ = std::max(origin_pad_factor_, origin_pad_factor(inst.error));
+        const TransformError& error = transform_errors_[i];
+        inst.world_bounds = instance_world_bounds(b, inst.to_world, error);
+        origin_pad_factor_ = std::max(origin_pad_factor_, origin_pad_factor(error));
       }
       placed.push_back(i);
       boxes.push_back(inst.world_bounds);

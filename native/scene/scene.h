@@ -24,6 +24,7 @@
 #include "materials/texture.h"
 #include "materials/transparency.h"
 #include "scene/instance.h"
+#include "scene/instance_bounds.h"
 #include "scene/mesh_shading.h"
 #include "scene/world.h"
 
@@ -312,6 +313,10 @@ class Scene {
   Bvh top_;  // over instances with a non-empty world box
   // The top-level walk widens every instance box by this times the ray origin's largest
   // coordinate: the rounding of rays sent into object space grows with it (instance_bounds.h).
+  // Beside instances_, one each: how far rays carried by to_object may stray
+  // (instance_bounds.h), made with the inverse at every transform change and read by each commit
+  // for the instance's box. Not in Instance, whose array the top-level walk reads per ray.
+  std::vector<TransformError> transform_errors_;
   float origin_pad_factor_ = 0.0f;
   bool single_identity_ = false;  // one untransformed instance: skip the top level
   bool all_cast_shadows_ = true;  // no instance with visible_shadow off: shadowed() is occluded()
