@@ -2,7 +2,8 @@
 // thread and on all, reported as ratios to Embree (timings on shared machines are noisy; ratios
 // measured side by side, best of several runs, are what carry over). Writes a Markdown table.
 //
-//   bench_trace [--out FILE] [--runs N] [--quick]
+//   bench_trace [--out FILE] [--runs N] [--quick] [--only TEXT]   (--only: the meshes whose name
+//                                                                 contains TEXT, e.g. "10K")
 #include "bench_util.h"
 #include "core/parallel.h"
 #include "embree_oracle.h"
@@ -101,7 +102,7 @@ std::string triangles_label(size_t n) {
 
 int main(int argc, char** argv) {
   keep_freed_memory();
-  const std::optional<Args> args = parse_args(argc, argv, "[--out FILE] [--runs N] [--quick]", 5);
+  const std::optional<Args> args = parse_args(argc, argv, "[--out FILE] [--runs N] [--quick] [--only TEXT]", 5);
   if (!args) return 2;
   const std::string& out_path = args->out;
   const int runs = args->runs;
@@ -126,6 +127,11 @@ int main(int argc, char** argv) {
   if (quick) cases.back().name = "triangle soup, 20K triangles";
   cases.push_back({quick ? "bumpy sphere, 100K, in a closed room" : "bumpy sphere, 1.0M, in a closed room",
                    uv_sphere(quick ? 224 : 708, quick ? 224 : 708, 1.0f, 0.15f), true});
+
+  if (!args->only.empty())
+    cases.erase(std::remove_if(cases.begin(), cases.end(),
+                               [&](const Case& c) { return c.name.find(args->only) == std::string::npos; }),
+                cases.end());
 
   std::ostringstream md, builds;
   std::vector<Row> rows;

@@ -71,6 +71,7 @@ inline std::string cpu_model() {
 // --smoke. Anything else prints the usage and returns nothing.
 struct Args {
   std::string out, csv, dump;
+  std::string only;  // --only TEXT: the cases whose name contains TEXT (benches that accept it)
   int runs = 1;
   bool quick = false, smoke = false;
 };
@@ -88,6 +89,8 @@ inline std::optional<Args> parse_args(int argc, char** argv, const std::string& 
       args.csv = argv[++i];
     else if (flag == "--dump" && has_value && accepts("--dump"))
       args.dump = argv[++i];
+    else if (flag == "--only" && has_value && accepts("--only"))
+      args.only = argv[++i];
     else if (flag == "--runs" && has_value && accepts("--runs"))
       args.runs = std::max(1, std::atoi(argv[++i]));
     else if (flag == "--quick" && accepts("--quick"))

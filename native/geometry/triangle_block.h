@@ -38,6 +38,7 @@ using simd::splat;
 inline vint bits_of(vfloat x) { return reinterpret_cast<vint>(x); }
 inline vfloat abs(vfloat x) { return reinterpret_cast<vfloat>(bits_of(x) & 0x7FFFFFFF); }
 inline vfloat max(vfloat a, vfloat b) { return a > b ? a : b; }
+inline vfloat min(vfloat a, vfloat b) { return a < b ? a : b; }
 using vint_in_memory = int32_t __attribute__((vector_size(kBlockWidth * sizeof(int32_t)), aligned(4), may_alias));
 using simd::mask_of;
 }  // namespace simdb
@@ -110,23 +111,32 @@ template <bool AnyHit, bool kSkip, class OnHit>
   // Or misses by distance: stop before the error bound.
   if (!live) return false;
 
-  // near_start_error of triangle.h, lane-wise.
-  const vfloat max_z = max(max(abs(z[0]), abs(z[1])), abs(z[2]));
-  const vfloat max_xy = max(max(max(abs(x[0]), abs(x[1])), abs(x[2])), max(max(abs(y[0]), abs(y[1])), abs(y[2])));
-  const vfloat error = near_start_error(max_xy, max_z, abs_det, tnear);
-  const vfloat past_start = signed_t - splat(tnear) * abs_det;
-  const vint clear_of_start = past_start > error;
-  // As far before the start as clear_of_start is after it (the same bound, so as sure): a miss in
-  // float. These are the surface a ray leaves and the far side of a closed mesh behind it, which
-  // would otherwise all be sent to the double-precision distance only to be rejected there.
-  const vint clear_before_start = past_start < -error;
-
-  // Lanes the vector test decides; lanes inside the triangle whose distance is too close to tnear
-  // for float (mostly the surface a ray leaves), whose crossing is decided in double directly,
-  // as the scalar test would after repeating the same float arithmetic; and lanes with an exact
-  // zero edge function, which take the whole scalar test.
-  const uint32_t accepted = mask_of(candidate & ~exact_zero & clear_of_start) & live;
-  const uint32_t near_start = mask_of(candidate & ~exact_zero & ~clear_of_start & ~clear_before_start) & live;
+  // start_side of triangle.h, lane-wise: lanes wholly ahead of the origin's plane across the
+  // dominant axis are past the start, lanes wholly behind it before the start, without the bound.
+  const vint decided = candidate & ~exact_zero;  // lanes the vector test decides
+  const vfloat z_low = min(min(z[0], z[1]), z[2]), z_high = max(max(z[0], z[1]), z[2]);
+  const vint ahead = z_low > splat(tnear <= 0.0f ? 0.0f : kInfinity);
+  const vint behind = z_high < splat(tnear >= 0.0f ? 0.0f : -kInfinity);
+  uint32_t accepted = mask_of(decided & ahead) & live;
+  uint32_t near_start = 0;
+  if (const uint32_t across = mask_of(decided & ~ahead & ~behind) & live) {
+    // near_start_error of triangle.h, lane-wise.
+    const vfloat max_z = max(max(abs(z[0]), abs(z[1])), abs(z[2]));
+    const vfloat max_xy = max(max(max(abs(x[0]), abs(x[1])), abs(x[2])), max(max(abs(y[0]), abs(y[1])), abs(y[2])));
+    const vfloat error = near_start_error(max_xy, max_z, abs_det, tnear);
+    const vfloat past_start = signed_t - splat(tnear) * abs_det;
+    const uint32_t clear_of_start = mask_of(past_start > error);
+    // As far before the start as clear_of_start is after it (the same bound, so as sure): a miss
+    // in float. These are mostly the surface a ray leaves and its neighbours, which would
+    // otherwise all be sent to the double-precision distance only to be rejected there.
+    const uint32_t clear_before_start = mask_of(past_start < -error);
+    accepted |= across & clear_of_start;
+    // Lanes inside the triangle whose distance is too close to tnear for float (mostly the
+    // surface a ray leaves): their crossing is decided in double directly, as the scalar test
+    // would after repeating the same float arithmetic.
+    near_start = across & ~clear_of_start & ~clear_before_start;
+  }
+  // Lanes with an exact zero edge function take the whole scalar test.
   const uint32_t scalar = mask_of(used & exact_zero) & live;
   bool any = false;
   if (accepted) {

@@ -86,9 +86,11 @@ namespace {
 // The float quantities of intersect_triangle for one ray and triangle, computed as it does, with
 // the magnitudes the near-start bound takes.
 struct ScaledDistance {
-  bool candidate = false;  // the edge functions share one sign, none zero
+  bool candidate = false;     // the edge functions share one sign, none zero
+  bool exact_inside = false;  // and so do those computed without rounding: the ray crosses the triangle
   float signed_t = 0, abs_det = 0, max_xy = 0, max_z = 0;
-  double pbrt_bound = 0;  // pbrt-v4's bound from the largest x, y, z and edge function, in double
+  float z[3] = {0, 0, 0};  // the scaled z of the vertices
+  double pbrt_bound = 0;   // pbrt-v4's bound from the largest x, y, z and edge function, in double
   long double exact_signed_t = 0, exact_abs_det = 0;
 };
 
@@ -113,6 +115,8 @@ ScaledDistance scaled_distance(const WatertightRay& r, const Vec3& p0, const Vec
                              xe[1] * ye[0] - ye[1] * xe[0]};
   const bool all_positive = e[0] > 0 && e[1] > 0 && e[2] > 0, all_negative = e[0] < 0 && e[1] < 0 && e[2] < 0;
   s.candidate = all_positive || all_negative;
+  s.exact_inside = (ee[0] > 0 && ee[1] > 0 && ee[2] > 0) || (ee[0] < 0 && ee[1] < 0 && ee[2] < 0);
+  for (int k = 0; k < 3; ++k) s.z[k] = z[k];
   const float det = e[0] + e[1] + e[2];
   const float scaled_t = e[0] * z[0] + e[1] * z[1] + e[2] * z[2];
   s.abs_det = std::fabs(det);
@@ -155,6 +159,27 @@ void for_rays_leaving_triangles(Check&& check) {
     // Directions are not normalised (a mesh traces the object-space direction an instance's
     // matrix gives it): lengths from 1e-3 to 1e3.
     const Vec3 dir = std::pow(10.0f, float(i % 7) - 3.0f) * Vec3(sym(rng), sym(rng), sym(rng));
+    if (dir == Vec3(0.0f)) continue;
+    check(make_watertight_ray(org, dir), p0, p1, p2);
+  }
+}
+
+// Rays from afar (a camera's): origins 1 to 10^4 triangle sizes away, aimed at points in and
+// around a random triangle, at scales from 1e-4 to 1e4, some with the triangle behind them.
+template <class Check>
+void for_rays_from_afar(Check&& check) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f), sym(-1.0f, 1.0f);
+  for (int i = 0; i < 100000; ++i) {
+    const float scale = std::pow(10.0f, float(i % 9) - 4.0f);
+    const Vec3 centre = scale * std::pow(10.0f, 3.0f * unit(rng)) * Vec3(sym(rng), sym(rng), sym(rng));
+    const Vec3 p0 = centre + scale * Vec3(sym(rng), sym(rng), sym(rng));
+    const Vec3 p1 = centre + scale * Vec3(sym(rng), sym(rng), sym(rng));
+    const Vec3 p2 = centre + scale * Vec3(sym(rng), sym(rng), sym(rng));
+    const float a = 1.2f * unit(rng), b = 1.2f * unit(rng) * (1 - a);  // a few just outside
+    const Vec3 aim = p0 + a * (p1 - p0) + b * (p2 - p0);
+    const Vec3 org = aim + scale * std::pow(10.0f, 4.0f * unit(rng)) * Vec3(sym(rng), sym(rng), sym(rng));
+    const Vec3 dir = (i % 4 == 3 ? -1.0f : 1.0f) * (aim - org);  // one in four looks away
     if (dir == Vec3(0.0f)) continue;
     check(make_watertight_ray(org, dir), p0, p1, p2);
   }
@@ -219,4 +244,39 @@ TEST(Triangle, NearStartErrorCoversTheComparisonWithTnear) {
   EXPECT_GT(candidates, 50000);
   EXPECT_GT(near_bound, 1000);  // the starts at the crossing reach the bound's edge
   EXPECT_EQ(outside, 0);
+}
+
+// start_side decides a candidate wholly on one side of the ray's origin (across the dominant axis)
+// without the error bound. Its argument is independent of the bound's, so the two must never
+// disagree: where the bound is sure, it is sure of the same side; the float comparison the test
+// would make agrees; and where the ray really crosses the triangle (the edge functions computed
+// without rounding share one sign too), the crossing computed without rounding is on that side.
+TEST(Triangle, StartSideNeverContradictsTheErrorBound) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  int decided = 0, beyond_the_bound = 0, contradicted = 0, float_disagrees = 0, crossing_disagrees = 0;
+  const auto check = [&](const WatertightRay& r, const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+    const ScaledDistance s = scaled_distance(r, p0, p1, p2);
+    if (!s.candidate) return;
+    const float tnears[] = {0.0f, -1e-3f * unit(rng), 1e-3f * unit(rng)};
+    for (const float tnear : tnears) {
+      const int side = start_side(s.z[0], s.z[1], s.z[2], tnear);
+      if (side == 0) continue;
+      ++decided;
+      const float past_start = s.signed_t - tnear * s.abs_det;  // as intersect_triangle computes it
+      const float error = near_start_error(s.max_xy, s.max_z, s.abs_det, tnear);
+      if (side > 0 ? past_start < -error : past_start > error) ++contradicted;
+      if (side > 0 ? !(past_start >= 0.0f) : !(past_start <= 0.0f)) ++float_disagrees;
+      if (std::fabs(past_start) <= error) ++beyond_the_bound;
+      const long double exact = s.exact_signed_t - (long double)tnear * s.exact_abs_det;
+      if (s.exact_inside && (side > 0 ? exact <= 0 : exact >= 0)) ++crossing_disagrees;
+    }
+  };
+  for_rays_leaving_triangles(check);
+  for_rays_from_afar(check);
+  EXPECT_GT(decided, 50000);
+  EXPECT_EQ(contradicted, 0);
+  EXPECT_EQ(float_disagrees, 0);
+  EXPECT_EQ(crossing_disagrees, 0);
+  EXPECT_GT(beyond_the_bound, 0);  // and it decides lanes the bound would send to double precision
 }
