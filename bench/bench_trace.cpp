@@ -135,6 +135,9 @@ int main(int argc, char** argv) {
 
   std::ostringstream md, builds;
   std::vector<Row> rows;
+  std::ostringstream memory;
+  memory << "| mesh | TOYRT, SAH commit | Embree default | TOYRT, LBVH commit | Embree Morton (LOW, dynamic) |\n"
+         << "|---|---|---|---|---|\n";
   builds << "| mesh | builders | threads | runs | TOYRT commit ms | Embree build ms | TOYRT / Embree (time) |\n"
          << "|---|---|---|---|---|---|---|\n";
   for (const Case& c : cases) {
@@ -171,6 +174,20 @@ int main(int argc, char** argv) {
     scene.commit();
     const EmbreeScene embree(traced.vertices, traced.triangles);
     const EmbreeScene robust(traced.vertices, traced.triangles, true);
+    if (!c.room) {
+      // What each engine keeps for tracing, per triangle, with either builder.
+      Scene lbvh_scene;
+      lbvh_scene.add_instance(lbvh_scene.add_mesh(traced.vertices, traced.triangles), Mat4(1.0f));
+      CommitOptions lbvh_options;
+      lbvh_options.builder = BuilderKind::Lbvh;
+      lbvh_scene.commit(lbvh_options);
+      const EmbreeScene morton(traced.vertices, traced.triangles, false, 0, true);
+      const double n = double(traced.triangles.size());
+      char line[256];
+      std::snprintf(line, sizeof line, "| %s | %.1f | %.1f | %.1f | %.1f |\n", c.name.c_str(), scene.memory_bytes() / n,
+                    embree.memory_bytes() / n, lbvh_scene.memory_bytes() / n, morton.memory_bytes() / n);
+      memory << line;
+    }
 
     // Camera rays that hit (a frame around the bounds misses in its corners; those rays cost
     // little in either engine and say nothing about traversal), and the surface points they find.
@@ -286,6 +303,10 @@ int main(int argc, char** argv) {
      << "as fit in two seconds (up to 51); medians of the times, and the median of the per-run ratios of TOYRT's "
      << "time to Embree's.\n\n"
      << builds.str();
+  md << "\n## Memory\n\nBytes per triangle each engine holds once a mesh is committed: TOYRT's `Scene::memory_bytes()` "
+     << "(the mesh's vertices and indices, its triangle blocks and wide nodes), Embree's allocations as its memory "
+     << "monitor reports them (its vertex and index buffers, the BVH and its triangle leaves).\n\n"
+     << memory.str();
 
   // Watertightness: rays from inside closed meshes aimed exactly at every vertex, every edge
   // midpoint and four random points on every edge (tests/native/watertight_test.cpp asserts

@@ -7,6 +7,9 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
 #include <vector>
 
 namespace toyrt::testing {
@@ -25,11 +28,15 @@ class EmbreeScene {
   Hit intersect(const Ray& ray) const;  // instance is 0 on a hit
   bool occluded(const Ray& ray) const;
   double build_ms() const { return build_ms_; }
+  // Bytes the device holds once the scene is built: the vertex and index buffers and the BVH with
+  // its triangle data (as Embree's memory monitor reports its allocations).
+  size_t memory_bytes() const { return size_t(std::max<int64_t>(memory_.load(), 0)); }
 
  private:
   RTCDevice device_;
   RTCScene scene_;
   double build_ms_ = 0.0;
+  std::atomic<int64_t> memory_{0};
 };
 
 }  // namespace toyrt::testing
