@@ -4,7 +4,8 @@ instructions) and mnemonic, from valgrind's callgrind (exact counts, unlike timi
 machine). Zen 1 and other CPUs with 128-bit vector units split every ymm instruction in two, so the
 mix says more about the time there than the instruction total does (docs/trace-speed.md).
 
-    python3 bench/instruction_mix.py build/bench/trace_only [diffuse|primary|shadow] [rings] [room]
+    python3 bench/instruction_mix.py build/bench/trace_only [diffuse|primary|shadow] [rings] [room|soup]
+    (soup: bench_trace's triangle soup of rings x 1000 triangles instead of the sphere)
 
 Needs valgrind (apt-get install valgrind) and objdump. Each engine runs the set once and three
 times; the difference over the extra rays is what a ray costs, without the scene's build and the
@@ -101,7 +102,7 @@ def mix(trace_only, ray_set, rings, extra, engine):
     keep_toyrt = lambda obj, fn: "trace_only" in obj and "toyrt::" in fn and "toyrt::testing::" not in fn  # noqa: E731
     keep_embree = lambda obj, fn: "libembree" in obj  # noqa: E731
     keep = keep_embree if engine == "embree" else keep_toyrt
-    last = [engine] if engine == "embree" else extra  # trace_only's fourth argument
+    last = extra + ([engine] if engine == "embree" else [])  # trace_only's words after the repeats
     with tempfile.TemporaryDirectory() as tmp:
         counts = []
         for repeats in (1, 3):
@@ -129,14 +130,17 @@ def main():
     parser.add_argument("trace_only", type=Path)
     parser.add_argument("ray_set", nargs="?", default="diffuse", choices=["diffuse", "primary", "shadow"])
     parser.add_argument("rings", nargs="?", type=int, default=71, help="71: the 10K-triangle sphere")
-    parser.add_argument("room", nargs="?", choices=["room"], help="TOYRT only: inside bench_trace's closed room")
+    parser.add_argument("mesh", nargs="?", choices=["room", "soup"],
+                        help="room: inside bench_trace's closed room (TOYRT only); soup: the triangle soup")
     args = parser.parse_args()
-    engines = ["toyrt"] + ([] if args.room else ["embree"])
-    print(f"{args.ray_set} rays, {args.rings} rings{' in the closed room' if args.room else ''}: instructions a ray")
+    room = args.mesh == "room"
+    engines = ["toyrt"] + ([] if room else ["embree"])
+    what = {"room": f"{args.rings} rings in the closed room", "soup": f"a soup of {args.rings}K triangles"}
+    print(f"{args.ray_set} rays, {what.get(args.mesh, f'{args.rings} rings')}: instructions a ray")
     print(f"{'engine':8} {'total':>7} {'general':>8} {'xmm':>6} {'ymm':>6} {'vector uops, 128-bit units':>27}")
     mnemonics = {}
     for engine in engines:
-        by_kind, mnemonics[engine] = mix(args.trace_only, args.ray_set, args.rings, [args.room] if args.room else [],
+        by_kind, mnemonics[engine] = mix(args.trace_only, args.ray_set, args.rings, [args.mesh] if args.mesh else [],
                                          engine)
         total = sum(by_kind.values())
         print(f"{engine:8} {total:7.0f} {by_kind['general']:8.0f} {by_kind['xmm']:6.0f} {by_kind['ymm']:6.0f} "

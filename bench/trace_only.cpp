@@ -45,10 +45,14 @@ int main(int argc, char** argv) {
   const std::string kind = argc > 1 ? argv[1] : "diffuse";
   const int rings = argc > 2 ? std::atoi(argv[2]) : 224;
   const int repeats = argc > 3 ? std::atoi(argv[3]) : 1;
-  const bool room = argc > 4 && std::string(argv[4]) == "room";
+  // The words after the repeats, in any order: room, soup, embree (below).
+  auto word = [&](const char* w) {
+    return std::find(argv + std::min(argc, 4), argv + argc, std::string(w)) != argv + argc;
+  };
+  const bool room = word("room");
   // "soup" as the fourth argument of commit and commit-all: bench_trace's triangle soup of
   // `rings` x 1000 triangles instead of the sphere.
-  const bool soup = argc > 4 && std::string(argv[4]) == "soup";
+  const bool soup = word("soup");
   const MeshData mesh = soup ? triangle_soup(size_t(rings) * 1000, 0.02f, 1) : uv_sphere(rings, rings, 1.0f, 0.15f);
   if (kind == "lbvh-all" || kind == "sah-all") {
     const bool sah = kind == "sah-all";
@@ -228,7 +232,7 @@ int main(int argc, char** argv) {
                                     : leaving_their_triangles(mesh, diffuse_rays(mesh, primary, hits, 17), hits);
   // "embree" as the fourth argument: the same rays through Embree 3 in its default mode, for
   // instruction counts side by side (under valgrind Embree runs its AVX2 kernels).
-  const bool embree = argc > 4 && std::string(argv[4]) == "embree";
+  const bool embree = word("embree");
   const EmbreeScene peer(mesh.vertices, mesh.triangles, false, 1);
   // "room" as the fourth argument: the same rays traced in the mesh inside a closed room of 12
   // triangles (bench_trace's closed room: with the light outside, a wall blocks every shadow ray).
