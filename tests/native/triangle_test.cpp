@@ -140,19 +140,35 @@ ScaledDistance scaled_distance(const WatertightRay& r, const Vec3& p0, const Vec
   return s;
 }
 
+// Random triangles of size `scale` (vertices within it of a centre), up to a thousand sizes from
+// the origin: a ray set's generator and its distributions.
+struct RandomTriangles {
+  std::mt19937 rng;
+  std::uniform_real_distribution<float> unit{0.0f, 1.0f}, sym{-1.0f, 1.0f};
+
+  explicit RandomTriangles(uint32_t seed) : rng(seed) {}
+  Vec3 point() { return Vec3(sym(rng), sym(rng), sym(rng)); }
+  void next(float scale, Vec3& p0, Vec3& p1, Vec3& p2) {
+    const Vec3 centre = scale * std::pow(10.0f, 3.0f * unit(rng)) * point();
+    p0 = centre + scale * point();
+    p1 = centre + scale * point();
+    p2 = centre + scale * point();
+  }
+};
+
 // Rays that start on or near a random triangle (as rays leaving a surface do), at scales from
 // 1e-4 to 1e4, up to a thousand triangle sizes from the origin, with directions of any length:
 // the cases near_start_error decides.
 template <class Check>
 void for_rays_leaving_triangles(Check&& check) {
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<float> unit(0.0f, 1.0f), sym(-1.0f, 1.0f);
+  RandomTriangles g(11);
+  auto& unit = g.unit;
+  auto& sym = g.sym;
+  auto& rng = g.rng;
   for (int i = 0; i < 200000; ++i) {
     const float scale = std::pow(10.0f, float(i % 9) - 4.0f);
-    const Vec3 centre = scale * std::pow(10.0f, 3.0f * unit(rng)) * Vec3(sym(rng), sym(rng), sym(rng));
-    const Vec3 p0 = centre + scale * Vec3(sym(rng), sym(rng), sym(rng));
-    const Vec3 p1 = centre + scale * Vec3(sym(rng), sym(rng), sym(rng));
-    const Vec3 p2 = centre + scale * Vec3(sym(rng), sym(rng), sym(rng));
+    Vec3 p0, p1, p2;
+    g.next(scale, p0, p1, p2);
     const float a = unit(rng), b = unit(rng) * (1 - a);
     const Vec3 on = p0 + a * (p1 - p0) + b * (p2 - p0);
     const Vec3 org = on + scale * std::pow(10.0f, -6.0f * unit(rng)) * Vec3(sym(rng), sym(rng), sym(rng));
@@ -168,17 +184,14 @@ void for_rays_leaving_triangles(Check&& check) {
 // around a random triangle, at scales from 1e-4 to 1e4, some with the triangle behind them.
 template <class Check>
 void for_rays_from_afar(Check&& check) {
-  std::mt19937 rng(13);
-  std::uniform_real_distribution<float> unit(0.0f, 1.0f), sym(-1.0f, 1.0f);
+  RandomTriangles g(13);
   for (int i = 0; i < 100000; ++i) {
     const float scale = std::pow(10.0f, float(i % 9) - 4.0f);
-    const Vec3 centre = scale * std::pow(10.0f, 3.0f * unit(rng)) * Vec3(sym(rng), sym(rng), sym(rng));
-    const Vec3 p0 = centre + scale * Vec3(sym(rng), sym(rng), sym(rng));
-    const Vec3 p1 = centre + scale * Vec3(sym(rng), sym(rng), sym(rng));
-    const Vec3 p2 = centre + scale * Vec3(sym(rng), sym(rng), sym(rng));
-    const float a = 1.2f * unit(rng), b = 1.2f * unit(rng) * (1 - a);  // a few just outside
+    Vec3 p0, p1, p2;
+    g.next(scale, p0, p1, p2);
+    const float a = 1.2f * g.unit(g.rng), b = 1.2f * g.unit(g.rng) * (1 - a);  // a few just outside
     const Vec3 aim = p0 + a * (p1 - p0) + b * (p2 - p0);
-    const Vec3 org = aim + scale * std::pow(10.0f, 4.0f * unit(rng)) * Vec3(sym(rng), sym(rng), sym(rng));
+    const Vec3 org = aim + scale * std::pow(10.0f, 4.0f * g.unit(g.rng)) * g.point();
     const Vec3 dir = (i % 4 == 3 ? -1.0f : 1.0f) * (aim - org);  // one in four looks away
     if (dir == Vec3(0.0f)) continue;
     check(make_watertight_ray(org, dir), p0, p1, p2);
