@@ -3,8 +3,10 @@
 // does not blur (bench_trace gives the speed against Embree). Prints rays, hits and a checksum of
 // the distances, so an A/B of two builds also shows that both found the same hits.
 //
-//   trace_only [primary|diffuse|shadow] [rings] [repeats] [embree|room]   (rings 708: the 1M-triangle sphere;
-//                                         room: traced inside a closed room, see below)
+//   trace_only [primary|diffuse|shadow] [rings] [repeats] [embree] [room|soup]   (rings 708: the
+//                                         1M-triangle sphere; room: traced inside a closed room, see
+//                                         below; soup: bench_trace's triangle soup of rings x 1000;
+//                                         embree: the same rays through Embree; words in any order)
 //   trace_only commit [rings] [repeats]   the whole single-thread SAH commit of a fresh scene, in
 //                                         CPU milliseconds (the process's CPU clock: one thread,
 //                                         so other work on the machine does not inflate it)
@@ -50,7 +52,7 @@ int main(int argc, char** argv) {
     return std::find(argv + std::min(argc, 4), argv + argc, std::string(w)) != argv + argc;
   };
   const bool room = word("room");
-  // "soup" as the fourth argument of commit and commit-all: bench_trace's triangle soup of
+  // "soup" (commit, commit-all, sah-all and the ray sets): bench_trace's triangle soup of
   // `rings` x 1000 triangles instead of the sphere.
   const bool soup = word("soup");
   const MeshData mesh = soup ? triangle_soup(size_t(rings) * 1000, 0.02f, 1) : uv_sphere(rings, rings, 1.0f, 0.15f);
@@ -230,11 +232,11 @@ int main(int argc, char** argv) {
                                 : kind == "shadow"
                                     ? leaving_their_triangles(mesh, shadow_rays(mesh, primary, hits, light), hits)
                                     : leaving_their_triangles(mesh, diffuse_rays(mesh, primary, hits, 17), hits);
-  // "embree" as the fourth argument: the same rays through Embree 3 in its default mode, for
+  // "embree": the same rays through Embree 3 in its default mode, for
   // instruction counts side by side (under valgrind Embree runs its AVX2 kernels).
   const bool embree = word("embree");
   const EmbreeScene peer(mesh.vertices, mesh.triangles, false, 1);
-  // "room" as the fourth argument: the same rays traced in the mesh inside a closed room of 12
+  // "room" (Embree ignores it): the same rays traced in the mesh inside a closed room of 12
   // triangles (bench_trace's closed room: with the light outside, a wall blocks every shadow ray).
   Scene in_room;
   if (room) {

@@ -68,14 +68,18 @@ inline F near_start_error(F max_xy, F max_z, F abs_det, float tnear) {
 // for the error bound to decide (0), from the scaled z of its vertices alone. Each z is
 // sz (p_z - o_z) along the dominant axis, whose sign is exact (a float difference is zero only
 // for equal operands and keeps the sign; so does the product), so z > 0 at every vertex says the
-// whole triangle lies strictly ahead of the origin's plane across that axis: a true crossing is at
-// t > 0. The float test agrees without rounding doubt: its crossing T / det is the sum of the
-// edge functions times the z's, and a candidate's edge functions share one sign, so no term
-// cancels. So with tnear <= 0 such a hit is past the start; likewise all z < 0 with tnear >= 0
-// is behind it. The bound is for triangles across that plane: the one a ray leaves and its
-// neighbours. Camera rays at 10K triangles: 4 % of their time was the bound (docs/trace-speed.md,
-// thirty-sixth session).
-inline int start_side(float az, float bz, float cz, float tnear) {
+// whole triangle lies strictly ahead of the origin's plane across that axis. The crossing the
+// float test found, T / det, is the sum of the edge functions times the z's; a candidate's edge
+// functions share one sign, so no term cancels and it lies ahead too, at a distance within the
+// triangle's span. So with tnear <= 0 such a hit is past the start; likewise all z < 0 with
+// tnear >= 0 is behind it. A ray the test lets in while it truly passes outside (within the
+// rounding of its shear: a ray starting within rounding of the triangle) is so decided by the
+// configuration that decided inside and outside, where the bound would have asked where the
+// true plane crosses the ray (docs/core.md). A determinant that overflowed (coordinates near
+// 1e19) leaves T / det meaningless: the bound and double precision decide those. Camera rays at
+// 10K triangles: 4 % of their time was the bound (docs/trace-speed.md, thirty-sixth session).
+inline int start_side(float az, float bz, float cz, float abs_det, float tnear) {
+  if (!(abs_det <= std::numeric_limits<float>::max())) return 0;
   if (tnear <= 0.0f && az > 0.0f && bz > 0.0f && cz > 0.0f) return 1;
   if (tnear >= 0.0f && az < 0.0f && bz < 0.0f && cz < 0.0f) return -1;
   return 0;
@@ -150,7 +154,7 @@ inline int start_side(float az, float bz, float cz, float tnear) {
   if (!(signed_t < tfar * abs_det)) return false;
   // A triangle wholly on one side of the ray's origin along the dominant axis needs no error
   // bound (start_side). Else the bound decides, and where it cannot, double precision does.
-  const int side = start_side(az, bz, cz, tnear);
+  const int side = start_side(az, bz, cz, abs_det, tnear);
   if (side < 0) return false;
   if (side == 0) {
     const float past_start = signed_t - tnear * abs_det;
@@ -192,9 +196,9 @@ inline void refine_hit(const Vec3& org, const Vec3& dir, const Vec3& p0, const V
   const double inv = 1.0 / det;
   const DVec3 tv = o - a, qv = glm::cross(tv, e1);
   // Never before the start. A plane crossing before it with the float test's crossing past it is
-  // a ray grazing the plane that rounding let into a triangle start_side found wholly ahead (the
-  // plane crossing of a ray nearly in the plane says little): the float distance, which lies
-  // within the triangle's span along the ray, stays.
+  // a ray that rounding let into a triangle start_side found wholly ahead while it truly passes
+  // outside (it starts within rounding of the triangle, or lies nearly in its plane): the float
+  // distance, which lies within the triangle's span along the ray, stays.
   const float refined = float(glm::dot(e2, qv) * inv);
   t = refined >= tnear ? refined : std::max(t, tnear);
   u = float(glm::dot(tv, pv) * inv);

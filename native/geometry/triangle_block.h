@@ -115,8 +115,9 @@ template <bool AnyHit, bool kSkip, class OnHit>
   // dominant axis are past the start, lanes wholly behind it before the start, without the bound.
   const vint decided = candidate & ~exact_zero;  // lanes the vector test decides
   const vfloat z_low = min(min(z[0], z[1]), z[2]), z_high = max(max(z[0], z[1]), z[2]);
-  const vint ahead = z_low > splat(tnear <= 0.0f ? 0.0f : kInfinity);
-  const vint behind = z_high < splat(tnear >= 0.0f ? 0.0f : -kInfinity);
+  const vint finite_det = abs_det <= splat(std::numeric_limits<float>::max());
+  const vint ahead = (z_low > splat(tnear <= 0.0f ? 0.0f : kInfinity)) & finite_det;
+  const vint behind = (z_high < splat(tnear >= 0.0f ? 0.0f : -kInfinity)) & finite_det;
   uint32_t accepted = mask_of(decided & ahead) & live;
   uint32_t near_start = 0;
   if (const uint32_t across = mask_of(decided & ~ahead & ~behind) & live) {

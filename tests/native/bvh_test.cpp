@@ -283,6 +283,65 @@ TEST(Bvh, TraversalAgreesExactlyWithTestingEveryTriangle) {
   }
 }
 
+// The same exact agreement for rays that start elsewhere than at their origin: before it (tnear
+// -1), at -0 and 0, halfway to the first surface, and just past it, where the triangles the ray
+// crosses first lie wholly ahead of its origin but before its start (start_side must leave
+// them to the error bound when tnear > 0).
+TEST(Bvh, TraversalAgreesExactlyWithTestingEveryTriangleFromAnyStart) {
+  for (const MeshData& m : {uv_sphere(12, 24, 1.0f, 0.3f), triangle_soup(3000, 0.05f, 3), slivers(500, 4)}) {
+    const Mesh mesh = built(m);
+    const auto camera = primary_rays(bounds_of(m), 48, 36);
+    std::vector<Hit> hits;
+    for (const Ray& r : camera) hits.push_back(brute_force(m, r));
+    std::vector<Ray> rays = camera;
+    for (const Ray& r : diffuse_rays(m, camera, hits, 7)) rays.push_back(r);
+    int compared = 0, found = 0;
+    for (const Ray& base : rays) {
+      const Hit first = brute_force(m, base);
+      const float halfway = first.found() ? 0.5f * first.t : 1.0f, past = first.found() ? 1.01f * first.t : 2.0f;
+      for (const float tnear : {-1.0f, -0.0f, 0.0f, halfway, past}) {
+        Ray r = base;
+        r.tnear = tnear;
+        const Hit ref = brute_force(m, r);
+        float tfar = r.tfar, u, v;
+        int32_t prim = -1;
+        const bool hit = mesh.intersect(r.org, r.dir, r.tnear, tfar, u, v, prim);
+        ASSERT_EQ(hit, ref.found()) << "tnear " << tnear;
+        if (hit) {
+          EXPECT_EQ(tfar, ref.t);
+          EXPECT_EQ(prim, ref.prim);
+          ++found;
+        }
+        EXPECT_EQ(mesh.occluded(r.org, r.dir, r.tnear, r.tfar), ref.found());
+        ++compared;
+      }
+    }
+    EXPECT_GT(found, 0);
+    EXPECT_GT(compared, 1000);
+  }
+}
+
+// A determinant that overflows (sheared coordinates near 1e19, edge functions near 1.5e38 each,
+// their sum beyond float) makes the float distance T / det meaningless; the distance is then
+// decided in double precision: the crossing at 1e-10 is found, and a segment ending before it
+// is not blocked. (start_side once accepted such a lane at t = -0, and as a blocker of any segment.)
+TEST(Mesh, AnOverflowingDeterminantLeavesTheDistanceToDoublePrecision) {
+  const float a = 1.22e19f, z = 1e-10f;
+  const MeshData m{{{a, 0.0f, z}, {0.0f, a, z}, {-a, -a, z}}, {{0, 1, 2}}};
+  const Mesh mesh = built(m);
+  const Vec3 o(0.0f), d(0.0f, 0.0f, 1.0f);
+  float tfar = kInfinity, u, v;
+  int32_t prim = -1;
+  ASSERT_TRUE(mesh.intersect(o, d, 0.0f, tfar, u, v, prim));
+  EXPECT_NEAR(tfar, z, 1e-6f * z);
+  EXPECT_EQ(prim, 0);
+  EXPECT_FALSE(mesh.occluded(o, d, 0.0f, 0.1f * z));
+  EXPECT_TRUE(mesh.occluded(o, d, 0.0f, 10.0f * z));
+  float t, tu, tv;
+  EXPECT_FALSE(intersect_triangle(make_watertight_ray(o, d), m.vertices[0], m.vertices[1], m.vertices[2], 0.0f,
+                                  0.1f * z, t, tu, tv));
+}
+
 // The any-hit walk visits a node's children in slot order, so collapse() stores them by
 // decreasing box area (the likeliest blockers first), with the empty slots last.
 TEST(WideBvh, ChildrenAreStoredByDecreasingArea) {

@@ -273,7 +273,7 @@ TEST(Triangle, StartSideNeverContradictsTheErrorBound) {
     if (!s.candidate) return;
     const float tnears[] = {0.0f, -1e-3f * unit(rng), 1e-3f * unit(rng)};
     for (const float tnear : tnears) {
-      const int side = start_side(s.z[0], s.z[1], s.z[2], tnear);
+      const int side = start_side(s.z[0], s.z[1], s.z[2], s.abs_det, tnear);
       if (side == 0) continue;
       ++decided;
       const float past_start = s.signed_t - tnear * s.abs_det;  // as intersect_triangle computes it

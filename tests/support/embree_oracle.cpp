@@ -8,18 +8,19 @@
 namespace toyrt::testing {
 
 EmbreeScene::EmbreeScene(const std::vector<Vec3>& vertices, const std::vector<Triangle>& triangles, bool robust,
-                         int threads, bool morton) {
+                         int threads, bool morton, bool count_memory) {
   const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
   device_ = rtcNewDevice(config.c_str());
   if (!device_) throw std::runtime_error("Embree: cannot create a device");
   // Counts every allocation and release (from any of the build's threads).
-  rtcSetDeviceMemoryMonitorFunction(
-      device_,
-      [](void* counter, ssize_t bytes, bool) {
-        static_cast<std::atomic<int64_t>*>(counter)->fetch_add(int64_t(bytes), std::memory_order_relaxed);
-        return true;
-      },
-      &memory_);
+  if (count_memory)
+    rtcSetDeviceMemoryMonitorFunction(
+        device_,
+        [](void* counter, ssize_t bytes, bool) {
+          static_cast<std::atomic<int64_t>*>(counter)->fetch_add(int64_t(bytes), std::memory_order_relaxed);
+          return true;
+        },
+        &memory_);
   const auto start = std::chrono::steady_clock::now();
   scene_ = rtcNewScene(device_);
   rtcSetSceneFlags(scene_, RTCSceneFlags((robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE) |

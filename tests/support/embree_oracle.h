@@ -18,9 +18,10 @@ class EmbreeScene {
  public:
   // robust: RTC_SCENE_FLAG_ROBUST (Embree's watertight-leaning mode); threads 0: all cores;
   // morton: Embree's fast builder (RTC_BUILD_QUALITY_LOW on a RTC_SCENE_FLAG_DYNAMIC scene, its
-  // Morton-code build), the peer of TOYRT's LBVH.
+  // Morton-code build), the peer of TOYRT's LBVH; count_memory: memory_bytes() counts the device's
+  // allocations (Embree's memory monitor, a callback on every one: not for timed builds).
   EmbreeScene(const std::vector<Vec3>& vertices, const std::vector<Triangle>& triangles, bool robust = false,
-              int threads = 0, bool morton = false);
+              int threads = 0, bool morton = false, bool count_memory = false);
   ~EmbreeScene();
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
