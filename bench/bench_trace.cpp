@@ -98,6 +98,16 @@ std::string triangles_label(size_t n) {
   return s;
 }
 
+// The mesh as a scene of one untransformed instance, committed with `builder` on `threads`
+// (0: all): what each timed TOYRT build does, and the scenes traced and measured.
+void commit_mesh(Scene& scene, const MeshData& mesh, BuilderKind builder, int threads = 0) {
+  scene.add_instance(scene.add_mesh(mesh.vertices, mesh.triangles), Mat4(1.0f));
+  CommitOptions options;
+  options.builder = builder;
+  options.threads = threads;
+  scene.commit(options);
+}
+
 // Prints the report, and writes it where --out says.
 int finish(const std::string& report, const std::string& out_path) {
   std::cout << report;
@@ -167,11 +177,7 @@ int main(int argc, char** argv) {
         if (c.room || (lbvh && threads != all)) continue;
         const auto mine = [&] {
           Scene s;
-          s.add_instance(s.add_mesh(traced.vertices, traced.triangles), Mat4(1.0f));
-          CommitOptions opt;
-          opt.builder = lbvh ? BuilderKind::Lbvh : BuilderKind::Sah;
-          opt.threads = threads;
-          s.commit(opt);
+          commit_mesh(s, traced, lbvh ? BuilderKind::Lbvh : BuilderKind::Sah, threads);
         };
         const auto theirs = [&] { EmbreeScene e(traced.vertices, traced.triangles, false, threads, lbvh); };
         // As many runs as the ray sets get, at least 5 (on this shared machine a single 4M build
@@ -186,10 +192,7 @@ int main(int argc, char** argv) {
         builds << line;
       }
     Scene scene;
-    scene.add_instance(scene.add_mesh(traced.vertices, traced.triangles), Mat4(1.0f));
-    CommitOptions sah_options;
-    sah_options.builder = BuilderKind::Sah;
-    scene.commit(sah_options);
+    commit_mesh(scene, traced, BuilderKind::Sah);
     // Embree's memory is counted for this build and the Morton one below only: its monitor's atomic
     // counter is not part of the timed builds.
     const EmbreeScene embree(traced.vertices, traced.triangles, false, 0, false, true);
@@ -197,10 +200,7 @@ int main(int argc, char** argv) {
     if (!c.room) {
       // What each engine keeps for tracing, per triangle, with either builder.
       Scene lbvh_scene;
-      lbvh_scene.add_instance(lbvh_scene.add_mesh(traced.vertices, traced.triangles), Mat4(1.0f));
-      CommitOptions lbvh_options;
-      lbvh_options.builder = BuilderKind::Lbvh;
-      lbvh_scene.commit(lbvh_options);
+      commit_mesh(lbvh_scene, traced, BuilderKind::Lbvh);
       const EmbreeScene morton(traced.vertices, traced.triangles, false, 0, true, true);
       const double n = double(traced.triangles.size());
       char line[256];
