@@ -19,7 +19,8 @@
 //   trace_only sah-all [rings] [repeats] [soup]   the whole SAH commit against Embree's default
 //                                             build, both on every core, interleaved, wall ms
 //                                             (lbvh-all and sah-all: TOYRT_THREADS=N runs both
-//                                             engines on N threads, as bench_trace's rows)
+//                                             engines on N threads, as bench_trace's rows;
+//                                             TOYRT_IDLE_US=N sleeps N us before each timed one)
 //   trace_only wide [rings]   the 8-wide layout of the SAH and LBVH trees, collapsed greedily and
 //                             by the SAH dynamic programme: children a node, SAH cost, collapse ms
 #include "accel/binned_sah_builder.h"
@@ -32,6 +33,7 @@
 #include "scene/scene.h"
 #include "test_scenes.h"
 
+#include <unistd.h>
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -59,6 +61,9 @@ int main(int argc, char** argv) {
   if (kind == "lbvh-all" || kind == "sah-all") {
     const bool sah = kind == "sah-all";
     const int threads = std::getenv("TOYRT_THREADS") ? std::atoi(std::getenv("TOYRT_THREADS")) : 0;
+    // TOYRT_IDLE_US=N: each engine's timed operation follows N microseconds asleep, as a commit
+    // after a user's export finds TBB's workers (docs/trace-speed.md, thirty-seventh session).
+    const int idle_us = std::getenv("TOYRT_IDLE_US") ? std::atoi(std::getenv("TOYRT_IDLE_US")) : 0;
     auto wall_ms = [] {
       timespec ts;
       clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -71,10 +76,12 @@ int main(int argc, char** argv) {
       CommitOptions options;
       options.builder = sah ? BuilderKind::Sah : BuilderKind::Lbvh;
       options.threads = threads;
+      if (idle_us) usleep(useconds_t(idle_us));
       double start = wall_ms();
       s.commit(options);
       if (k) mine.push_back(wall_ms() - start);
       if (!s.commit_stats().warning.empty()) std::fprintf(stderr, "%s\n", s.commit_stats().warning.c_str());
+      if (idle_us) usleep(useconds_t(idle_us));
       start = wall_ms();
       { EmbreeScene e(mesh.vertices, mesh.triangles, false, threads, !sah); }
       if (k) theirs.push_back(wall_ms() - start);
