@@ -108,7 +108,9 @@ struct WideSlabTest {
     // widening) is visited for nothing, rarely, and one broadcast and one min a visit are saved.
     tmin = max_keep(max_keep(max_keep(start, tnx), tny), tnz);
     vfloat tmax = min_keep(min_keep(min_keep(end, tfx), tfy), tfz);
-    if (negative_start) {  // rare (rays reaching back before their origin): the general form
+    // The hint: without it GCC laid the common form out of line, two taken jumps a visit (10K
+    // camera rays 2-4 % faster with it, docs/trace-speed.md, thirty-seventh session).
+    if (__builtin_expect(negative_start, 0)) {  // rare (rays reaching back before their origin): the general form
       tmin = tmin < 0.0f ? tmin * widen : tmin;
       tmax = tmax * (tmax < 0.0f ? shrink : widen);
     } else {  // tmin >= 0, so a negative exit is a miss however it is scaled: Ize's form
