@@ -61,8 +61,9 @@ int main(int argc, char** argv) {
   if (kind == "lbvh-all" || kind == "sah-all") {
     const bool sah = kind == "sah-all";
     const int threads = std::getenv("TOYRT_THREADS") ? std::atoi(std::getenv("TOYRT_THREADS")) : 0;
-    // TOYRT_IDLE_US=N: each engine's timed operation follows N microseconds asleep, as a commit
-    // after a user's export finds TBB's workers (docs/trace-speed.md, thirty-seventh session).
+    // TOYRT_IDLE_US=N: each engine's timed operation follows N microseconds asleep, so that it
+    // finds TBB's workers asleep, as a commit after a user's export does (docs/trace-speed.md,
+    // thirty-seventh session).
     const int idle_us = std::getenv("TOYRT_IDLE_US") ? std::atoi(std::getenv("TOYRT_IDLE_US")) : 0;
     auto wall_ms = [] {
       timespec ts;
