@@ -14,7 +14,6 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdio>
-#include <cstring>
 #include <future>
 #include <stdexcept>
 #include <thread>
@@ -130,11 +129,13 @@ namespace {
 // instructions a ray.
 bool is_traceable(const Ray& ray) {
   static_assert(offsetof(Ray, self) == 8 * sizeof(float) && kWidth == 8, "Ray: origin, tnear, direction, tfar");
-  // Copied, not loaded through simd::load: a ray is 16-byte aligned at best, and clang (unlike
-  // GCC) keeps a vector type's 32-byte alignment whatever the typedef asks (UBSan: a misaligned
-  // load; found by tests/fuzz).
-  simd::vfloat v;
-  std::memcpy(&v, &ray, sizeof v);
+  // Made from the fields, not copied from the ray's 32 bytes: a ray that RayBatch::at has just
+  // written sits in the store queue as six smaller stores, which one 32-byte load cannot take
+  // from there, so it waited for them to reach the cache (a batch's camera rays at 10K
+  // triangles 6-9 % slower, docs/trace-speed.md, thirty-eighth session). Where the ray is in
+  // memory already, GCC still makes this one load. (Not through simd::load either: a ray is
+  // 16-byte aligned at best, which clang's vector types do not accept; found by tests/fuzz.)
+  const simd::vfloat v = {ray.org.x, ray.org.y, ray.org.z, ray.tnear, ray.dir.x, ray.dir.y, ray.dir.z, ray.tfar};
   const uint32_t finite = simd::mask_of((v - v) == 0.0f);  // inf - inf and NaN - NaN are NaN
   const uint32_t nonzero = simd::mask_of(v != 0.0f);
   constexpr uint32_t kOrigin = 0x07, kDirection = 0x70;
@@ -516,7 +517,9 @@ void Scene::intersect(const RayBatch& rays, const HitBatch& hits, int threads) c
   run_with_threads(threads, [&] {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.count, kRayGrain), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t i = r.begin(); i != r.end(); ++i) {
-        const Hit h = intersect(rays.at(i));
+        // intersect(ray)'s body, inlined here: a call and a returned Hit fewer a ray.
+        Hit h;
+        if (!trace<false>(rays.at(i), h)) h = Hit{};
         hits.t[i] = h.t;
         hits.u[i] = h.u;
         hits.v[i] = h.v;
@@ -532,7 +535,10 @@ void Scene::occluded(const RayBatch& rays, uint8_t* blocked, int threads) const 
   check_threads(threads);
   run_with_threads(threads, [&] {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.count, kRayGrain), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i != r.end(); ++i) blocked[i] = occluded(rays.at(i)) ? 1 : 0;
+      for (size_t i = r.begin(); i != r.end(); ++i) {
+        Hit unused;  // occluded(ray)'s body, inlined as in intersect's batch above
+        blocked[i] = trace<true>(rays.at(i), unused) ? 1 : 0;
+      }
     });
   });
 }
