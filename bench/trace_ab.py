@@ -2,8 +2,8 @@
 swapped every round (old-new, then new-old), so a slow spell of this shared machine falls on both
 alike; the report is the median of the per-round speed ratios with its interquartile range, which
 says more than two medians taken apart. The machine's noise changes by the hour: an A/A run (one
-binary named twice) just before says how wide the range is at the moment (0.97-1.01 in a quiet
-spell, 0.95-1.15 in a busy one, docs/trace-speed.md). Both binaries must find the same hits (count
+binary named twice) just before says how wide the range is at the moment (0.998-1.004 in a quiet
+spell, 5-15 % wide in a busy one; docs/trace-speed.md, thirty-eighth session). Both binaries must find the same hits (count
 and checksum; exit status 1 otherwise): a change meant to be faster must not change an answer.
 
     cp build/bench/trace_only /tmp/trace_old     # before the change; rebuild, then:

@@ -134,10 +134,11 @@ bool is_traceable(const Ray& ray) {
   static_assert(offsetof(Ray, self) == 8 * sizeof(float) && kWidth == 8, "Ray: origin, tnear, direction, tfar");
   // Made from the fields, not copied from the ray's 32 bytes: a ray that RayBatch::at has just
   // written sits in the store queue as six smaller stores, which one 32-byte load cannot take
-  // from there, so it waited for them to reach the cache (a batch's camera rays at 10K
-  // triangles 6-9 % slower, docs/trace-speed.md, thirty-eighth session). Where the ray is in
-  // memory already, GCC still makes this one load. (Not through simd::load either: a ray is
-  // 16-byte aligned at best, which clang's vector types do not accept; found by tests/fuzz.)
+  // from there, so it waited for them to reach the cache (this and the batch loops' inlined
+  // call: a batch's camera rays at 10K triangles 6-9 % faster, docs/trace-speed.md,
+  // thirty-eighth session). Where the ray is in memory already, GCC still makes this one load.
+  // (Not through simd::load either: a ray is 16-byte aligned at best, which clang's vector types
+  // do not accept; found by tests/fuzz.)
   const simd::vfloat v = {ray.org.x, ray.org.y, ray.org.z, ray.tnear, ray.dir.x, ray.dir.y, ray.dir.z, ray.tfar};
   const uint32_t finite = simd::mask_of((v - v) == 0.0f);  // inf - inf and NaN - NaN are NaN
   const uint32_t nonzero = simd::mask_of(v != 0.0f);
