@@ -313,6 +313,54 @@ TEST(Scene, BatchResultsDoNotDependOnThreadCount) {
   for (size_t i = 0; i < rays.size(); i += 101) EXPECT_EQ(one.first[i], scene.intersect(rays[i]).t);
 }
 
+// A scene of one untransformed mesh skips the top level and the instance record (the mesh kept at
+// commit); a second instance far away sends the same rays through the top-level walk. Both answer
+// every query alike, bit for bit, rays naming the triangle they leave among them; after
+// replace_mesh and a commit the mesh traced is the new one.
+TEST(Scene, ASingleUntransformedMeshAnswersAsTheTopLevelWalkDoes) {
+  const MeshData m = uv_sphere(40, 80, 1.0f, 0.2f);
+  const MeshData far = triangle_soup(10, 0.1f, 5);
+  Scene alone, with_top;
+  alone.add_instance(alone.add_mesh(m.vertices, m.triangles), Mat4(1.0f));
+  with_top.add_instance(with_top.add_mesh(m.vertices, m.triangles), Mat4(1.0f));
+  with_top.add_instance(with_top.add_mesh(far.vertices, far.triangles),
+                        glm::translate(Mat4(1.0f), Vec3(1000.0f, 0.0f, 0.0f)));
+  alone.commit();
+  with_top.commit();
+  auto same = [](const Hit& a, const Hit& b) {
+    return a.t == b.t && a.u == b.u && a.v == b.v && a.prim == b.prim && a.instance == b.instance;
+  };
+  size_t hits = 0, named = 0;
+  for (const Ray& r : random_rays(20000, 2.0f, 29)) {
+    const Hit a = alone.intersect(r);
+    ASSERT_TRUE(same(a, with_top.intersect(r)));
+    ASSERT_EQ(alone.occluded(r), with_top.occluded(r));
+    EXPECT_EQ(alone.occluded(r), a.found());
+    if (!a.found()) continue;
+    ++hits;
+    EXPECT_EQ(a.instance, 0);
+    // From the hit on, naming the triangle left (as the renderer's rays do), onwards and back.
+    for (const float side : {1.0f, -1.0f}) {
+      const Ray leaving(r.org + a.t * r.dir, 0.0f, side * r.dir, kInfinity, {a.prim, 0});
+      const Hit c = alone.intersect(leaving);
+      ASSERT_TRUE(same(c, with_top.intersect(leaving)));
+      ASSERT_EQ(alone.occluded(leaving), with_top.occluded(leaving));
+      EXPECT_NE(c.prim, a.prim);
+      named += c.found();
+    }
+  }
+  EXPECT_GT(hits, 2000u);  // the test says something only if many rays hit, and go on to hit again
+  EXPECT_GT(named, 200u);
+
+  // The mesh replaced: after the commit, the ray finds the new geometry (a plane at z = 5).
+  const std::vector<Vec3> plane = {{-10, -10, 5}, {10, -10, 5}, {10, 10, 5}, {-10, 10, 5}};
+  alone.replace_mesh(0, plane, {{0u, 1u, 2u}, {0u, 2u, 3u}});
+  alone.commit();
+  const Hit h = alone.intersect(Ray(Vec3(0.0f), 0.0f, Vec3(0.0f, 0.0f, 1.0f), kInfinity));
+  EXPECT_EQ(h.t, 5.0f);
+  EXPECT_EQ(h.instance, 0);
+}
+
 TEST(Scene, DegenerateTrianglesAreLeftOutAndOthersKeepTheirIndices) {
   // The clean sphere's triangles with zero-area ones between them (two equal corners, or three
   // exactly collinear points), spread over several of the commit's 16384-triangle chunks. The
