@@ -3,8 +3,9 @@ swapped every round (old-new, then new-old), so a slow spell of this shared mach
 alike; the report is the median of the per-round speed ratios with its interquartile range, which
 says more than two medians taken apart. The machine's noise changes by the hour: an A/A run (one
 binary named twice) just before says how wide the range is at the moment (0.998-1.004 in a quiet
-spell, 5-15 % wide in a busy one; docs/trace-speed.md, thirty-eighth session). Both binaries must find the same hits (count
-and checksum; exit status 1 otherwise): a change meant to be faster must not change an answer.
+spell, 5-15 % wide in a busy one; docs/trace-speed.md, thirty-eighth session). Both binaries must
+find the same hits (count and checksum; exit status 1 otherwise): a change meant to be faster must
+not change an answer.
 
     cp build/bench/trace_only /tmp/trace_old     # before the change; rebuild, then:
     python3 bench/trace_ab.py /tmp/trace_old build/bench/trace_only --rounds 16 -- diffuse 71 30
