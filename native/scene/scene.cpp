@@ -416,6 +416,26 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+namespace {
+
+// An instance's mesh traced by a ray carried into its object space (org, dir): the triangle the
+// ray leaves skipped where the ray names it in instance `id`, the instance named on a hit.
+// identity: org and dir are the world ray's, whose finite components Scene::trace has checked.
+template <bool AnyHit>
+[[gnu::always_inline]] inline bool trace_mesh(const Mesh& mesh, uint32_t id, const Vec3& org, const Vec3& dir,
+                                              bool identity, const Ray& ray, float& t_max, Hit& hit) {
+  const int32_t skip = ray.self.instance == int32_t(id) ? ray.self.prim : kInvalidId;
+  if constexpr (AnyHit) {
+    return mesh.occluded(org, dir, ray.tnear, t_max, identity, skip);
+  } else {
+    if (!mesh.intersect(org, dir, ray.tnear, t_max, hit.u, hit.v, hit.prim, identity, skip)) return false;
+    hit.instance = int32_t(id);
+    return true;
+  }
+}
+
+}  // namespace
+
 template <bool AnyHit, bool ShadowCastersOnly, bool Visibility>
 [[gnu::always_inline]] inline bool Scene::trace_instance(uint32_t id, const Ray& ray, float& t_max, Hit& hit,
                                                          uint64_t blockers, uint8_t seen_by) const {
@@ -427,19 +447,9 @@ template <bool AnyHit, bool ShadowCastersOnly, bool Visibility>
     if (!(inst.visibility & seen_by)) return false;
   }
   const Mesh& mesh = *meshes_[inst.mesh];
-  Vec3 org = ray.org, dir = ray.dir;
-  if (!inst.identity) {
-    org = Vec3(inst.to_object * glm::vec4(org, 1.0f));
-    dir = glm::mat3(inst.to_object) * dir;
-  }
-  const int32_t skip = ray.self.instance == int32_t(id) ? ray.self.prim : kInvalidId;
-  if constexpr (AnyHit) {
-    return mesh.occluded(org, dir, ray.tnear, t_max, inst.identity, skip);
-  } else {
-    if (!mesh.intersect(org, dir, ray.tnear, t_max, hit.u, hit.v, hit.prim, inst.identity, skip)) return false;
-    hit.instance = int32_t(id);
-    return true;
-  }
+  if (inst.identity) return trace_mesh<AnyHit>(mesh, id, ray.org, ray.dir, true, ray, t_max, hit);
+  const Vec3 org(inst.to_object * glm::vec4(ray.org, 1.0f)), dir(glm::mat3(inst.to_object) * ray.dir);
+  return trace_mesh<AnyHit>(mesh, id, org, dir, false, ray, t_max, hit);
 }
 
 template <bool AnyHit, bool ShadowCastersOnly, bool Visibility>
@@ -450,22 +460,12 @@ bool Scene::trace(const Ray& ray, Hit& hit, uint64_t blockers, uint8_t seen_by) 
   // whose stack and registers made this path's every call set up a 1 KB frame (a diffuse ray at
   // 10K triangles: 1,052 -> 1,031 instructions, docs/trace-speed.md).
   float tfar = ray.tfar;
-  if constexpr (!ShadowCastersOnly && !Visibility) {
-    // Nor an instance record to read (its flags matter to the light-linking and visibility
-    // variants only, below): the mesh kept at commit, two dependent loads fewer a ray (10K
-    // triangles: camera rays 1 %, diffuse 2 %, shadow rays 4 % faster, docs/trace-speed.md,
-    // thirty-eighth session). As trace_instance with the identity transform.
-    const int32_t skip = ray.self.instance == 0 ? ray.self.prim : kInvalidId;
-    if constexpr (AnyHit) {
-      return single_mesh_->occluded(ray.org, ray.dir, ray.tnear, tfar, true, skip);
-    } else {
-      if (!single_mesh_->intersect(ray.org, ray.dir, ray.tnear, tfar, hit.u, hit.v, hit.prim, true, skip)) return false;
-      hit.instance = 0;
-      hit.t = tfar;
-      return true;
-    }
-  }
-  const bool found = trace_instance<AnyHit, ShadowCastersOnly, Visibility>(0, ray, tfar, hit, blockers, seen_by);
+  // Nor an instance record to read, but in the light-linking and visibility variants, which test
+  // its flags: the mesh kept at commit, two dependent loads fewer a ray (10K triangles: camera
+  // rays 1 %, diffuse 2 %, shadow rays 4 % faster, docs/trace-speed.md, thirty-eighth session).
+  const bool found = !ShadowCastersOnly && !Visibility
+                         ? trace_mesh<AnyHit>(*single_mesh_, 0, ray.org, ray.dir, true, ray, tfar, hit)
+                         : trace_instance<AnyHit, ShadowCastersOnly, Visibility>(0, ray, tfar, hit, blockers, seen_by);
   if (found) hit.t = tfar;
   return found;
 }
