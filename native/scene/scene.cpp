@@ -131,7 +131,7 @@ namespace {
 // tfar) are checked as one vector: every ray pays this, and one test per component was about 35
 // instructions a ray.
 bool is_traceable(const Ray& ray) {
-  static_assert(offsetof(Ray, self) == 8 * sizeof(float) && kWidth == 8, "Ray: origin, tnear, direction, tfar");
+  static_assert(kWidth == 8, "one lane for each of the ray's origin, tnear, direction and tfar floats");
   // Made from the fields, not copied from the ray's 32 bytes: a ray that RayBatch::at has just
   // written sits in the store queue as six smaller stores, which one 32-byte load cannot take
   // from there, so it waited for them to reach the cache (this and the batch loops' inlined
@@ -385,8 +385,7 @@ void Scene::build(const CommitOptions& options, const std::atomic<bool>* cancel)
     top_config.sah.max_leaf = 1;  // an instance test is a whole traversal: never group them
     top_ = build_bvh(BuilderKind::Sah, boxes.data(), boxes.size(), top_config);
     for (uint32_t& id : top_.prim_ids) id = placed[id];
-    single_identity_ = instances_.size() == 1 && instances_[0].identity;
-    single_mesh_ = single_identity_ ? meshes_[instances_[0].mesh].get() : nullptr;
+    single_mesh_ = instances_.size() == 1 && instances_[0].identity ? meshes_[instances_[0].mesh].get() : nullptr;
     all_cast_shadows_ =
         std::all_of(instances_.begin(), instances_.end(), [](const Instance& i) { return i.visible_shadow; });
     all_visible_ = std::all_of(instances_.begin(), instances_.end(),
@@ -455,7 +454,7 @@ template <bool AnyHit, bool ShadowCastersOnly, bool Visibility>
 template <bool AnyHit, bool ShadowCastersOnly, bool Visibility>
 bool Scene::trace(const Ray& ray, Hit& hit, uint64_t blockers, uint8_t seen_by) const {
   if (!is_traceable(ray)) return false;
-  if (!single_identity_) return trace_instances<AnyHit, ShadowCastersOnly, Visibility>(ray, hit, blockers, seen_by);
+  if (!single_mesh_) return trace_instances<AnyHit, ShadowCastersOnly, Visibility>(ray, hit, blockers, seen_by);
   // One untransformed instance (a single mesh): no top level. Kept apart from the top-level walk,
   // whose stack and registers made this path's every call set up a 1 KB frame (a diffuse ray at
   // 10K triangles: 1,052 -> 1,031 instructions, docs/trace-speed.md).

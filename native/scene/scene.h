@@ -318,10 +318,11 @@ class Scene {
   // for the instance's box. Not in Instance, whose array the top-level walk reads per ray.
   std::vector<TransformError> transform_errors_;
   float origin_pad_factor_ = 0.0f;
-  bool single_identity_ = false;       // one untransformed instance: skip the top level
-  const Mesh* single_mesh_ = nullptr;  // that instance's mesh (single_identity_)
-  bool all_cast_shadows_ = true;       // no instance with visible_shadow off: shadowed() is occluded()
-  bool all_visible_ = true;            // every instance seen by every path ray: intersect(ray, kinds) is intersect(ray)
+  // The mesh of the scene's one instance when it is untransformed (trace() skips the top level
+  // and the instance record), else null.
+  const Mesh* single_mesh_ = nullptr;
+  bool all_cast_shadows_ = true;  // no instance with visible_shadow off: shadowed() is occluded()
+  bool all_visible_ = true;       // every instance seen by every path ray: intersect(ray, kinds) is intersect(ray)
   bool committed_ = false;
   CommitStats stats_;
 };
