@@ -4,7 +4,7 @@ what a shared machine does to both; this runs the two binaries in turn, the orde
 round (old-new, then new-old), and reports each row's median ratio under either build. Where a
 change acts through memory (a 1M- or 4M-triangle mesh, beyond the caches), single trace_only runs
 (bench/trace_ab.py) moved with the machine's memory traffic more than the change moved them; the
-ratio to Embree did not (docs/trace-speed.md, thirty-ninth session).
+ratio to Embree moved much less (docs/trace-speed.md, thirty-ninth session).
 
     cp build/bench/bench_trace /tmp/bench_trace_old     # before the change; rebuild, then:
     python3 bench/bench_trace_ab.py /tmp/bench_trace_old build/bench/bench_trace --only "1.0M triangles"
