@@ -11,6 +11,7 @@
 #endif
 
 #include <cstring>
+#include <utility>
 
 namespace toyrt {
 
@@ -130,8 +131,9 @@ struct WideSlabTest {
 // is entered or stacked (prefetch_leaf(first, count)): a mesh's triangle blocks missed the cache
 // on most leaves of a large mesh. Diffuse rays at 1M triangles on a first-generation EPYC: 5-6 %
 // faster; 1 % when only the stacked leaves were fetched (all of a block's lines requested at
-// once beat the block test's own loads). The any-hit walk measured no gain. Callers without
-// one get this.
+// once beat the block test's own loads). The any-hit walk, whose leaves' blocks fetched when
+// stacked measured no gain, requests a leaf's block one step before testing it where the blocks
+// are far beyond the caches (any_hit_wide<true>). Callers without one get this.
 struct NoLeafPrefetch {
   void operator()(uint32_t, uint32_t) const {}
 };
@@ -165,18 +167,19 @@ inline constexpr DescendingSlots kDescendingSlots{};
 // The any-hit walk: children entered in slot order, which collapse() makes decreasing box area
 // (the likeliest blockers first), no distances kept (any hit ends the walk, so nothing is pruned
 // by distance). Stacks of child and count side by side, so that a node's other children are
-// stacked by two vector stores.
-template <class LeafFn>
+// stacked by two vector stores. With kOverlapLeaves, a leaf in flight (below).
+template <bool kOverlapLeaves = false, class LeafFn, class PrefetchLeaf = NoLeafPrefetch>
 [[gnu::always_inline]] inline bool any_hit_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear, float tfar,
-                                                LeafFn&& leaf) {
+                                                LeafFn&& leaf, PrefetchLeaf&& prefetch_leaf = {}) {
   using namespace simd;
   if (bvh.nodes.empty()) return bvh.root_leaf_count && leaf(bvh.root_leaf_first, bvh.root_leaf_count, tfar);
 
   const WideSlabTest slab(ray, tnear);
   const vfloat end = splat(tfar);  // an any-hit walk never shortens its segment
 
-  // kWidth - 1 a level at most, and room for a whole vector store at the top.
-  constexpr int kStack = (kWidth - 1) * kMaxBvhDepth + kWidth;
+  // kWidth - 1 a level at most, and room for a whole vector store at the top; one more for a
+  // chosen child waiting while the leaf in flight is tested (kOverlapLeaves).
+  constexpr int kStack = (kWidth - 1) * kMaxBvhDepth + kWidth + int(kOverlapLeaves);
   uint32_t stack_child[kStack], stack_count[kStack];
   int sp = 0;
   // Stacks the slots `slots` of node `n`, highest first.
@@ -209,35 +212,105 @@ template <class LeafFn>
   // blocks (a wall beside a dense model) the stacking would be wasted.
   const WideNode* deferred_node = nullptr;
   uint32_t deferred = 0;
-  for (;;) {
-    if (count == 0) {
-      const WideNode& n = bvh.nodes[child];
-      vfloat tmin;
-      const uint32_t mask = slab.enter(n, end, tmin);
-      if (mask != 0) {
+  if constexpr (kOverlapLeaves) {
+    // kOverlapLeaves: one leaf in flight. A leaf reached is requested and tested one step later,
+    // after the next node visit or once the next leaf has been requested, so that its block's lines
+    // arrive meanwhile. But a leaf that one of a ray's first two visits enters first is tested at
+    // once, as in the plain walk: the top of the tree is reached by most rays and stays cached, and
+    // its leaves are the likeliest blockers (a room's walls: put in flight, 29 % of the closed room's
+    // shadow rays visited a node of the model before the wall that blocked them). One call of `leaf`
+    // in the loop, reached by jumps: with four, the block test inlined at each, the walk's code doubled.
+    uint32_t pending_child = 0, pending_count = 0;
+    bool at_once = false;
+    int visits = 0;
+    for (;;) {
+      if (count == 0) {
+        const bool near_top = ++visits <= 2;
+        const WideNode& n = bvh.nodes[child];
+        vfloat tmin;
+        const uint32_t mask = slab.enter(n, end, tmin);
+        if (mask == 0) {
+          if (pending_count != 0) goto test_pending;
+          goto pop;
+        }
         const int first = __builtin_ctz(mask);
         const uint32_t rest = mask & (mask - 1);
         child = n.child[first];
         count = n.count[first];
-        if (count != 0) {
+        if (count != 0 && near_top) {
           deferred_node = &n;
           deferred = rest;
+          at_once = true;
         } else if (rest != 0) {
           push(n, rest);
         }
+        if (pending_count != 0) {
+          // The chosen child waits on the stack while the leaf in flight is tested.
+          stack_child[sp] = child;
+          stack_count[sp++] = count;
+          goto test_pending;
+        }
         continue;
       }
-    } else {
+      if (!at_once) {
+        prefetch_leaf(child, count);
+        std::swap(child, pending_child);
+        std::swap(count, pending_count);
+        if (count == 0) goto pop;  // nothing was in flight
+      }
+    test:
       if (leaf(child, count, tfar)) return true;
+      at_once = false;
       if (deferred != 0) {
         push(*deferred_node, deferred);
         deferred = 0;
       }
+    pop:
+      if (sp == 0) {
+        if (pending_count != 0) goto test_pending;
+        return false;
+      }
+      --sp;
+      child = stack_child[sp];
+      count = stack_count[sp];
+      continue;
+    test_pending:
+      child = pending_child;
+      count = pending_count;
+      pending_count = 0;
+      goto test;
     }
-    if (sp == 0) return false;
-    --sp;
-    child = stack_child[sp];
-    count = stack_count[sp];
+  } else {
+    for (;;) {
+      if (count == 0) {
+        const WideNode& n = bvh.nodes[child];
+        vfloat tmin;
+        const uint32_t mask = slab.enter(n, end, tmin);
+        if (mask != 0) {
+          const int first = __builtin_ctz(mask);
+          const uint32_t rest = mask & (mask - 1);
+          child = n.child[first];
+          count = n.count[first];
+          if (count != 0) {
+            deferred_node = &n;
+            deferred = rest;
+          } else if (rest != 0) {
+            push(n, rest);
+          }
+          continue;
+        }
+      } else {
+        if (leaf(child, count, tfar)) return true;
+        if (deferred != 0) {
+          push(*deferred_node, deferred);
+          deferred = 0;
+        }
+      }
+      if (sp == 0) return false;
+      --sp;
+      child = stack_child[sp];
+      count = stack_count[sp];
+    }
   }
 }
 
@@ -393,12 +466,13 @@ template <bool kOverlapLeaves = false, class LeafFn, class PrefetchLeaf = NoLeaf
 }
 
 // Both walks behind one name: AnyHit stops at the first hit (occlusion), else the nearest
-// (kOverlapLeaves: see closest_hit_wide; the any-hit walk has no nearest leaf to wait for).
+// (kOverlapLeaves: a leaf's block requested ahead of its test, in each walk its own way: see
+// closest_hit_wide and any_hit_wide).
 template <bool AnyHit, bool kOverlapLeaves = false, class LeafFn, class PrefetchLeaf = NoLeafPrefetch>
 [[gnu::always_inline]] inline bool traverse_wide(const WideBvh& bvh, const RayBoxData& ray, float tnear, float& tfar,
                                                  LeafFn&& leaf, PrefetchLeaf&& prefetch_leaf = {}) {
   if constexpr (AnyHit)
-    return any_hit_wide(bvh, ray, tnear, tfar, leaf);
+    return any_hit_wide<kOverlapLeaves>(bvh, ray, tnear, tfar, leaf, prefetch_leaf);
   else
     return closest_hit_wide<kOverlapLeaves>(bvh, ray, tnear, tfar, leaf, prefetch_leaf);
 }

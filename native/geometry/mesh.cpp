@@ -172,7 +172,7 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
     first_block[i] = block_count;
     for (int k = 0; k < kWidth; ++k) block_count += blocks_of(wide_.nodes[i].count[k]);
   }
-  prefetch_blocks_ = false;  // until the blocks are made
+  prefetch_blocks_ = leaf_in_flight_ = false;  // until the blocks are made
   blocks_.clear();
   blocks_.shrink_to_fit();
   blocks_.resize(block_count);  // exactly, and not zeroed (HugePageAllocator): every field is written below
@@ -280,6 +280,7 @@ void Mesh::finish(WideBuild built, const UninitializedArray<uint32_t>& valid) {
   // Blocks beyond the caches are fetched ahead by the closest-hit walk; where they fit, the
   // prefetches were pure cost (1-3 % slower at 10K and 100K triangles, 3-8 % faster at 1M).
   prefetch_blocks_ = beyond_caches;
+  leaf_in_flight_ = blocks_.size() * sizeof(TriangleBlock) > kLeafInFlightBlockBytes;
   built_ = true;
 }
 
@@ -363,6 +364,11 @@ bool Mesh::intersect(const Vec3& org, const Vec3& dir, float tnear, float& tfar,
 bool Mesh::occluded(const Vec3& org, const Vec3& dir, float tnear, float tfar, bool ray_checked, int32_t skip) const {
   float u, v;
   int32_t prim;
+  // Where the blocks are far beyond the caches, the any-hit walk keeps a leaf in flight
+  // (any_hit_wide's kOverlapLeaves).
+  if (leaf_in_flight_)
+    return skip == kInvalidId ? trace<true, false, true>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip)
+                              : trace<true, true, true>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip);
   return skip == kInvalidId ? trace<true, false, false>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip)
                             : trace<true, true, false>(org, dir, tnear, tfar, u, v, prim, ray_checked, skip);
 }

@@ -82,9 +82,17 @@ class Mesh {
   // finish() writes them past the caches, the closest-hit walk prefetches each leaf's block, and
   // intersect() takes the walk that visits a stacked node while the nearest leaf's block arrives.
   static constexpr size_t kPrefetchBlockBytes = size_t(16) << 20;
+  // The blocks' size beyond which occluded() takes the any-hit walk that keeps one leaf in flight
+  // (any_hit_wide<true>). Where most blocks miss even the last level it pays: shadow rays through
+  // a 4M-triangle sphere's 200 MB of blocks, unoccluded 9-11 % faster, occluded 1-3 %. Where the
+  // last level (32 MB on the Zen 4 measured) still holds much of them it does not: the 1M sphere's
+  // 50 MB, unoccluded unchanged, occluded 6-7 % slower, and the closed room's wall-blocked rays 9-16 %
+  // (docs/trace-speed.md, fortieth session).
+  static constexpr size_t kLeafInFlightBlockBytes = size_t(128) << 20;
 
  private:
   bool prefetch_blocks_ = false;  // the blocks exceed kPrefetchBlockBytes (finish())
+  bool leaf_in_flight_ = false;   // the blocks exceed kLeafInFlightBlockBytes (finish())
 };
 
 }  // namespace toyrt

@@ -157,12 +157,14 @@ TEST(Mesh, EverySlotBoxIsItsTrianglesExactBoundsAndSlotsAreInAnyHitOrder) {
   }
 }
 
-TEST(Mesh, RaysFindTheNearestTriangleWhereTheBlocksAreBeyondTheCaches) {
+TEST(Mesh, RaysFindTheNearestTriangleAndOccludersWhereTheBlocksAreBeyondTheCaches) {
   // Blocks beyond kPrefetchBlockBytes take the closest-hit walk that visits a stacked node while
   // the nearest leaf's block arrives (closest_hit_wide<true>): every ray must still find a nearest
   // triangle, the one a loop over all triangles finds (or one at the same distance, where the ray
   // meets an edge or vertex); and, naming that triangle as the one it leaves (Ray::self), the
-  // nearest of the others.
+  // nearest of the others. Occlusion takes the any-hit walk with a leaf in flight
+  // (any_hit_wide<true>): a segment just past that nearest distance is blocked, one just short of
+  // it is not.
   const MeshData m = uv_sphere(400, 700, 1.0f, 0.1f);
   Mesh mesh(m.vertices, m.triangles);
   mesh.build(BuilderKind::Sah, BuildConfig{});
@@ -195,6 +197,11 @@ TEST(Mesh, RaysFindTheNearestTriangleWhereTheBlocksAreBeyondTheCaches) {
       int32_t prim = -1;
       const bool found = mesh.intersect(org, dir, 0.0f, tfar, u, v, prim, false, skip);
       ASSERT_EQ(found, nearest < kInfinity) << "ray " << k << " pass " << pass;
+      ASSERT_EQ(mesh.occluded(org, dir, 0.0f, found ? nearest * 1.0001f : kInfinity, false, skip), found)
+          << "ray " << k << " pass " << pass;
+      if (found) {
+        ASSERT_FALSE(mesh.occluded(org, dir, 0.0f, nearest * 0.9999f, false, skip)) << "ray " << k;
+      }
       if (!found) break;
       hits += pass == 0;
       ASSERT_NE(prim, skip);

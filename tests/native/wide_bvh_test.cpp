@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <random>
 #include <type_traits>
@@ -251,4 +252,90 @@ TEST(WideTraverse, OverlappedLeafFetchesTestTheSameLeavesInTheSameOrder) {
   EXPECT_GT(rays_through_several_leaves, rays / 2);
   EXPECT_GT(hits, rays / 4);
   EXPECT_GT(overlapped, rays / 20);
+}
+
+// any_hit_wide<true> keeps one leaf in flight: a leaf reached is requested (prefetch_leaf) and
+// tested one step later, but for a leaf that a ray's first two visits (the root and one of its
+// children) enter first. Its answer must be the plain walk's and a loop over every triangle's, on
+// segments short enough that some rays are blocked and others not; a ray nothing blocks must test
+// the same leaves as the plain walk, each once, each after its request but for those near the top.
+TEST(WideTraverse, AnyHitWithALeafInFlightGivesThePlainWalksAnswer) {
+  size_t rays = 0, blocked = 0, open_through_several_leaves = 0, with_leaves_in_flight = 0;
+  for (const MeshData& m : varied_meshes()) {
+    const Bvh bvh = sah_tree(m);
+    const WideBvh wide = collapse(bvh, kLeaf, CollapseMethod::Sah);
+    // Leaves the walk may test without a request: the root's, and its child nodes'.
+    std::vector<int64_t> near_top;
+    if (wide.nodes.empty()) near_top.push_back(wide.root_leaf_first);  // one leaf: tested at once
+    for (int i = 0; i < kWidth && !wide.nodes.empty(); ++i) {
+      const WideNode& root = wide.nodes[0];
+      if (!root.used(i)) continue;
+      if (root.count[i] != 0) {
+        near_top.push_back(root.child[i]);
+        continue;
+      }
+      const WideNode& n = wide.nodes[root.child[i]];
+      for (int j = 0; j < kWidth; ++j)
+        if (n.used(j) && n.count[j] != 0) near_top.push_back(n.child[j]);
+    }
+    const BBox box = bounds_of(m);
+    std::mt19937 rng(12);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    auto point_in = [&](float spread) {
+      const Vec3 r(unit(rng), unit(rng), unit(rng));
+      return box.center() + (r - 0.5f) * box.extent() * spread;
+    };
+    for (int k = 0; k < 2000; ++k) {
+      const Vec3 org = point_in(3.0f), dir = point_in(1.0f) - org;
+      const float tfar = 2.0f * unit(rng);  // the far point lies from the origin to twice as far as the box's inside
+      const WatertightRay tri_ray = make_watertight_ray(org, dir);
+      auto hits_triangle = [&](uint32_t prim) {
+        const Triangle& tri = m.triangles[prim];
+        float t, u, v;
+        return intersect_triangle(tri_ray, m.vertices[tri[0]], m.vertices[tri[1]], m.vertices[tri[2]], 0.0f, tfar, t, u,
+                                  v);
+      };
+      // calls: a leaf tested as its first slot, a leaf requested as -1 - its first slot
+      auto walk = [&](auto overlap, std::vector<int64_t>& calls) {
+        return any_hit_wide<decltype(overlap)::value>(
+            wide, make_ray_box_data(org, dir), 0.0f, tfar,
+            [&](uint32_t first, uint32_t count, float) {
+              calls.push_back(first);
+              for (uint32_t j = first; j < first + count; ++j)
+                if (hits_triangle(bvh.prim_ids[j])) return true;
+              return false;
+            },
+            [&](uint32_t first, uint32_t) { calls.push_back(-1 - int64_t(first)); });
+      };
+      bool expected = false;
+      for (uint32_t i = 0; i < m.triangles.size() && !expected; ++i) expected = hits_triangle(i);
+      std::vector<int64_t> plain_calls, in_flight_calls;
+      ASSERT_EQ(walk(std::false_type{}, plain_calls), expected) << "ray " << k;
+      ASSERT_EQ(walk(std::true_type{}, in_flight_calls), expected) << "ray " << k;
+      ++rays;
+      blocked += expected;
+      if (expected) continue;
+      std::vector<int64_t> tested, requested;
+      for (int64_t c : in_flight_calls) {
+        if (c < 0) {
+          requested.push_back(-1 - c);
+        } else {
+          const bool at_top = std::find(near_top.begin(), near_top.end(), c) != near_top.end();
+          ASSERT_TRUE(at_top || std::find(requested.begin(), requested.end(), c) != requested.end())
+              << "tested before its request, ray " << k;
+          tested.push_back(c);
+        }
+      }
+      std::sort(tested.begin(), tested.end());
+      ASSERT_EQ(std::adjacent_find(tested.begin(), tested.end()), tested.end()) << "a leaf tested twice, ray " << k;
+      std::sort(plain_calls.begin(), plain_calls.end());
+      ASSERT_EQ(tested, plain_calls) << "ray " << k;
+      open_through_several_leaves += tested.size() > 1;
+      with_leaves_in_flight += !requested.empty();
+    }
+  }
+  EXPECT_GT(blocked, rays / 10);
+  EXPECT_LT(blocked, rays * 9 / 10);
+  EXPECT_GT(open_through_several_leaves, rays / 10);
+  EXPECT_GT(with_leaves_in_flight, rays / 10);
 }
