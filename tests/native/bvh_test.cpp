@@ -213,6 +213,44 @@ TEST(Mesh, RaysFindTheNearestTriangleAndOccludersWhereTheBlocksAreBeyondTheCache
   EXPECT_GT(hits, 20);
 }
 
+TEST(Mesh, OccludersMatchTheNearestHitWhereALeafIsKeptInFlight) {
+  // Blocks beyond kLeafInFlightBlockBytes take the any-hit walk that tests each leaf a step after
+  // requesting it (any_hit_wide<true>): a segment just past a ray's nearest hit (the closest-hit
+  // walk's, which the test above checks against every triangle) is blocked, one just short of it
+  // is not, with and without the triangle the ray leaves named.
+  const MeshData m = uv_sphere(1200, 1200, 1.0f, 0.1f);
+  Mesh mesh(m.vertices, m.triangles);
+  mesh.build(BuilderKind::Sah, BuildConfig{});
+  ASSERT_GT(mesh.blocks().size() * sizeof(TriangleBlock), Mesh::kLeafInFlightBlockBytes);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  int hits = 0, misses = 0;
+  for (int k = 0; k < 400; ++k) {
+    const Vec3 org = 3.0f * glm::normalize(Vec3(unit(rng), unit(rng), unit(rng)));
+    const Vec3 dir = 1.5f * Vec3(unit(rng), unit(rng), unit(rng)) - org;
+    float tfar = kInfinity, u, v;
+    int32_t prim = -1;
+    if (!mesh.intersect(org, dir, 0.0f, tfar, u, v, prim)) {
+      ++misses;
+      ASSERT_FALSE(mesh.occluded(org, dir, 0.0f, kInfinity)) << "ray " << k;
+      continue;
+    }
+    ++hits;
+    ASSERT_TRUE(mesh.occluded(org, dir, 0.0f, tfar * 1.0001f)) << "ray " << k;
+    ASSERT_FALSE(mesh.occluded(org, dir, 0.0f, tfar * 0.9999f)) << "ray " << k;
+    // Leaving the hit triangle towards the far side of the sphere: the next hit blocks it.
+    float next = kInfinity;
+    const int32_t first = prim;
+    const bool again = mesh.intersect(org, dir, 0.0f, next, u, v, prim, false, first);
+    ASSERT_EQ(mesh.occluded(org, dir, 0.0f, again ? next * 1.0001f : kInfinity, false, first), again) << "ray " << k;
+    if (again) {
+      ASSERT_FALSE(mesh.occluded(org, dir, 0.0f, next * 0.9999f, false, first)) << "ray " << k;
+    }
+  }
+  EXPECT_GT(hits, 100);
+  EXPECT_GT(misses, 20);
+}
+
 TEST(BinnedSahBuilder, CoincidentCentroidsStayShallow) {
   // 100,000 copies of one triangle: no plane separates them; splits must still halve the range.
   MeshData m;
