@@ -84,9 +84,9 @@ class Mesh {
   static constexpr size_t kPrefetchBlockBytes = size_t(16) << 20;
   // The blocks' size beyond which occluded() takes the any-hit walk that keeps one leaf in flight
   // (any_hit_wide<true>). Where most blocks miss even the last level it pays: shadow rays through
-  // a 4M-triangle sphere's 200 MB of blocks, unoccluded 9-11 % faster, occluded 1-3 %. Where the
-  // last level (32 MB on the Zen 4 measured) still holds much of them it does not: the 1M sphere's
-  // 50 MB, unoccluded unchanged, occluded 6-7 % slower, and the closed room's wall-blocked rays 9-16 %
+  // a 4M-triangle sphere's 200 MB of blocks, unoccluded 3-7 % faster, occluded 2 %. Where the last
+  // level (32 MB on the Zen 4 measured) still holds much of them it did not: the 1M sphere's 50 MB,
+  // unoccluded unchanged, occluded 6-7 % slower, and the closed room's wall-blocked rays 9-16 %
   // (docs/trace-speed.md, fortieth session).
   static constexpr size_t kLeafInFlightBlockBytes = size_t(128) << 20;
 
