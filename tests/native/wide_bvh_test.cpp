@@ -287,7 +287,9 @@ TEST(WideTraverse, AnyHitWithALeafInFlightGivesThePlainWalksAnswer) {
     };
     for (int k = 0; k < 2000; ++k) {
       const Vec3 org = point_in(3.0f), dir = point_in(1.0f) - org;
-      const float tfar = 2.0f * unit(rng);  // the far point lies from the origin to twice as far as the box's inside
+      // The segment ends anywhere from the origin to twice as far as the point inside the box that
+      // dir aims at, so some rays are blocked and others are not.
+      const float tfar = 2.0f * unit(rng);
       const WatertightRay tri_ray = make_watertight_ray(org, dir);
       auto hits_triangle = [&](uint32_t prim) {
         const Triangle& tri = m.triangles[prim];
