@@ -21,8 +21,11 @@
 //                                             (lbvh-all and sah-all: TOYRT_THREADS=N runs both
 //                                             engines on N threads, as bench_trace's rows;
 //                                             TOYRT_IDLE_US=N sleeps N us before each timed one)
-//   trace_only wide [rings]   the 8-wide layout of the SAH and LBVH trees, collapsed greedily and
-//                             by the SAH dynamic programme: children a node, SAH cost, collapse ms
+//   trace_only wide [rings] [repeats] [soup]   the 8-wide layout of the SAH and LBVH trees, collapsed
+//                             greedily and by the SAH dynamic programme: children a node, SAH cost,
+//                             collapse ms, and the cost on Embree's own metric (below), to set beside
+//                             the figure Embree prints for its tree with
+//                             `TOYRT_EMBREE_CONFIG=verbose=2 trace_only shadow [rings] 1 embree`
 #include "accel/binned_sah_builder.h"
 #include "accel/lbvh_builder.h"
 #include "accel/morton_wide_builder.h"
@@ -43,6 +46,42 @@
 
 using namespace toyrt;
 using namespace toyrt::testing;
+
+namespace {
+
+// A wide tree's expected cost on the metric Embree's statistics print (verbose=2): the areas of
+// every node's box and of every leaf's box times its 4-triangle blocks, over the root's. TOYRT's
+// leaves are tested eight triangles at a time, so its blocks term is given too.
+struct EmbreeMetric {
+  double nodes = 1.0;  // the root
+  double blocks_of_4 = 0.0, blocks_of_8 = 0.0;
+  double triangles_a_leaf = 0.0;
+};
+EmbreeMetric embree_metric(const WideBvh& wide) {
+  EmbreeMetric m;
+  if (wide.nodes.empty()) return m;
+  BBox root;
+  for (int i = 0; i < kWidth; ++i)
+    if (wide.nodes[0].used(i)) root.extend(wide.nodes[0].box(i));
+  size_t leaves = 0, triangles = 0;
+  for (const WideNode& n : wide.nodes)
+    for (int i = 0; i < kWidth; ++i) {
+      if (!n.used(i)) continue;
+      const double p = double(n.box(i).half_area()) / double(root.half_area());
+      if (n.count[i] == 0) {
+        m.nodes += p;
+        continue;
+      }
+      m.blocks_of_4 += p * double((n.count[i] + 3) / 4);
+      m.blocks_of_8 += p * double((n.count[i] + kBlockWidth - 1) / kBlockWidth);
+      ++leaves;
+      triangles += n.count[i];
+    }
+  m.triangles_a_leaf = double(triangles) / double(leaves);
+  return m;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   bench::keep_freed_memory();
@@ -136,11 +175,14 @@ int main(int argc, char** argv) {
         }
         std::sort(ms.begin(), ms.end());
         const WideStats st = wide_stats(wide, kBlockWidth);
+        const EmbreeMetric em = embree_metric(wide);
         std::printf(
             "wide: %zu triangles, %s tree, %s collapse: %zu nodes, %.2f children a node, SAH cost %.2f, "
-            "collapse %.1f ms (median of 3)\n",
+            "collapse %.1f ms (median of 3); Embree's metric %.2f (nodes %.2f, leaves %.2f in blocks of 4, "
+            "%.2f in blocks of 8; %.2f triangles a leaf)\n",
             mesh.triangles.size(), t ? "LBVH" : "SAH", method == CollapseMethod::Sah ? "DP" : "greedy", st.nodes,
-            st.children_per_node, st.sah_cost, ms[1]);
+            st.children_per_node, st.sah_cost, ms[1], em.nodes + em.blocks_of_4, em.nodes, em.blocks_of_4,
+            em.blocks_of_8, em.triangles_a_leaf);
       }
     // The kernels' radix tree collapsed where it lies, as the LBVH commit does (held in host
     // memory here, so each run times the collapse alone): medians of `repeats` runs.

@@ -81,6 +81,14 @@ void check_structure(const WideBvh& wide, const Bvh& bvh, uint32_t leaf_size) {
   for (size_t k = 0; k < node_seen.size(); ++k) ASSERT_EQ(node_seen[k], 1) << "wide node " << k;
 }
 
+// A random point of `box` scaled about its centre by `spread`: the walk tests' rays start in a box
+// three times the mesh's and aim at a point inside it.
+Vec3 point_in(const BBox& box, float spread, std::mt19937& rng) {
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  const Vec3 r(unit(rng), unit(rng), unit(rng));
+  return box.center() + (r - 0.5f) * box.extent() * spread;
+}
+
 }  // namespace
 
 TEST(WideBvh, EveryPrimitiveInExactlyOneLeafAndEveryNodeReachedOnce) {
@@ -197,13 +205,8 @@ TEST(WideTraverse, OverlappedLeafFetchesTestTheSameLeavesInTheSameOrder) {
     const WideBvh wide = collapse(bvh, kLeaf, CollapseMethod::Sah);
     const BBox box = bounds_of(m);
     std::mt19937 rng(11);
-    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-    auto point_in = [&](float spread) {
-      const Vec3 r(unit(rng), unit(rng), unit(rng));
-      return box.center() + (r - 0.5f) * box.extent() * spread;
-    };
     for (int k = 0; k < 2000; ++k) {
-      const Vec3 org = point_in(3.0f), dir = point_in(1.0f) - org;
+      const Vec3 org = point_in(box, 3.0f, rng), dir = point_in(box, 1.0f, rng) - org;
       const WatertightRay tri_ray = make_watertight_ray(org, dir);
       // calls: a leaf tested as its first slot, a leaf requested as -1 - its first slot
       auto walk = [&](auto overlap, std::vector<int64_t>& calls, int64_t& prim) {
@@ -281,12 +284,8 @@ TEST(WideTraverse, AnyHitWithALeafInFlightGivesThePlainWalksAnswer) {
     const BBox box = bounds_of(m);
     std::mt19937 rng(12);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-    auto point_in = [&](float spread) {
-      const Vec3 r(unit(rng), unit(rng), unit(rng));
-      return box.center() + (r - 0.5f) * box.extent() * spread;
-    };
     for (int k = 0; k < 2000; ++k) {
-      const Vec3 org = point_in(3.0f), dir = point_in(1.0f) - org;
+      const Vec3 org = point_in(box, 3.0f, rng), dir = point_in(box, 1.0f, rng) - org;
       // The segment ends anywhere from the origin to twice as far as the point inside the box that
       // dir aims at, so some rays are blocked and others are not.
       const float tfar = 2.0f * unit(rng);

@@ -1,6 +1,7 @@
 #include "embree_oracle.h"
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -9,7 +10,10 @@ namespace toyrt::testing {
 
 EmbreeScene::EmbreeScene(const std::vector<Vec3>& vertices, const std::vector<Triangle>& triangles, bool robust,
                          int threads, bool morton, bool count_memory) {
-  const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
+  std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
+  // TOYRT_EMBREE_CONFIG: more of Embree's device settings, for a look inside (verbose=2 prints
+  // its tree's statistics: bench/trace_only.cpp's `wide` mode sets TOYRT's beside them).
+  if (const char* more = std::getenv("TOYRT_EMBREE_CONFIG")) config += (config.empty() ? "" : ",") + std::string(more);
   device_ = rtcNewDevice(config.c_str());
   if (!device_) throw std::runtime_error("Embree: cannot create a device");
   // Counts every allocation and release (from any of the build's threads).
