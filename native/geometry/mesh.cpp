@@ -307,8 +307,8 @@ bool Mesh::trace(const Vec3& org, const Vec3& dir, float tnear, float& tfar, flo
         bool hit = false;
         const uint32_t end = first + (count + kBlockWidth - 1) / kBlockWidth;
         for (uint32_t k = first; k < end; ++k) {
-          hit |=
-              intersect_block<AnyHit, kSkip>(tri_ray, block_ray, blocks[k], tnear, t_max, skip, [&](int lane, float t) {
+          hit |= intersect_block<AnyHit, kSkip>(
+              tri_ray, block_ray, blocks[k], tnear, t_max, skip, [&](int lane, float t) __attribute__((always_inline)) {
                 // The nearest so far; and the first this walk finds even where its float distance
                 // only ties t_max (the block test put it before t_max in the scaled domain; t_max
                 // stays, and the end below keeps t < tfar). Without that, a mesh reported such a

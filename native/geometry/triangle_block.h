@@ -67,6 +67,35 @@ inline BlockRay make_block_ray(const WatertightRay& r) {
           size_t(r.kz) * sizeof(float) * kBlockWidth};
 }
 
+// The lanes the vector test leaves to the scalar one, one at a time: `near_start` lanes take the
+// double-precision distance of a crossing too close to tnear for float, `scalar` lanes (an exact
+// zero edge function) the whole scalar test. Writes each hit lane's distance to t and returns the
+// lanes hit; with AnyHit it stops at the first. Out of line and given no callback: as a lambda
+// calling the caller's `hit` (which GCC called out of line), the hot path built that callback's
+// closure in memory at every block tested, rare lanes or not (ten moves a block).
+template <bool AnyHit>
+[[gnu::noinline, gnu::cold]] inline uint32_t rare_lanes(const WatertightRay& r, const TriangleBlock& b,
+                                                        uint32_t near_start, uint32_t scalar, float tnear, float tfar,
+                                                        float t[kBlockWidth]) {
+  uint32_t hits = 0;
+  float u, v;
+  for (uint32_t m = near_start; m; m &= m - 1) {
+    const int lane = __builtin_ctz(m);
+    if (near_start_in_double(r, b.vertex(lane, 0), b.vertex(lane, 1), b.vertex(lane, 2), tnear, tfar, t[lane], u, v)) {
+      hits |= 1u << lane;
+      if constexpr (AnyHit) return hits;
+    }
+  }
+  for (uint32_t m = scalar; m; m &= m - 1) {
+    const int lane = __builtin_ctz(m);
+    if (intersect_triangle(r, b.vertex(lane, 0), b.vertex(lane, 1), b.vertex(lane, 2), tnear, tfar, t[lane], u, v)) {
+      hits |= 1u << lane;
+      if constexpr (AnyHit) return hits;
+    }
+  }
+  return hits;
+}
+
 // Tests the block's triangles against [tnear, tfar). For each lane hit, hit(lane, t) is called
 // (nearest lanes are not sorted; the caller keeps the minimum); with AnyHit the first ends it.
 // With kSkip, the triangle `skip` (the one the ray leaves) is never hit. Returns whether any lane
@@ -149,24 +178,18 @@ template <bool AnyHit, bool kSkip, class OnHit>
       if constexpr (AnyHit) return true;
     }
   }
-  // The rare lanes, one at a time: `test` is the double-precision distance or the whole scalar
-  // test. Returns whether an any-hit query is over.
-  auto lane_by_lane = [&](uint32_t lanes, auto&& test) {
-    for (uint32_t m = lanes; m; m &= m - 1) {
-      const int lane = __builtin_ctz(m);
-      float t, u, v;
-      if (test(r, b.vertex(lane, 0), b.vertex(lane, 1), b.vertex(lane, 2), tnear, tfar, t, u, v)) {
-        hit(lane, t);
+  if (__builtin_expect((near_start | scalar) != 0, 0)) {
+    float rare_t[kBlockWidth];
+    const uint32_t rare_hits = rare_lanes<AnyHit>(r, b, near_start, scalar, tnear, tfar, rare_t);
+    // The near-start lanes first, then the scalar ones: the order in which they were tested.
+    for (const uint32_t lanes : {rare_hits & near_start, rare_hits & scalar})
+      for (uint32_t m = lanes; m; m &= m - 1) {
+        const int lane = __builtin_ctz(m);
+        hit(lane, rare_t[lane]);
         any = true;
         if constexpr (AnyHit) return true;
       }
-    }
-    return false;
-  };
-  // intersect_triangle through a lambda: as a function pointer it is an indirect call, which GCC
-  // cannot inline (always_inline) below -O2, and Debug and -O1 builds failed to compile.
-  const auto whole_test = [](auto&&... args) { return intersect_triangle(args...); };
-  if (lane_by_lane(near_start, near_start_in_double) || lane_by_lane(scalar, whole_test)) return true;
+  }
   return any;
 }
 
