@@ -5,7 +5,15 @@ machine). Zen 1 and other CPUs with 128-bit vector units split every ymm instruc
 mix says more about the time there than the instruction total does (docs/trace-speed.md).
 
     python3 bench/instruction_mix.py build/bench/trace_only [diffuse|primary|shadow] [rings] [room|soup]
-    (soup: bench_trace's triangle soup of rings x 1000 triangles instead of the sphere)
+        [--lines N]
+    (soup: bench_trace's triangle soup of rings x 1000 triangles instead of the sphere; --lines N:
+    TOYRT's N most executed source lines, innermost inlined line first, for a build with -g, e.g.
+    cmake -S . -B /tmp/build-v3g -DCMAKE_BUILD_TYPE=Release -DTOYRT_NATIVE_ARCH=OFF
+    "-DCMAKE_CXX_FLAGS=-march=x86-64-v3 -g"; TOYRT_FRAME=1024x768 in the environment gives
+    bench_trace's camera frame, see trace_only.cpp)
+
+The stack column counts the instructions that read or write the stack frame (an operand on %rbp
+or %rsp, push and pop): most of them are a register allocator's spills and reloads.
 
 Needs valgrind (apt-get install valgrind) and objdump. Each engine runs the set once and three
 times; the difference over the extra rays is what a ray costs, without the scene's build and the
@@ -88,6 +96,21 @@ def disassemble(obj, addresses):
     return text
 
 
+def touches_stack(instruction):
+    mnemonic, _, operands = instruction.partition(" ")
+    return mnemonic.startswith(("push", "pop")) or re.search(r"\(%r[bs]p[,)]", operands) is not None
+
+
+def source_lines(obj, addresses):
+    """file:line of each address of `obj` (the innermost inlined function's line), from addr2line:
+    '??:0' where the build has no debug information."""
+    addresses = sorted(addresses)
+    out = subprocess.run(["addr2line", "-e", obj, "-a"] + [f"{a:#x}" for a in addresses], capture_output=True,
+                         text=True, check=True).stdout.splitlines()
+    # Two lines an address: the address echoed, then file:line (with " (discriminator N)" at times).
+    return {int(out[2 * i], 16): Path(out[2 * i + 1].split(" ")[0]).name for i in range(len(addresses))}
+
+
 def kind_of(instruction):
     mnemonic, _, operands = instruction.partition(" ")
     if "%ymm" in operands or "%zmm" in operands:
@@ -97,7 +120,7 @@ def kind_of(instruction):
     return mnemonic, "general"
 
 
-def mix(trace_only, ray_set, rings, extra, engine):
+def mix(trace_only, ray_set, rings, extra, engine, with_lines=False):
     # (A name may begin with its return type: "bool toyrt::Mesh::trace<false>(...)".)
     keep_toyrt = lambda obj, fn: "trace_only" in obj and "toyrt::" in fn and "toyrt::testing::" not in fn  # noqa: E731
     keep_embree = lambda obj, fn: "libembree" in obj  # noqa: E731
@@ -114,15 +137,19 @@ def mix(trace_only, ray_set, rings, extra, engine):
             counts.append(costs_by_address(profile, keep))
     rays = int(re.search(r"(\d+) rays", report).group(1)) * 2  # the extra two repeats
     per_ray = {k: (counts[1][k] - counts[0].get(k, 0)) / rays for k in counts[1]}
-    by_kind, by_mnemonic = collections.Counter(), collections.Counter()
+    by_kind, by_mnemonic, by_line = collections.Counter(), collections.Counter(), collections.Counter()
     for obj in {o for o, _ in per_ray}:
         addresses = [a for o, a in per_ray if o == obj]
         text = disassemble(obj, addresses)
+        lines = source_lines(obj, addresses) if with_lines else {}
         for a in addresses:
             mnemonic, kind = kind_of(text[a]) if a in text else ("(not disassembled)", "general")
             by_kind[kind] += per_ray[(obj, a)]
+            if a in text and touches_stack(text[a]):
+                by_kind["stack"] += per_ray[(obj, a)]
             by_mnemonic[(mnemonic, kind)] += per_ray[(obj, a)]
-    return by_kind, by_mnemonic
+            by_line[lines.get(a, "?")] += per_ray[(obj, a)]
+    return by_kind, by_mnemonic, by_line
 
 
 def main():
@@ -132,22 +159,34 @@ def main():
     parser.add_argument("rings", nargs="?", type=int, default=71, help="71: the 10K-triangle sphere")
     parser.add_argument("mesh", nargs="?", choices=["room", "soup"],
                         help="room: inside bench_trace's closed room (TOYRT only); soup: the triangle soup")
+    parser.add_argument("--lines", type=int, default=0, metavar="N",
+                        help="TOYRT's N most executed source lines (a build with -g)")
     args = parser.parse_args()
+    if args.lines < 0:
+        parser.error("--lines: a count of lines, 0 or more")
     room = args.mesh == "room"
     engines = ["toyrt"] + ([] if room else ["embree"])
     what = {"room": f"{args.rings} rings in the closed room", "soup": f"a soup of {args.rings}K triangles"}
     print(f"{args.ray_set} rays, {what.get(args.mesh, f'{args.rings} rings')}: instructions a ray")
-    print(f"{'engine':8} {'total':>7} {'general':>8} {'xmm':>6} {'ymm':>6} {'vector uops, 128-bit units':>27}")
-    mnemonics = {}
+    print(f"{'engine':8} {'total':>7} {'general':>8} {'xmm':>6} {'ymm':>6} {'vector uops, 128-bit units':>27} "
+          f"{'stack':>6}")
+    mnemonics, lines = {}, {}
     for engine in engines:
-        by_kind, mnemonics[engine] = mix(args.trace_only, args.ray_set, args.rings, [args.mesh] if args.mesh else [],
-                                         engine)
-        total = sum(by_kind.values())
+        by_kind, mnemonics[engine], lines[engine] = mix(args.trace_only, args.ray_set, args.rings,
+                                                        [args.mesh] if args.mesh else [], engine,
+                                                        with_lines=engine == "toyrt" and args.lines > 0)
+        total = by_kind["general"] + by_kind["xmm"] + by_kind["ymm"]
         print(f"{engine:8} {total:7.0f} {by_kind['general']:8.0f} {by_kind['xmm']:6.0f} {by_kind['ymm']:6.0f} "
-              f"{by_kind['xmm'] + 2 * by_kind['ymm']:27.0f}")
+              f"{by_kind['xmm'] + 2 * by_kind['ymm']:27.0f} {by_kind['stack']:6.0f}")
     for engine in engines:
         top = sorted(mnemonics[engine].items(), key=lambda kv: -kv[1])[:16]
         print(f"\n{engine}, the most executed: " + ", ".join(f"{m} ({k}) {c:.1f}" for (m, k), c in top))
+    if args.lines:
+        top = sorted(lines["toyrt"].items(), key=lambda kv: -kv[1])[:args.lines]
+        if all(line.startswith("??") for line, _ in top):
+            print("\ntoyrt: no source lines (build with -g)")
+        else:
+            print("\ntoyrt, by source line: " + ", ".join(f"{line} {c:.1f}" for line, c in top))
     return 0
 
 
