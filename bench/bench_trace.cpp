@@ -325,10 +325,13 @@ int main(int argc, char** argv) {
      << "through TOYRT's tree of the 1M sphere enters nodes worth 12.4 against Embree's 13.4 and tests 2.96 blocks of "
      << "eight triangles where Embree's tests 3.55 of four. On the 1M sphere's diffuse rays TOYRT reads no more cache "
      << "lines than Embree (a simulated 1 MB cache: 9.3 misses a ray against Embree's 10.3) but executes about 40 % "
-     << "more instructions a ray (29 % at 10K, where the rows are at or near 1), as its exact test shears nine vertex "
-     << "coordinates per block for each ray and keeps its arithmetic unfused, so that every CPU level of the wheels "
-     << "returns the same bits; on the soup a closest-hit ray tests five blocks. [trace-speed.md](trace-speed.md) "
-     << "records what each change bought and what was tried and dropped.\n";
+     << "more instructions a ray (29 % at 10K, where the rows are at or near 1), and most of the difference (56-86 % "
+     << "in x86-64-v3 builds, on the diffuse rays of the 1M sphere and the soup) reads and writes the stack: the "
+     << "compiler's spills and reloads around each leaf and node visit, where the walk and the inlined exact test "
+     << "(which shears nine vertex coordinates per block for each ray, its arithmetic unfused, so that every CPU "
+     << "level of the wheels returns the same bits) need more registers than the CPU has; on the soup a closest-hit "
+     << "ray tests five blocks. [trace-speed.md](trace-speed.md) records what each change bought and what was tried "
+     << "and dropped.\n";
   md << "\n## Building\n\nThe whole operation in each engine: TOYRT's `add_mesh` and `commit()`, Embree's device, "
      << "buffers and build, in alternation after a warm-up pair; at least 5 runs each, and for small meshes as many "
      << "as fit in two seconds (up to 51); medians of the times, and the median of the per-run ratios of TOYRT's "
