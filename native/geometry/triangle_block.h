@@ -232,14 +232,17 @@ template <int kZ, bool AnyHit, bool kSkip, class OnHit>
 template <bool AnyHit, bool kSkip, class OnHit>
 [[gnu::always_inline]] inline bool intersect_block(const WatertightRay& r, const BlockRay& br, const TriangleBlock& b,
                                                    float tnear, float tfar, int32_t skip, OnHit&& hit) {
-  if constexpr (!AnyHit) return intersect_block_along<-1, AnyHit, kSkip>(r, br, b, tnear, tfar, skip, hit);
-  switch (br.kz) {
-    case 0:
-      return intersect_block_along<0, AnyHit, kSkip>(r, br, b, tnear, tfar, skip, hit);
-    case 1:
-      return intersect_block_along<1, AnyHit, kSkip>(r, br, b, tnear, tfar, skip, hit);
-    default:
-      return intersect_block_along<2, AnyHit, kSkip>(r, br, b, tnear, tfar, skip, hit);
+  if constexpr (!AnyHit) {
+    return intersect_block_along<-1, AnyHit, kSkip>(r, br, b, tnear, tfar, skip, hit);
+  } else {
+    switch (br.kz) {
+      case 0:
+        return intersect_block_along<0, AnyHit, kSkip>(r, br, b, tnear, tfar, skip, hit);
+      case 1:
+        return intersect_block_along<1, AnyHit, kSkip>(r, br, b, tnear, tfar, skip, hit);
+      default:
+        return intersect_block_along<2, AnyHit, kSkip>(r, br, b, tnear, tfar, skip, hit);
+    }
   }
 }
 
